@@ -1,0 +1,136 @@
+// The 8-node hexahedron with one-point (uniform strain) integration of Flanagan and
+// Belytschko (1981, IJNME 17, 679-706). Written once as templates over the value type:
+// `double` for setup and tests, simd::vdouble in the vectorised kernel, so both paths
+// run the same arithmetic in the same order.
+#pragma once
+
+#include <array>
+
+namespace anvil::hex8 {
+
+// Hourglass base vectors Gamma (eta zeta, xi zeta, xi eta, xi eta zeta at the nodes).
+inline constexpr double gamma_base[4][8] = {{1, 1, -1, -1, -1, -1, 1, 1},
+                                            {1, -1, -1, 1, -1, 1, 1, -1},
+                                            {1, -1, 1, -1, 1, -1, 1, -1},
+                                            {-1, 1, -1, 1, 1, -1, 1, -1}};
+
+// For node a, the nodes that play "2..8" in Flanagan and Belytschko's formula for b_1.
+inline constexpr int fb_perm[8][7] = {{1, 2, 3, 4, 5, 6, 7}, {2, 3, 0, 5, 6, 7, 4},
+                                      {3, 0, 1, 6, 7, 4, 5}, {0, 1, 2, 7, 4, 5, 6},
+                                      {7, 6, 5, 0, 3, 2, 1}, {4, 7, 6, 1, 0, 3, 2},
+                                      {5, 4, 7, 2, 1, 0, 3}, {6, 5, 4, 3, 2, 1, 0}};
+
+// Gradient operator B_ia = integral over the element of dN_a/dx_i = dV/dx_ia, exact for
+// the trilinear map (Flanagan and Belytschko eq. 79). x[a][i]: node a, coordinate i.
+template <class V>
+inline void gradient(const V (&x)[8][3], V (&B)[8][3]) {
+  for (int a = 0; a < 8; ++a) {
+    const int* p = fb_perm[a];
+    for (int i = 0; i < 3; ++i) {
+      const int j = (i + 1) % 3, k = (i + 2) % 3;
+      auto y = [&](int n) -> const V& { return x[p[n - 2]][j]; };
+      auto z = [&](int n) -> const V& { return x[p[n - 2]][k]; };
+      B[a][i] = (y(2) * ((z(6) - z(3)) - (z(4) - z(5))) + y(3) * (z(2) - z(4)) +
+                 y(4) * ((z(3) - z(8)) - (z(5) - z(2))) + y(5) * ((z(8) - z(6)) - (z(2) - z(4))) +
+                 y(6) * (z(5) - z(2)) + y(8) * (z(4) - z(5))) *
+                (1.0 / 12.0);
+    }
+  }
+}
+
+// Volume from the gradient: V = sum_a x_a B_xa (exact).
+template <class V>
+inline V volume(const V (&x)[8][3], const V (&B)[8][3]) {
+  V v = x[0][0] * B[0][0];
+  for (int a = 1; a < 8; ++a) v += x[a][0] * B[a][0];
+  return v;
+}
+
+// Sum of B_ia^2, the measure of the element's maximum eigenvalue.
+template <class V>
+inline V gradient_norm2(const V (&B)[8][3]) {
+  V s = B[0][0] * B[0][0];
+  for (int a = 0; a < 8; ++a)
+    for (int i = (a == 0 ? 1 : 0); i < 3; ++i) s += B[a][i] * B[a][i];
+  return s;
+}
+
+// Hourglass shape vectors gamma_alpha = Gamma_alpha - (1/V)(Gamma_alpha . x_i) B_i, which
+// are orthogonal to every linear velocity field on any shape (the property that lets the
+// element pass the patch test with hourglass control on).
+template <class V>
+inline void hourglass_shape(const V (&x)[8][3], const V (&B)[8][3], const V& inv_volume,
+                            V (&g)[4][8]) {
+  for (int al = 0; al < 4; ++al) {
+    V h[3];
+    for (int i = 0; i < 3; ++i) {
+      h[i] = gamma_base[al][0] * x[0][i];
+      for (int a = 1; a < 8; ++a) h[i] += gamma_base[al][a] * x[a][i];
+      h[i] *= inv_volume;
+    }
+    for (int a = 0; a < 8; ++a)
+      g[al][a] = gamma_base[al][a] - (h[0] * B[a][0] + h[1] * B[a][1] + h[2] * B[a][2]);
+  }
+}
+
+// Velocity gradient L_ij = (1/V) sum_a v_ia B_ja split into the rate of deformation
+// d (xx, yy, zz, xy, yz, xz) and the spin's axial vector w (W_zy, W_xz, W_yx).
+template <class V>
+inline void velocity_gradient(const V (&v)[8][3], const V (&B)[8][3], const V& inv_volume,
+                              V (&d)[6], V (&w)[3]) {
+  V L[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      V s = v[0][i] * B[0][j];
+      for (int a = 1; a < 8; ++a) s += v[a][i] * B[a][j];
+      L[i][j] = s * inv_volume;
+    }
+  d[0] = L[0][0];
+  d[1] = L[1][1];
+  d[2] = L[2][2];
+  d[3] = 0.5 * (L[0][1] + L[1][0]);
+  d[4] = 0.5 * (L[1][2] + L[2][1]);
+  d[5] = 0.5 * (L[0][2] + L[2][0]);
+  w[0] = 0.5 * (L[2][1] - L[1][2]);
+  w[1] = 0.5 * (L[0][2] - L[2][0]);
+  w[2] = 0.5 * (L[1][0] - L[0][1]);
+}
+
+// Incremental rotation of Hughes and Winget (1980): Q = (I - A)^-1 (I + A), A = dt/2 W,
+// which for a skew A with axial vector a is Q = I + 2 (A + A^2) / (1 + |a|^2). It is
+// exactly orthogonal and reproduces the rotation of the mid-step configuration, so a
+// rigidly spinning body keeps its stress unchanged but for the rotation.
+template <class V>
+inline void hughes_winget(const V (&w)[3], double dt, V (&Q)[3][3]) {
+  const V a0 = (0.5 * dt) * w[0], a1 = (0.5 * dt) * w[1], a2 = (0.5 * dt) * w[2];
+  const V k = 2.0 / (1.0 + (a0 * a0 + a1 * a1 + a2 * a2));
+  // A = [[0, -a2, a1], [a2, 0, -a0], [-a1, a0, 0]]; A^2 = a a^T - |a|^2 I.
+  const V n2 = a0 * a0 + a1 * a1 + a2 * a2;
+  Q[0][0] = 1.0 + k * (a0 * a0 - n2);
+  Q[1][1] = 1.0 + k * (a1 * a1 - n2);
+  Q[2][2] = 1.0 + k * (a2 * a2 - n2);
+  Q[0][1] = k * (a0 * a1 - a2);
+  Q[1][0] = k * (a0 * a1 + a2);
+  Q[0][2] = k * (a0 * a2 + a1);
+  Q[2][0] = k * (a0 * a2 - a1);
+  Q[1][2] = k * (a1 * a2 - a0);
+  Q[2][1] = k * (a1 * a2 + a0);
+}
+
+// s <- Q s Q^T for a symmetric tensor in (xx, yy, zz, xy, yz, xz) order.
+template <class V>
+inline void rotate_symmetric(const V (&Q)[3][3], V (&s)[6]) {
+  const V S[3][3] = {{s[0], s[3], s[5]}, {s[3], s[1], s[4]}, {s[5], s[4], s[2]}};
+  V T[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) T[i][j] = Q[i][0] * S[0][j] + Q[i][1] * S[1][j] + Q[i][2] * S[2][j];
+  auto r = [&](int i, int j) { return T[i][0] * Q[j][0] + T[i][1] * Q[j][1] + T[i][2] * Q[j][2]; };
+  s[0] = r(0, 0);
+  s[1] = r(1, 1);
+  s[2] = r(2, 2);
+  s[3] = r(0, 1);
+  s[4] = r(1, 2);
+  s[5] = r(0, 2);
+}
+
+} // namespace anvil::hex8

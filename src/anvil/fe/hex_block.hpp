@@ -1,0 +1,99 @@
+// A block of hexahedra on one rank (one part: one material, one hourglass control) and
+// the element kernel that turns nodal positions and velocities into corner forces:
+// stress update at the mid-step (Jaumann rate through the Hughes-Winget rotation),
+// constitutive update through the material's batch interface, internal forces from the
+// uniform-strain gradient, Flanagan-Belytschko hourglass forces, artificial bulk
+// viscosity and the element stable time step. The kernel knows nothing of MPI.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "anvil/material/material.hpp"
+
+namespace anvil {
+
+struct HourglassControl {
+  enum class Model { viscous, stiffness };
+  Model model = Model::viscous;
+  // Viscous: Q = coefficient/4 rho c V^(2/3) q (LS-DYNA's scaling of its type 1-3).
+  // Stiffness: dQ/dt = coefficient (lambda + 2 mu) (B:B) / (3 V) q (Flanagan-Belytschko).
+  double coefficient = 0.1;
+};
+
+// Artificial bulk viscosity q = rho l (quadratic l |tr D| - linear c) tr D when the
+// element compresses (tr D < 0), l = V^(1/3) (von Neumann-Richtmyer plus Landshoff, with
+// LS-DYNA's default coefficients).
+struct BulkViscosity {
+  double quadratic = 1.5;
+  double linear = 0.06;
+};
+
+struct HexBlock {
+  std::string name;                       // part name
+  int part = 0;                           // part index in the deck
+  const Material* material = nullptr;     // not owned
+  HourglassControl hourglass;
+  BulkViscosity bulk_viscosity;
+
+  std::vector<std::int64_t> gid;          // global element ids, ascending
+  std::array<std::vector<int>, 8> conn;   // local node index of each corner
+  std::vector<double> mass;               // kg
+  std::vector<double> volume;             // current volume, m^3
+  std::array<std::vector<double>, 6> stress; // Cauchy stress, Pa
+  std::vector<double> plastic_strain;     // empty unless the material has it
+  std::vector<double> temperature;        // empty unless the material has it
+  std::array<std::vector<double>, 12> hourglass_force; // Q_i,alpha, stiffness form only
+  std::vector<double> internal_energy;    // J, stress work plus bulk viscosity work
+  std::vector<double> hourglass_energy;   // J
+  std::size_t corner_base = 0;            // corner (e, a) of this block lives at slot
+                                          // corner_base + a * size() + e
+
+  int size() const { return static_cast<int>(gid.size()); }
+  // Sizes every state array for `n` elements (connectivity and gid set by the caller).
+  void allocate_state();
+};
+
+struct NodalView {
+  const double* x[3]; // positions at t(n)
+  const double* v[3]; // velocities at t(n - 1/2)
+};
+
+struct CornerView {
+  double* f[3]; // corner forces, indexed by slot
+};
+
+// What one kernel call reports back.
+struct HexResult {
+  double dt_stable = 1e300;        // smallest element stable time step, s
+  std::int64_t stable_gid = -1;    // element that controls it
+  std::int64_t inverted_gid = -1;  // first element (by gid) with non-positive volume, or -1
+  std::int64_t nonfinite_gid = -1; // first element with a non-finite force or stress, or -1
+};
+
+// Scratch space reused by every call (the cycle allocates nothing).
+class HexWorkspace {
+public:
+  static constexpr int chunk = 64; // elements per material batch
+  HexWorkspace();
+
+private:
+  friend void hex_forces(HexBlock&, const NodalView&, double, CornerView, HexWorkspace&,
+                         HexResult&);
+  std::vector<double> buf_;
+};
+
+// Cycle step 1 for one block: updates stress and state from the velocities over the
+// previous interval dt_prev (0 on the first cycle: no increment), writes the corner
+// forces at the current positions, accumulates element energies and reports the stable
+// time step. Positions are at t(n), velocities at t(n - 1/2).
+void hex_forces(HexBlock& block, const NodalView& nodes, double dt_prev, CornerView corners,
+                HexWorkspace& work, HexResult& result);
+
+// Element volumes at the given positions (setup and output).
+void hex_volumes(const HexBlock& block, const double* const x[3], std::span<double> out);
+
+} // namespace anvil

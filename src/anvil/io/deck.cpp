@@ -1,0 +1,489 @@
+#include "anvil/io/deck.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+
+namespace anvil {
+
+const MaterialConfig* Config::material(const std::string& name) const {
+  for (const auto& m : materials)
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+namespace {
+
+// A YAML node together with the file and key path it was found at, so that every check
+// can say where the problem is.
+class Node {
+public:
+  Node(YAML::Node n, std::string path, const std::string* file, int fallback_line)
+      : n_(std::move(n)), path_(std::move(path)), file_(file), fallback_line_(fallback_line) {}
+
+  const std::string& path() const { return path_; }
+  int line() const {
+    const auto m = n_.Mark();
+    return m.line >= 0 ? m.line + 1 : fallback_line_;
+  }
+  SourceLocation where() const { return {*file_, line(), path_}; }
+  [[noreturn]] void fail(const std::string& msg) const { throw InputError(where(), msg); }
+
+  bool is_map() const { return n_.IsMap(); }
+  bool is_seq() const { return n_.IsSequence(); }
+  bool is_scalar() const { return n_.IsScalar(); }
+  bool is_null() const { return !n_ || n_.IsNull(); }
+
+  // Children of a map, in file order, after checking the keys against `allowed` (empty:
+  // any key) and rejecting duplicates.
+  std::vector<std::pair<std::string, Node>> entries(std::initializer_list<std::string_view> allowed = {}) const {
+    if (!n_.IsMap()) fail("expected a mapping (key: value pairs)");
+    std::vector<std::pair<std::string, Node>> out;
+    std::set<std::string> seen;
+    for (auto it = n_.begin(); it != n_.end(); ++it) {
+      const auto key_mark = it->first.Mark();
+      const int kline = key_mark.line >= 0 ? key_mark.line + 1 : line();
+      if (!it->first.IsScalar())
+        throw InputError({*file_, kline, path_}, "keys must be plain names");
+      const std::string key = it->first.Scalar();
+      const std::string sub = path_.empty() ? key : path_ + "." + key;
+      if (allowed.size() > 0 &&
+          std::find(allowed.begin(), allowed.end(), std::string_view(key)) == allowed.end()) {
+        std::string list;
+        for (auto a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+        throw InputError({*file_, kline, sub}, fmt::format("unknown key '{}' (expected one of: {})", key, list));
+      }
+      if (!seen.insert(key).second) throw InputError({*file_, kline, sub}, "duplicate key");
+      out.emplace_back(key, Node(it->second, sub, file_, kline));
+    }
+    return out;
+  }
+  void check_keys(std::initializer_list<std::string_view> allowed) const { (void)entries(allowed); }
+
+  bool has(const std::string& key) const { return n_.IsMap() && n_[key]; }
+  Node child(const std::string& key) const {
+    return Node(n_[key], path_.empty() ? key : path_ + "." + key, file_, line());
+  }
+  Node required(const std::string& key) const {
+    if (!n_.IsMap()) fail("expected a mapping (key: value pairs)");
+    // Reported at the line of the key that owns this mapping (the part's name, say).
+    if (!has(key))
+      throw InputError({*file_, fallback_line_ > 0 ? fallback_line_ : line(), path_.empty() ? key : path_ + "." + key},
+                       "required key is missing");
+    return child(key);
+  }
+  std::vector<Node> items() const {
+    if (!n_.IsSequence()) fail("expected a list");
+    std::vector<Node> out;
+    for (std::size_t i = 0; i < n_.size(); ++i)
+      out.emplace_back(n_[i], fmt::format("{}[{}]", path_, i), file_, line());
+    return out;
+  }
+
+  std::string str() const {
+    if (!n_.IsScalar()) fail("expected a single value");
+    return n_.Scalar();
+  }
+  double number() const {
+    if (!n_.IsScalar()) fail("expected a number");
+    const std::string& s = n_.Scalar();
+    double v = 0;
+    std::size_t used = 0;
+    try {
+      v = std::stod(s, &used);
+    } catch (...) {
+      used = 0;
+    }
+    if (used == 0 || used != s.size() || !std::isfinite(v))
+      fail(fmt::format("expected a finite number, got '{}'", s));
+    return v;
+  }
+  std::int64_t integer() const {
+    const double v = number();
+    if (v != std::floor(v) || std::abs(v) > 9e15) fail(fmt::format("expected an integer, got '{}'", str()));
+    return static_cast<std::int64_t>(v);
+  }
+  double positive() const {
+    const double v = number();
+    if (!(v > 0)) fail(fmt::format("must be positive, got {}", v));
+    return v;
+  }
+  Vec3 vec3() const {
+    if (!n_.IsSequence() || n_.size() != 3) fail("expected a list of three numbers [x, y, z]");
+    const auto it = items();
+    return {it[0].number(), it[1].number(), it[2].number()};
+  }
+  template <std::size_t N>
+  std::array<int, N> positive_ints() const {
+    if (!n_.IsSequence() || n_.size() != N) fail(fmt::format("expected a list of {} positive integers", N));
+    std::array<int, N> out{};
+    const auto it = items();
+    for (std::size_t i = 0; i < N; ++i) {
+      const auto v = it[i].integer();
+      if (v < 1 || v > 100000000) it[i].fail("must be a positive integer");
+      out[i] = static_cast<int>(v);
+    }
+    return out;
+  }
+  int axis() const {
+    const std::string s = str();
+    if (s == "x") return 0;
+    if (s == "y") return 1;
+    if (s == "z") return 2;
+    fail(fmt::format("axis must be x, y or z, got '{}'", s));
+  }
+  // A list of components: [x, z], or `all`.
+  std::array<bool, 3> components() const {
+    std::array<bool, 3> out{false, false, false};
+    if (n_.IsScalar() && n_.Scalar() == "all") return {true, true, true};
+    for (const auto& c : items()) out[c.axis()] = true;
+    return out;
+  }
+
+private:
+  YAML::Node n_;
+  std::string path_;
+  const std::string* file_;
+  int fallback_line_;
+};
+
+// Generated meshes define these sets; file meshes define their own (checked at setup).
+std::vector<std::string> generated_sets(MeshConfig::Kind kind) {
+  switch (kind) {
+  case MeshConfig::Kind::box: return {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+  case MeshConfig::Kind::cylinder: return {"bottom", "top", "outer"};
+  case MeshConfig::Kind::can: return {"bottom", "top", "inner", "outer"};
+  case MeshConfig::Kind::file: return {};
+  }
+  return {};
+}
+
+MaterialConfig parse_material(const std::string& name, const Node& n) {
+  MaterialConfig m;
+  m.name = name;
+  m.where = n.where();
+  const std::string model = n.required("model").str();
+  const MaterialModel* info = find_material_model(model);
+  if (!info) {
+    std::string list;
+    for (const auto& mm : material_models()) list += (list.empty() ? "" : ", ") + std::string(mm.name);
+    n.child("model").fail(fmt::format("unknown material model '{}' (available: {})", model, list));
+  }
+  m.model = model;
+  for (const auto& [key, v] : n.entries()) {
+    if (key == "model") continue;
+    const auto spec = std::find_if(info->params.begin(), info->params.end(),
+                                   [&](const ParamSpec& p) { return p.name == key; });
+    if (spec == info->params.end()) {
+      std::string list;
+      for (const auto& p : info->params) list += (list.empty() ? "" : ", ") + std::string(p.name);
+      v.fail(fmt::format("unknown parameter '{}' for model {} (expected: {})", key, model, list));
+    }
+    const double x = v.number();
+    const bool low_ok = spec->min_exclusive ? x > spec->min : x >= spec->min;
+    const bool high_ok = spec->max_exclusive ? x < spec->max : x <= spec->max;
+    if (!low_ok || !high_ok) {
+      std::string range;
+      if (spec->min > -1e299) range += fmt::format("{} {}", spec->min_exclusive ? ">" : ">=", spec->min);
+      if (spec->max < 1e299)
+        range += fmt::format("{}{} {}", range.empty() ? "" : " and ", spec->max_exclusive ? "<" : "<=", spec->max);
+      v.fail(fmt::format("{} = {} is impossible: must be {}", key, x, range));
+    }
+    m.params[key] = x;
+  }
+  for (const auto& p : info->params) {
+    if (m.params.count(std::string(p.name))) continue;
+    if (p.required)
+      throw InputError({m.where.file, m.where.line, m.where.key + "." + std::string(p.name)},
+                       fmt::format("required parameter of model {} is missing", model));
+    m.params[std::string(p.name)] = p.default_value;
+  }
+  if (model == "johnson_cook" && !(m.params["melt_temperature"] > m.params["room_temperature"]))
+    throw InputError({m.where.file, m.where.line, m.where.key + ".melt_temperature"},
+                     "melt_temperature must exceed room_temperature");
+  return m;
+}
+
+MeshConfig parse_mesh(const Node& n, const std::string& base_dir) {
+  MeshConfig mc;
+  mc.where = n.where();
+  if (n.has("file")) {
+    n.check_keys({"file"});
+    mc.kind = MeshConfig::Kind::file;
+    std::filesystem::path p(n.child("file").str());
+    if (p.is_relative()) p = std::filesystem::path(base_dir) / p;
+    mc.file = p.string();
+    if (!std::filesystem::exists(p)) n.child("file").fail(fmt::format("mesh file '{}' does not exist", mc.file));
+    return mc;
+  }
+  const std::string gen = n.required("generate").str();
+  if (gen == "box") {
+    n.check_keys({"generate", "min", "max", "divisions"});
+    mc.kind = MeshConfig::Kind::box;
+    mc.box.min = n.required("min").vec3();
+    mc.box.max = n.required("max").vec3();
+    mc.box.divisions = n.required("divisions").positive_ints<3>();
+    for (int i = 0; i < 3; ++i)
+      if (!(mc.box.max[i] > mc.box.min[i])) n.child("max").fail("max must exceed min in every direction");
+  } else if (gen == "cylinder") {
+    n.check_keys({"generate", "radius", "length", "axis", "origin", "divisions"});
+    mc.kind = MeshConfig::Kind::cylinder;
+    mc.cylinder.radius = n.required("radius").positive();
+    mc.cylinder.length = n.required("length").positive();
+    if (n.has("axis")) mc.cylinder.axis = n.child("axis").axis();
+    if (n.has("origin")) mc.cylinder.origin = n.child("origin").vec3();
+    mc.cylinder.divisions = n.required("divisions").positive_ints<2>();
+    if (mc.cylinder.divisions[0] < 2) n.child("divisions").fail("needs at least 2 elements across the radius");
+  } else if (gen == "can") {
+    n.check_keys({"generate", "radius", "height", "thickness", "axis", "origin", "divisions"});
+    mc.kind = MeshConfig::Kind::can;
+    mc.can.radius = n.required("radius").positive();
+    mc.can.height = n.required("height").positive();
+    mc.can.thickness = n.required("thickness").positive();
+    if (mc.can.thickness >= 2 * mc.can.radius) n.child("thickness").fail("must be less than the diameter");
+    if (n.has("axis")) mc.can.axis = n.child("axis").axis();
+    if (n.has("origin")) mc.can.origin = n.child("origin").vec3();
+    mc.can.divisions = n.required("divisions").positive_ints<3>();
+    if (mc.can.divisions[0] < 3) n.child("divisions").fail("needs at least 3 elements around");
+  } else {
+    n.child("generate").fail(fmt::format("unknown generator '{}' (expected box, cylinder or can)", gen));
+  }
+  return mc;
+}
+
+PartConfig parse_part(const std::string& name, const Node& n, const std::string& base_dir) {
+  PartConfig p;
+  p.name = name;
+  p.where = n.where();
+  n.check_keys({"mesh", "material", "hourglass", "bulk_viscosity"});
+  p.mesh = parse_mesh(n.required("mesh"), base_dir);
+  p.material = n.required("material").str();
+  if (n.has("hourglass")) {
+    const Node h = n.child("hourglass");
+    h.check_keys({"model", "coefficient"});
+    if (h.has("model")) {
+      const std::string m = h.child("model").str();
+      if (m == "viscous") p.hourglass.model = HourglassControl::Model::viscous;
+      else if (m == "stiffness") p.hourglass.model = HourglassControl::Model::stiffness;
+      else h.child("model").fail(fmt::format("unknown hourglass model '{}' (expected viscous or stiffness)", m));
+    }
+    if (h.has("coefficient")) {
+      const double c = h.child("coefficient").number();
+      if (!(c >= 0 && c <= 1)) h.child("coefficient").fail("must be between 0 and 1");
+      p.hourglass.coefficient = c;
+    }
+  }
+  if (n.has("bulk_viscosity")) {
+    const Node b = n.child("bulk_viscosity");
+    b.check_keys({"linear", "quadratic"});
+    if (b.has("linear")) p.bulk_viscosity.linear = b.child("linear").number();
+    if (b.has("quadratic")) p.bulk_viscosity.quadratic = b.child("quadratic").number();
+    if (p.bulk_viscosity.linear < 0) b.child("linear").fail("must not be negative");
+    if (p.bulk_viscosity.quadratic < 0) b.child("quadratic").fail("must not be negative");
+  }
+  return p;
+}
+
+Box3 parse_box(const Node& n) {
+  n.check_keys({"min", "max"});
+  Box3 b{n.required("min").vec3(), n.required("max").vec3()};
+  for (int i = 0; i < 3; ++i)
+    if (b.hi[i] < b.lo[i]) n.child("max").fail("max must not be below min");
+  return b;
+}
+
+// An inline selection {part, box} (either or both).
+Selection parse_inline_selection(const Node& n) {
+  Selection s;
+  s.where = n.where();
+  n.check_keys({"part", "box"});
+  if (n.has("part")) s.part = n.child("part").str();
+  if (n.has("box")) s.box = parse_box(n.child("box"));
+  if (!s.part && !s.box) n.fail("a selection needs a part, a box, or both");
+  return s;
+}
+
+// A set reference: a name, or an inline selection.
+Selection parse_set_ref(const Node& n) {
+  if (n.is_map()) return parse_inline_selection(n);
+  Selection s;
+  s.name = n.str();
+  s.where = n.where();
+  return s;
+}
+
+} // namespace
+
+Config parse_deck(const std::string& text, const std::string& name, const std::string& base_dir) {
+  Config c;
+  c.deck_file = name;
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw InputError({name, e.mark.line >= 0 ? e.mark.line + 1 : 0, ""}, "malformed YAML: " + e.msg);
+  }
+  const Node top(root, "", &c.deck_file, 1);
+  if (top.is_null()) throw InputError({name, 1, ""}, "the deck is empty");
+  const auto entries = top.entries({"title", "termination", "time_step", "materials", "parts",
+                                    "particles", "node_sets", "initial_conditions",
+                                    "boundary_conditions", "contact", "rigid_walls", "probes",
+                                    "output"});
+  for (const auto& [key, n] : entries) {
+    if (key == "particles" || key == "contact" || key == "rigid_walls")
+      n.fail(fmt::format("'{}' is part of the deck contract but not implemented in anvil {} yet", key, "0.1"));
+  }
+
+  if (top.has("title")) c.title = top.child("title").str();
+
+  const Node term = top.required("termination");
+  term.check_keys({"time", "cycles"});
+  if (!term.has("time") && !term.has("cycles")) term.fail("give an end time, a number of cycles, or both");
+  if (term.has("time")) c.end_time = term.child("time").positive();
+  if (term.has("cycles")) {
+    c.end_cycles = term.child("cycles").integer();
+    if (c.end_cycles < 0) term.child("cycles").fail("must not be negative");
+  }
+
+  if (top.has("time_step")) {
+    const Node ts = top.child("time_step");
+    ts.check_keys({"scale"});
+    if (ts.has("scale")) {
+      c.time_step_scale = ts.child("scale").number();
+      if (!(c.time_step_scale > 0 && c.time_step_scale <= 1))
+        ts.child("scale").fail("must be in (0, 1]: a fraction of the stable time step");
+    }
+  }
+
+  for (const auto& [mname, mn] : top.required("materials").entries())
+    c.materials.push_back(parse_material(mname, mn));
+  if (c.materials.empty()) top.child("materials").fail("at least one material is needed");
+
+  for (const auto& [pname, pn] : top.required("parts").entries()) {
+    if (pname.find('.') != std::string::npos) pn.fail("part names may not contain '.'");
+    PartConfig p = parse_part(pname, pn, base_dir);
+    if (!c.material(p.material))
+      pn.child("material").fail(fmt::format("material '{}' is not defined under materials", p.material));
+    c.parts.push_back(std::move(p));
+  }
+  if (c.parts.empty()) top.child("parts").fail("at least one part is needed");
+
+  auto part_exists = [&](const std::string& n) {
+    return std::any_of(c.parts.begin(), c.parts.end(), [&](const PartConfig& p) { return p.name == n; });
+  };
+  auto check_part = [&](const Selection& s) {
+    if (s.part && !part_exists(*s.part))
+      throw InputError({s.where.file, s.where.line, s.where.key + ".part"},
+                       fmt::format("part '{}' is not defined under parts", *s.part));
+  };
+  // Named sets: deck sets, then PART.SET of generated meshes; file meshes are checked
+  // once read.
+  auto check_name = [&](const Selection& s) {
+    if (s.name.empty()) return check_part(s);
+    if (c.node_sets.count(s.name)) return;
+    const auto dot = s.name.find('.');
+    if (dot != std::string::npos) {
+      const std::string part = s.name.substr(0, dot), set = s.name.substr(dot + 1);
+      for (const auto& p : c.parts)
+        if (p.name == part) {
+          if (p.mesh.kind == MeshConfig::Kind::file) return;
+          const auto sets = generated_sets(p.mesh.kind);
+          if (std::find(sets.begin(), sets.end(), set) != sets.end()) return;
+          std::string list;
+          for (const auto& x : sets) list += (list.empty() ? "" : ", ") + part + "." + x;
+          throw InputError(s.where, fmt::format("node set '{}' does not exist: part '{}' has {}", s.name, part, list));
+        }
+    }
+    throw InputError(s.where, fmt::format("node set '{}' is not defined (define it under node_sets, or use PART.SET)", s.name));
+  };
+
+  if (top.has("node_sets")) {
+    for (const auto& [sname, sn] : top.child("node_sets").entries()) {
+      Selection s = parse_inline_selection(sn);
+      s.name.clear();
+      check_part(s);
+      c.node_sets[sname] = s;
+    }
+  }
+
+  if (top.has("initial_conditions")) {
+    for (const auto& n : top.child("initial_conditions").items()) {
+      n.check_keys({"part", "set", "velocity", "angular_velocity", "center"});
+      InitialCondition ic;
+      ic.where = n.where();
+      if (n.has("part") == n.has("set")) n.fail("give exactly one of 'part' or 'set'");
+      if (n.has("part")) {
+        ic.nodes.part = n.child("part").str();
+        ic.nodes.where = n.child("part").where();
+      } else {
+        ic.nodes = parse_set_ref(n.child("set"));
+      }
+      check_name(ic.nodes);
+      if (!n.has("velocity") && !n.has("angular_velocity")) n.fail("give a velocity, an angular_velocity, or both");
+      if (n.has("velocity")) ic.velocity = n.child("velocity").vec3();
+      if (n.has("angular_velocity")) {
+        ic.angular_velocity = n.child("angular_velocity").vec3();
+        ic.center = n.required("center").vec3();
+      } else if (n.has("center")) {
+        n.child("center").fail("center is only used with angular_velocity");
+      }
+      c.initial_conditions.push_back(ic);
+    }
+  }
+
+  if (top.has("boundary_conditions")) {
+    for (const auto& n : top.child("boundary_conditions").items()) {
+      n.check_keys({"set", "fix", "velocity", "components"});
+      BoundaryCondition bc;
+      bc.where = n.where();
+      bc.nodes = parse_set_ref(n.required("set"));
+      check_name(bc.nodes);
+      if (n.has("fix") == n.has("velocity")) n.fail("give exactly one of 'fix' or 'velocity'");
+      if (n.has("fix")) {
+        bc.fix = n.child("fix").components();
+        if (n.has("components")) n.child("components").fail("components goes with velocity; list fixed components under fix");
+      } else {
+        bc.prescribed = true;
+        bc.velocity = n.child("velocity").vec3();
+        bc.components = n.has("components") ? n.child("components").components() : std::array<bool, 3>{true, true, true};
+      }
+      c.boundary_conditions.push_back(bc);
+    }
+  }
+
+  if (top.has("probes")) {
+    std::set<std::string> names;
+    for (const auto& n : top.child("probes").items()) {
+      n.check_keys({"name", "at"});
+      ProbeConfig p{n.required("name").str(), n.required("at").vec3(), n.where()};
+      if (!names.insert(p.name).second) n.child("name").fail(fmt::format("probe name '{}' is used twice", p.name));
+      c.probes.push_back(p);
+    }
+  }
+
+  if (top.has("output")) {
+    const Node o = top.child("output");
+    o.check_keys({"fields_every", "history_every"});
+    if (o.has("fields_every")) c.fields_every = o.child("fields_every").positive();
+    if (o.has("history_every")) c.history_every = o.child("history_every").positive();
+  }
+  return c;
+}
+
+Config read_deck(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError({path, 0, ""}, "cannot open the deck file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const auto dir = std::filesystem::path(path).parent_path();
+  return parse_deck(ss.str(), path, dir.empty() ? "." : dir.string());
+}
+
+} // namespace anvil

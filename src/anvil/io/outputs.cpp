@@ -1,0 +1,254 @@
+#include "anvil/io/outputs.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "anvil/io/files.hpp"
+#include "anvil/version.hpp"
+
+namespace anvil {
+
+VtuPiece fe_piece(const Simulation& sim) {
+  VtuPiece p;
+  const auto& nd = sim.nodes();
+  const std::size_t nn = nd.size();
+  p.points.resize(3 * nn);
+  VtuArray disp{"displacement", 3}, vel{"velocity", 3}, nid{"node_id", 1};
+  nid.is_int = true;
+  disp.f64.resize(3 * nn);
+  vel.f64.resize(3 * nn);
+  nid.i64.resize(nn);
+  for (std::size_t n = 0; n < nn; ++n) {
+    for (int i = 0; i < 3; ++i) {
+      p.points[3 * n + i] = nd.x[i][n];
+      disp.f64[3 * n + i] = nd.x[i][n] - nd.x0[i][n];
+      vel.f64[3 * n + i] = nd.v[i][n];
+    }
+    nid.i64[n] = sim.fe().node_gid[n] + 1;
+  }
+  p.point_data = {std::move(disp), std::move(vel), std::move(nid)};
+
+  VtuArray stress{"stress", 6}, vm{"von_mises", 1}, pres{"pressure", 1}, ep{"plastic_strain", 1},
+      temp{"temperature", 1}, rank{"fe_rank", 1}, eid{"element_id", 1}, part{"part", 1};
+  rank.is_int = eid.is_int = part.is_int = true;
+  bool any_temp = false;
+  for (const auto& b : sim.blocks()) {
+    for (int e = 0; e < b.size(); ++e) {
+      for (int a = 0; a < 8; ++a) p.connectivity.push_back(b.conn[a][e]);
+      p.offsets.push_back(static_cast<std::int64_t>(p.connectivity.size()));
+      p.types.push_back(12);
+      double s[6];
+      for (int k = 0; k < 6; ++k) {
+        s[k] = b.stress[k][e];
+        stress.f64.push_back(s[k]);
+      }
+      const double m = (s[0] + s[1] + s[2]) / 3;
+      const double j2 = 0.5 * ((s[0] - m) * (s[0] - m) + (s[1] - m) * (s[1] - m) + (s[2] - m) * (s[2] - m)) +
+                        s[3] * s[3] + s[4] * s[4] + s[5] * s[5];
+      vm.f64.push_back(std::sqrt(3 * j2));
+      pres.f64.push_back(-m);
+      ep.f64.push_back(b.plastic_strain.empty() ? 0.0 : b.plastic_strain[e]);
+      temp.f64.push_back(b.temperature.empty() ? 0.0 : b.temperature[e]);
+      any_temp = any_temp || !b.temperature.empty();
+      rank.i64.push_back(sim.comm().rank());
+      eid.i64.push_back(b.gid[e] + 1);
+      part.i64.push_back(b.part);
+    }
+  }
+  // Every rank must list the same arrays: temperature appears when any part has it.
+  const bool temp_anywhere = sim.comm().max(static_cast<std::int64_t>(any_temp)) > 0;
+  p.cell_data = {std::move(stress), std::move(vm), std::move(pres), std::move(ep)};
+  if (temp_anywhere) p.cell_data.push_back(std::move(temp));
+  p.cell_data.push_back(std::move(rank));
+  p.cell_data.push_back(std::move(eid));
+  p.cell_data.push_back(std::move(part));
+  return p;
+}
+
+Outputs::Outputs(const Simulation& sim, OutputOptions options) : sim_(sim), opt_(std::move(options)) {
+  // Rank 0 creates the directories; the others wait for it.
+  std::int64_t ok = 1;
+  std::string err;
+  if (sim_.comm().rank() == 0) {
+    try {
+      make_directories(opt_.directory);
+      make_directories(opt_.directory + "/fields");
+    } catch (const InputError& e) {
+      ok = 0;
+      err = e.what();
+    }
+  }
+  ok = sim_.comm().min(ok);
+  sim_.comm().broadcast(err, 0);
+  if (!ok) throw InputError(err);
+  tty_ = sim_.comm().rank() == 0 && ::isatty(STDOUT_FILENO);
+}
+
+Outputs::~Outputs() {
+  if (history_) std::fclose(history_);
+}
+
+double Outputs::loop_seconds() const { return wall_seconds() - start_wall_; }
+
+void Outputs::begin() {
+  start_wall_ = last_progress_wall_ = wall_seconds();
+  const Config& c = sim_.config();
+  if (sim_.comm().rank() == 0) {
+    history_ = std::fopen((opt_.directory + "/history.csv").c_str(), "w");
+    if (!history_) throw InputError("cannot write " + opt_.directory + "/history.csv");
+    std::string h = "time,cycle,dt,kinetic,internal,hourglass,contact,external_work,total";
+    for (const auto& p : c.probes)
+      for (const char* f : {"ux", "uy", "uz", "vx", "vy", "vz"}) h += fmt::format(",{}.{}", p.name, f);
+    std::fprintf(history_, "%s\n", h.c_str());
+    std::fflush(history_);
+  }
+  write_fields();
+  next_fields_ = c.fields_every > 0 ? c.fields_every : std::numeric_limits<double>::infinity();
+  next_history_ = 0;
+}
+
+void Outputs::write_history_row(const Sample& s) {
+  if (!history_) return;
+  std::string row = fmt::format("{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", s.time,
+                                s.cycle, s.dt, s.kinetic, s.internal, s.hourglass, s.contact,
+                                s.external_work, s.total());
+  for (double v : s.probes) row += fmt::format(",{:.17g}", v);
+  std::fprintf(history_, "%s\n", row.c_str());
+  std::fflush(history_);
+}
+
+void Outputs::after_step() {
+  ScopedPhase t(output_timer_, Phase::output);
+  const Config& c = sim_.config();
+  const Clock& clk = sim_.clock();
+  const double t_sample = clk.time - clk.dt; // the step's forces were at t(n)
+  const bool last = sim_.finished();
+  if (t_sample >= next_history_ * (1 - 1e-12) || last) {
+    last_sample_ = sim_.sample();
+    have_sample_ = true;
+    write_history_row(last_sample_);
+    if (c.history_every > 0)
+      while (next_history_ <= t_sample * (1 + 1e-12)) next_history_ += c.history_every;
+  }
+  if (clk.time >= next_fields_ * (1 - 1e-12) || last) {
+    write_fields();
+    while (next_fields_ <= clk.time * (1 + 1e-12)) next_fields_ += c.fields_every;
+  }
+  progress(last);
+}
+
+void Outputs::write_fields() {
+  const Clock& clk = sim_.clock();
+  if (last_field_cycle_ == clk.cycle) return;
+  last_field_cycle_ = clk.cycle;
+  const std::string stem = fmt::format("step_{:06d}", field_count_++);
+  const VtuPiece piece = fe_piece(sim_);
+  write_vtu(fmt::format("{}/fields/{}_r{:04d}.vtu", opt_.directory, stem, sim_.comm().rank()), piece);
+  sim_.comm().barrier(); // every piece is complete before the index names it
+  if (sim_.comm().rank() == 0) {
+    std::vector<std::string> pieces;
+    for (int r = 0; r < sim_.comm().size(); ++r) pieces.push_back(fmt::format("{}_r{:04d}.vtu", stem, r));
+    write_pvtu(fmt::format("{}/fields/{}.pvtu", opt_.directory, stem), pieces, piece);
+    pvd_.emplace_back(clk.time, fmt::format("fields/{}.pvtu", stem));
+    write_pvd(opt_.directory + "/results.pvd", pvd_);
+  }
+}
+
+void Outputs::progress(bool last) {
+  if (!opt_.progress || sim_.comm().rank() != 0) return;
+  const Config& c = sim_.config();
+  const Clock& clk = sim_.clock();
+  double frac = 0;
+  if (std::isfinite(c.end_time)) frac = clk.time / c.end_time;
+  if (c.end_cycles < std::numeric_limits<std::int64_t>::max())
+    frac = std::max(frac, static_cast<double>(clk.cycle) / static_cast<double>(std::max<std::int64_t>(c.end_cycles, 1)));
+  frac = std::min(frac, 1.0);
+  const double now = wall_seconds();
+  const bool due = tty_ ? (now - last_progress_wall_ >= 0.25) : (frac - last_progress_fraction_ >= 0.1 || now - last_progress_wall_ >= 30);
+  if (!due && !last) return;
+  last_progress_wall_ = now;
+  last_progress_fraction_ = frac;
+  const double elapsed = now - start_wall_;
+  const double eta = frac > 0 ? elapsed * (1 - frac) / frac : 0;
+  const double n = static_cast<double>(sim_.global_elements());
+  const double grind = clk.cycle > 0 ? elapsed / static_cast<double>(clk.cycle) / n * 1e6 : 0;
+  const std::string line = fmt::format("cycle {:>8}  t {:.4e} s  dt {:.3e} s  {:5.1f}%  left {:6.1f} s  grind {:.4f} us",
+                                       clk.cycle, clk.time, clk.dt, 100 * frac, eta, grind);
+  if (tty_) std::printf("\r%s%s", line.c_str(), last ? "\n" : "");
+  else std::printf("%s\n", line.c_str());
+  std::fflush(stdout);
+}
+
+void Outputs::finish(int status, const std::string& message) {
+  {
+    ScopedPhase t(output_timer_, Phase::output);
+    write_fields();
+  }
+  write_summary(status, message);
+}
+
+void Outputs::write_summary(int status, const std::string& message) {
+  const Comm& comm = sim_.comm();
+  const double wall = loop_seconds();
+  const auto& timers = sim_.timers().all();
+  std::vector<double> tmax(timers.begin(), timers.end());
+  tmax[static_cast<int>(Phase::output)] += output_timer_.seconds(Phase::output);
+  std::vector<double> tsum = tmax;
+  comm.max(std::span<double>(tmax));
+  comm.sum(std::span<double>(tsum));
+  const Sample s = have_sample_ ? last_sample_ : sim_.sample();
+  if (comm.rank() != 0) return;
+  using nlohmann::json;
+  const Clock& clk = sim_.clock();
+  const double n = static_cast<double>(sim_.global_elements());
+  const double cycles = static_cast<double>(std::max<std::int64_t>(clk.cycle, 1));
+  json j;
+  j["anvil_version"] = std::string(version);
+  j["title"] = sim_.config().title;
+  j["deck"] = sim_.config().deck_file;
+  j["status"] = status == 0 ? "completed" : "failed";
+  j["exit_status"] = status;
+  if (!message.empty()) j["message"] = message;
+  j["ranks"] = comm.size();
+  j["nodes"] = sim_.global_nodes();
+  j["elements"] = sim_.global_elements();
+  j["particles"] = 0;
+  j["cycles"] = clk.cycle;
+  j["time"] = clk.time;
+  j["dt_initial"] = clk.dt_initial;
+  j["dt_final"] = clk.dt;
+  j["wall_seconds"] = wall;
+  j["grind_us"] = wall / cycles / n * 1e6;
+  j["grind_us_compute"] = (wall - tmax[static_cast<int>(Phase::output)]) / cycles / n * 1e6;
+  json t, imb;
+  for (std::size_t p = 0; p < tmax.size(); ++p) t[std::string(phase_names[p])] = tmax[p];
+  j["timers"] = t;
+  auto ratio = [&](Phase p) {
+    const double mean = tsum[static_cast<int>(p)] / comm.size();
+    return mean > 0 ? tmax[static_cast<int>(p)] / mean : 1.0;
+  };
+  imb["fe"] = ratio(Phase::fe);
+  imb["sph"] = 1.0;
+  imb["contact"] = 1.0;
+  j["imbalance"] = imb;
+  j["energy"] = {{"time", s.time},
+                 {"kinetic", s.kinetic},
+                 {"internal", s.internal},
+                 {"hourglass", s.hourglass},
+                 {"contact", s.contact},
+                 {"external_work", s.external_work},
+                 {"total", s.total()},
+                 {"balance_error", sim_.balance_error(s)}};
+  json masses = json::object();
+  for (std::size_t i = 0; i < sim_.config().parts.size(); ++i) masses[sim_.config().parts[i].name] = sim_.part_masses()[i];
+  j["part_mass"] = masses;
+  write_file_atomic(opt_.directory + "/summary.json", j.dump(2) + "\n");
+}
+
+} // namespace anvil

@@ -1,0 +1,60 @@
+// The results of a run in OUTDIR (DESIGN.md section 4): results.pvd with a .pvtu and
+// per-rank .vtu pieces per field output, history.csv (energies and probes), and
+// summary.json; plus the progress line on rank 0. Every method is collective.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "anvil/io/vtu.hpp"
+#include "anvil/solver/simulation.hpp"
+
+namespace anvil {
+
+struct OutputOptions {
+  std::string directory = "out";
+  bool progress = true; // progress line on rank 0
+};
+
+class Outputs {
+public:
+  Outputs(const Simulation& sim, OutputOptions options);
+  ~Outputs();
+
+  // Writes the initial fields (t = 0) and opens the history.
+  void begin();
+  // After each step: history row and fields when due, progress line.
+  void after_step();
+  // Final fields (unless just written) and summary.json. `status` is the exit status,
+  // `message` the failure (empty on success).
+  void finish(int status, const std::string& message);
+
+  double loop_seconds() const;
+
+private:
+  void write_fields();
+  void write_history_row(const Sample& s);
+  void write_summary(int status, const std::string& message);
+  void progress(bool last);
+
+  const Simulation& sim_;
+  OutputOptions opt_;
+  std::vector<std::pair<double, std::string>> pvd_;
+  std::FILE* history_ = nullptr;
+  double next_fields_ = 0, next_history_ = 0;
+  std::int64_t last_field_cycle_ = -1;
+  int field_count_ = 0;
+  double start_wall_ = 0, last_progress_wall_ = 0, last_progress_fraction_ = 0;
+  bool tty_ = false;
+  PhaseTimers output_timer_;
+  Sample last_sample_;
+  bool have_sample_ = false;
+};
+
+// The field piece of this rank: points, hexahedra and their nodal and element fields.
+VtuPiece fe_piece(const Simulation& sim);
+
+} // namespace anvil

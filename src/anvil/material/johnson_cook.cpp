@@ -1,0 +1,94 @@
+#include "anvil/material/johnson_cook.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace anvil {
+
+namespace {
+constexpr ParamSpec jc_params[] = {
+    {"density", "kg/m^3", true, 0, 0, 1e300, true, false, "reference mass density"},
+    {"youngs_modulus", "Pa", true, 0, 0, 1e300, true, false, "Young's modulus"},
+    {"poissons_ratio", "-", true, 0, -1, 0.5, true, true, "Poisson's ratio"},
+    {"A", "Pa", true, 0, 0, 1e300, true, false, "yield stress at zero plastic strain"},
+    {"B", "Pa", true, 0, 0, 1e300, false, false, "hardening coefficient"},
+    {"C", "-", false, 0, 0, 1e300, false, false, "strain-rate coefficient"},
+    {"n", "-", true, 0, 0, 1e300, true, false, "hardening exponent"},
+    {"m", "-", false, 1, 0, 1e300, true, false, "thermal softening exponent"},
+    {"reference_strain_rate", "1/s", false, 1, 0, 1e300, true, false,
+     "strain rate at which C has no effect"},
+    {"room_temperature", "K", false, 293, 0, 1e300, true, false, "initial and reference temperature"},
+    {"melt_temperature", "K", true, 0, 0, 1e300, true, false, "melting temperature"},
+    {"specific_heat", "J/(kg K)", true, 0, 0, 1e300, true, false, "specific heat capacity"},
+    {"taylor_quinney", "-", false, 0.9, 0, 1, false, false,
+     "fraction of plastic work converted to heat"},
+};
+} // namespace
+
+std::span<const ParamSpec> JohnsonCook::params() { return jc_params; }
+
+JohnsonCook::JohnsonCook(const ParamValues& p)
+    : Material(p), A_(p.at("A")), B_(p.at("B")), C_(p.at("C")), n_(p.at("n")), m_(p.at("m")),
+      rate0_(p.at("reference_strain_rate")), room_(p.at("room_temperature")),
+      melt_(p.at("melt_temperature")), cp_(p.at("specific_heat")), chi_(p.at("taylor_quinney")) {}
+
+double JohnsonCook::yield_stress(double ep, double rate, double T) const {
+  const double rate_factor = 1 + C_ * std::log(std::max(rate / rate0_, 1.0));
+  const double ts = std::clamp((T - room_) / (melt_ - room_), 0.0, 1.0);
+  const double thermal = 1 - std::pow(ts, m_);
+  return (A_ + B_ * std::pow(std::max(ep, 0.0), n_)) * rate_factor * thermal;
+}
+
+void JohnsonCook::update(const MaterialBatch& b) const {
+  const double G = elastic().shear, lam = elastic().lambda;
+  const double M = elastic().plane_wave_modulus();
+  const double dt = b.dt;
+  for (int p = 0; p < b.n; ++p) {
+    double s[6];
+    const double* d[6] = {b.d[0] + p, b.d[1] + p, b.d[2] + p, b.d[3] + p, b.d[4] + p, b.d[5] + p};
+    const double tr = (*d[0] + *d[1] + *d[2]) * dt;
+    for (int k = 0; k < 3; ++k) s[k] = b.stress[k][p] + lam * tr + 2 * G * *d[k] * dt;
+    for (int k = 3; k < 6; ++k) s[k] = b.stress[k][p] + 2 * G * *d[k] * dt;
+    const double mean = (s[0] + s[1] + s[2]) * (1.0 / 3.0);
+    double dev[6] = {s[0] - mean, s[1] - mean, s[2] - mean, s[3], s[4], s[5]};
+    const double j2 = 0.5 * (dev[0] * dev[0] + dev[1] * dev[1] + dev[2] * dev[2]) +
+                      dev[3] * dev[3] + dev[4] * dev[4] + dev[5] * dev[5];
+    const double q = std::sqrt(3.0 * j2);
+    // Equivalent total strain rate sqrt(2/3 D':D').
+    const double dm = (*d[0] + *d[1] + *d[2]) / 3;
+    const double dd = (*d[0] - dm) * (*d[0] - dm) + (*d[1] - dm) * (*d[1] - dm) +
+                      (*d[2] - dm) * (*d[2] - dm) +
+                      2 * (*d[3] * *d[3] + *d[4] * *d[4] + *d[5] * *d[5]);
+    const double rate = std::sqrt(2.0 / 3.0 * dd);
+    const double ep = b.plastic_strain[p];
+    const double T = b.temperature[p];
+    double dgamma = 0;
+    if (q > yield_stress(ep, rate, T)) {
+      // Solve g(x) = q - 3 G x - sigma_y(ep + x) = 0 on [0, q / 3G]; g is decreasing.
+      double lo = 0, hi = q / (3 * G), x = 0;
+      for (int it = 0; it < 60; ++it) {
+        const double g = q - 3 * G * x - yield_stress(ep + x, rate, T);
+        if (g > 0) lo = x; else hi = x;
+        const double h = 1e-7 * std::max(ep + x, 1e-6);
+        const double slope = -3 * G - (yield_stress(ep + x + h, rate, T) - yield_stress(ep + x, rate, T)) / h;
+        double next = x - g / slope;
+        if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+        if (std::abs(next - x) <= 1e-14 * std::max(1.0, ep) + 1e-16) { x = next; break; }
+        x = next;
+      }
+      dgamma = x;
+      const double scale = 1 - 3 * G * dgamma / q;
+      for (double& c : dev) c *= scale;
+      const double sy = yield_stress(ep + dgamma, rate, T);
+      b.temperature[p] = T + chi_ * sy * dgamma / (b.density[p] * cp_);
+    }
+    b.stress[0][p] = mean + dev[0];
+    b.stress[1][p] = mean + dev[1];
+    b.stress[2][p] = mean + dev[2];
+    for (int k = 3; k < 6; ++k) b.stress[k][p] = dev[k];
+    b.plastic_strain[p] = ep + dgamma;
+    b.wave_speed[p] = std::sqrt(M / b.density[p]);
+  }
+}
+
+} // namespace anvil

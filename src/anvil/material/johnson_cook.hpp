@@ -1,0 +1,28 @@
+#pragma once
+
+#include "anvil/material/material.hpp"
+
+namespace anvil {
+
+// Johnson-Cook viscoplasticity: sigma_y = (A + B ep^n)(1 + C ln(max(rate/rate0, 1)))
+// (1 - T*^m), T* = (T - T_room)/(T_melt - T_room) clipped to [0, 1]; rate is the
+// equivalent total strain rate of the step; radial return solved by safeguarded Newton
+// on the plastic increment with the rate and thermal factors frozen over the step;
+// adiabatic heating dT = taylor_quinney * sigma_y * dep / (density * specific_heat).
+class JohnsonCook : public Material {
+public:
+  explicit JohnsonCook(const ParamValues& p);
+  void update(const MaterialBatch& b) const override;
+  bool has_plastic_strain() const override { return true; }
+  bool has_temperature() const override { return true; }
+  double initial_temperature() const override { return room_; }
+  static std::span<const ParamSpec> params();
+
+  // Yield stress at the given state (exposed for tests).
+  double yield_stress(double plastic_strain, double strain_rate, double temperature) const;
+
+private:
+  double A_, B_, C_, n_, m_, rate0_, room_, melt_, cp_, chi_;
+};
+
+} // namespace anvil

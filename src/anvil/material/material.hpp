@@ -1,0 +1,80 @@
+// Constitutive models behind one interface that works on batches of material points
+// (element centres or particles), structure of arrays, so that the loops inside a model
+// vectorise across points. Stresses are Cauchy, tensile positive, in Pa; tensor
+// components in the order xx, yy, zz, xy, yz, xz (tensor shear, not engineering).
+#pragma once
+
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace anvil {
+
+// One batch of points. The caller owns every array; each holds `n` values.
+struct MaterialBatch {
+  int n = 0;
+  double dt = 0;                 // time increment, s
+  const double* d[6] = {};       // rate of deformation at the mid-step, 1/s
+  const double* density = {};    // current density, kg/m^3
+  double* stress[6] = {};        // in: old stress already rotated to the new frame; out: new
+  double* plastic_strain = {};   // equivalent plastic strain (models with plasticity)
+  double* temperature = {};      // K (models with thermal softening)
+  double* wave_speed = {};       // out: longitudinal wave speed, m/s
+};
+
+// A deck parameter of a model: name, unit, and the admissible range that the deck reader
+// enforces with file, line and key in the message.
+struct ParamSpec {
+  std::string_view name;
+  std::string_view unit;
+  bool required = true;
+  double default_value = 0;
+  double min = -1e300, max = 1e300;
+  bool min_exclusive = false, max_exclusive = false;
+  std::string_view doc;
+};
+using ParamValues = std::map<std::string, double, std::less<>>;
+
+// Isotropic elastic constants shared by every solid model.
+struct ElasticConstants {
+  double density = 0;        // reference density, kg/m^3
+  double youngs_modulus = 0; // Pa
+  double poissons_ratio = 0;
+  double shear = 0;          // G, Pa
+  double bulk = 0;           // K, Pa
+  double lambda = 0;         // Lame's first parameter, Pa
+  static ElasticConstants from(const ParamValues& p);
+  double plane_wave_modulus() const { return lambda + 2 * shear; } // M = K + 4G/3
+};
+
+class Material {
+public:
+  explicit Material(const ParamValues& p) : elastic_(ElasticConstants::from(p)) {}
+  virtual ~Material() = default;
+
+  // Advances the stress of every point in the batch by one step.
+  virtual void update(const MaterialBatch& batch) const = 0;
+  virtual bool has_plastic_strain() const { return false; }
+  virtual bool has_temperature() const { return false; }
+  virtual double initial_temperature() const { return 0; }
+
+  const ElasticConstants& elastic() const { return elastic_; }
+
+private:
+  ElasticConstants elastic_;
+};
+
+// The registry: deck name = class = file (`j2_plasticity` -> J2Plasticity ->
+// j2_plasticity.cpp).
+struct MaterialModel {
+  std::string_view name;
+  std::span<const ParamSpec> params;
+  std::unique_ptr<Material> (*make)(const ParamValues&);
+  std::string_view doc;
+};
+std::span<const MaterialModel> material_models();
+const MaterialModel* find_material_model(std::string_view name);
+
+} // namespace anvil

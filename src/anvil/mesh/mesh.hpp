@@ -1,0 +1,72 @@
+// Mesh: the global description of the finite-element model as read or generated, before
+// it is distributed. Nodes are numbered 0..N-1 (the global node id), elements are
+// numbered across blocks in block order (the global element id). Every sum over
+// elements in the solver runs in ascending global element id (DESIGN.md section 3).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "anvil/core/vec3.hpp"
+
+namespace anvil {
+
+// Hexahedron node order (Exodus, VTK and Flanagan-Belytschko alike): nodes 0-3 around
+// the bottom face counter-clockwise seen from above, 4-7 the top face above them.
+using Hex = std::array<std::int64_t, 8>;
+
+// Local node numbers of the six faces, each counter-clockwise seen from outside
+// (outward normal by the right-hand rule). Face order is Exodus's side numbering
+// minus one: sides 1-4 around the element, 5 bottom, 6 top.
+inline constexpr std::array<std::array<int, 4>, 6> hex_faces = {{{0, 1, 5, 4},
+                                                                {1, 2, 6, 5},
+                                                                {2, 3, 7, 6},
+                                                                {3, 0, 4, 7},
+                                                                {0, 3, 2, 1},
+                                                                {4, 5, 6, 7}}};
+
+struct ElementBlock {
+  std::string name;             // part name (deck) or block name (mesh file)
+  std::vector<Hex> elements;    // connectivity by global node id
+};
+
+struct SideEntry {
+  std::int64_t element; // global element id
+  int face;             // 0..5, see hex_faces
+};
+
+struct Mesh {
+  std::vector<Vec3> nodes;                                   // coordinates by global id
+  std::vector<ElementBlock> blocks;                          // in global element order
+  std::map<std::string, std::vector<std::int64_t>> node_sets; // sorted, unique node ids
+  std::map<std::string, std::vector<SideEntry>> side_sets;
+
+  std::int64_t num_nodes() const { return static_cast<std::int64_t>(nodes.size()); }
+  std::int64_t num_elements() const;
+  // Global id of the first element of each block, plus the total at the end.
+  std::vector<std::int64_t> block_offsets() const;
+
+  // Appends `other` after this mesh (nodes and elements renumbered after ours). Its
+  // blocks keep their names; its sets are renamed `prefix.SET` unless prefix is empty.
+  void append(const Mesh& other, const std::string& prefix);
+
+  // Moves every node by `d`.
+  void translate(const Vec3& d);
+};
+
+// Signed volume of a hexahedron (exact for the trilinear map).
+double hex_volume(const std::array<Vec3, 8>& x);
+
+// Sorted, unique ids of the nodes inside `box` (boundary included), optionally only
+// among `candidates` (sorted); an empty candidate list means all nodes.
+std::vector<std::int64_t> select_nodes(const Mesh& mesh, const Box3& box,
+                                       const std::vector<std::int64_t>* candidates = nullptr);
+
+// Sorted, unique ids of the nodes used by the elements of block `b`.
+std::vector<std::int64_t> block_nodes(const Mesh& mesh, std::size_t b);
+
+} // namespace anvil

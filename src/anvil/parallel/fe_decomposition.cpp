@@ -1,0 +1,183 @@
+#include "anvil/parallel/fe_decomposition.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "anvil/core/simd.hpp"
+
+namespace anvil {
+
+std::int64_t FeDecomposition::num_elements() const {
+  std::int64_t n = 0;
+  for (const auto& b : blocks) n += static_cast<std::int64_t>(b.gid.size());
+  return n;
+}
+
+std::int64_t FeDecomposition::num_owned_nodes() const {
+  return std::count(node_owned.begin(), node_owned.end(), std::uint8_t{1});
+}
+
+FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, int rank, int ranks) {
+  FeDecomposition d;
+  d.rank = rank;
+  d.ranks = ranks;
+  const auto nn = mesh.num_nodes();
+  const auto ne = mesh.num_elements();
+  if (static_cast<std::int64_t>(owner.size()) != ne) throw std::logic_error("owner size mismatch");
+
+  // Global corner lists per node (CSR), in ascending (element gid, corner).
+  std::vector<std::int64_t> ptr(static_cast<std::size_t>(nn) + 1, 0);
+  std::vector<const Hex*> hex(static_cast<std::size_t>(ne));
+  {
+    std::int64_t e = 0;
+    for (const auto& b : mesh.blocks)
+      for (const auto& h : b.elements) {
+        hex[e++] = &h;
+        for (auto n : h) ++ptr[n + 1];
+      }
+  }
+  for (std::int64_t i = 0; i < nn; ++i) ptr[i + 1] += ptr[i];
+  std::vector<std::int64_t> corner(static_cast<std::size_t>(ptr[nn])); // e * 8 + a
+  {
+    std::vector<std::int64_t> fill(ptr.begin(), ptr.end() - 1);
+    for (std::int64_t e = 0; e < ne; ++e)
+      for (int a = 0; a < 8; ++a) corner[fill[(*hex[e])[a]]++] = e * 8 + a;
+  }
+
+  // Which ranks touch each node: local nodes are those we touch.
+  std::vector<int> g2l(static_cast<std::size_t>(nn), -1);
+  auto touches = [&](std::int64_t n, int r) {
+    for (auto p = ptr[n]; p < ptr[n + 1]; ++p)
+      if (owner[corner[p] / 8] == r) return true;
+    return false;
+  };
+  auto min_rank = [&](std::int64_t n) {
+    int m = ranks;
+    for (auto p = ptr[n]; p < ptr[n + 1]; ++p) m = std::min(m, owner[corner[p] / 8]);
+    return m;
+  };
+  for (std::int64_t n = 0; n < nn; ++n)
+    if (touches(n, rank)) {
+      g2l[n] = static_cast<int>(d.node_gid.size());
+      d.node_gid.push_back(n);
+      d.node_owned.push_back(min_rank(n) == rank ? 1 : 0);
+    }
+
+  // Owned elements per block and their corner slots.
+  std::vector<std::int64_t> local_index(static_cast<std::size_t>(ne), -1); // within block
+  std::vector<int> block_of(static_cast<std::size_t>(ne), 0);
+  {
+    std::int64_t e = 0;
+    std::size_t base = 0;
+    for (std::size_t b = 0; b < mesh.blocks.size(); ++b) {
+      FeDecomposition::Block lb;
+      for (const auto& h : mesh.blocks[b].elements) {
+        block_of[e] = static_cast<int>(b);
+        if (owner[e] == rank) {
+          local_index[e] = static_cast<std::int64_t>(lb.gid.size());
+          lb.gid.push_back(e);
+          std::array<int, 8> c;
+          for (int a = 0; a < 8; ++a) c[a] = g2l[h[a]];
+          lb.conn.push_back(c);
+        }
+        ++e;
+      }
+      lb.stride = simd::padded_size(static_cast<int>(lb.gid.size()));
+      lb.corner_base = base;
+      base += static_cast<std::size_t>(lb.stride) * 8;
+      d.blocks.push_back(std::move(lb));
+    }
+    d.local_slots = base;
+  }
+  auto local_slot = [&](std::int64_t c) -> std::int64_t {
+    const auto e = c / 8;
+    const auto& b = d.blocks[block_of[e]];
+    return static_cast<std::int64_t>(b.corner_base) + (c % 8) * b.stride + local_index[e];
+  };
+
+  // Slot of every corner of every local node: local corners directly, remote ones in the
+  // order the neighbour sends them: by neighbour rank, then node gid, then corner.
+  std::vector<std::int64_t> slot_of(corner.size(), -1);
+  for (auto n : d.node_gid)
+    for (auto p = ptr[n]; p < ptr[n + 1]; ++p)
+      if (owner[corner[p] / 8] == rank) slot_of[p] = local_slot(corner[p]);
+
+  std::vector<int> neighbor_ranks;
+  for (auto n : d.node_gid)
+    for (auto p = ptr[n]; p < ptr[n + 1]; ++p)
+      if (owner[corner[p] / 8] != rank) neighbor_ranks.push_back(owner[corner[p] / 8]);
+  std::sort(neighbor_ranks.begin(), neighbor_ranks.end());
+  neighbor_ranks.erase(std::unique(neighbor_ranks.begin(), neighbor_ranks.end()), neighbor_ranks.end());
+
+  std::size_t next_remote = d.local_slots;
+  for (int q : neighbor_ranks) {
+    FeDecomposition::Neighbor nb;
+    nb.rank = q;
+    nb.recv_base = next_remote;
+    for (auto n : d.node_gid) {
+      if (!touches(n, q)) continue;
+      for (auto p = ptr[n]; p < ptr[n + 1]; ++p) {
+        const int o = owner[corner[p] / 8];
+        if (o == rank) nb.send_slots.push_back(slot_of[p]);
+        else if (o == q) slot_of[p] = static_cast<std::int64_t>(next_remote++);
+      }
+    }
+    nb.recv_count = next_remote - nb.recv_base;
+    d.neighbors.push_back(std::move(nb));
+  }
+  d.remote_slots = next_remote - d.local_slots;
+
+  d.gather_ptr.assign(d.node_gid.size() + 1, 0);
+  for (std::size_t i = 0; i < d.node_gid.size(); ++i) {
+    const auto n = d.node_gid[i];
+    for (auto p = ptr[n]; p < ptr[n + 1]; ++p) d.gather_slot.push_back(slot_of[p]);
+    d.gather_ptr[i + 1] = static_cast<int>(d.gather_slot.size());
+  }
+  return d;
+}
+
+CornerExchange::CornerExchange(const FeDecomposition& d, const Comm& comm) : d_(d), comm_(comm) {
+  std::size_t ns = 0;
+  for (const auto& nb : d.neighbors) ns += nb.send_slots.size();
+  send_.resize(ns * 3);
+  recv_.resize(d.remote_slots * 3);
+}
+
+void CornerExchange::exchange(const std::vector<double*>& arrays) {
+  if (d_.neighbors.empty()) return;
+  const std::size_t k = arrays.size();
+  Requests req;
+  for (const auto& nb : d_.neighbors) {
+    double* r = recv_.data() + (nb.recv_base - d_.local_slots) * k;
+    comm_.irecv(std::span<double>(r, nb.recv_count * k), nb.rank, 11, req);
+  }
+  std::size_t off = 0;
+  for (const auto& nb : d_.neighbors) {
+    double* s = send_.data() + off;
+    for (std::size_t j = 0; j < nb.send_slots.size(); ++j)
+      for (std::size_t c = 0; c < k; ++c) s[j * k + c] = arrays[c][nb.send_slots[j]];
+    comm_.isend(std::span<const double>(s, nb.send_slots.size() * k), nb.rank, 11, req);
+    off += nb.send_slots.size() * k;
+  }
+  req.wait();
+  for (std::size_t j = 0; j < d_.remote_slots; ++j)
+    for (std::size_t c = 0; c < k; ++c) arrays[c][d_.local_slots + j] = recv_[j * k + c];
+}
+
+void gather_corners(const FeDecomposition& d, const std::vector<const double*>& corner,
+                    const std::vector<double*>& out) {
+  const std::size_t nn = d.node_gid.size();
+  const int* ptr = d.gather_ptr.data();
+  const std::int64_t* slot = d.gather_slot.data();
+  for (std::size_t c = 0; c < corner.size(); ++c) {
+    const double* src = corner[c];
+    double* dst = out[c];
+    for (std::size_t n = 0; n < nn; ++n) {
+      double s = 0.0;
+      for (int p = ptr[n]; p < ptr[n + 1]; ++p) s += src[slot[p]];
+      dst[n] = s;
+    }
+  }
+}
+
+} // namespace anvil

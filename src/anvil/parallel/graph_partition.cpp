@@ -1,0 +1,69 @@
+#include "anvil/parallel/graph_partition.hpp"
+
+#include <metis.h>
+
+#include <algorithm>
+#include <map>
+#include <numeric>
+#include <stdexcept>
+
+namespace anvil {
+
+std::vector<int> partition_elements(const Mesh& mesh, int parts) {
+  const auto ne = mesh.num_elements();
+  std::vector<int> out(static_cast<std::size_t>(ne), 0);
+  if (parts <= 1 || ne == 0) return out;
+  if (ne <= parts) {
+    std::iota(out.begin(), out.end(), 0);
+    return out;
+  }
+  std::vector<idx_t> eptr(static_cast<std::size_t>(ne) + 1), eind;
+  eind.reserve(static_cast<std::size_t>(ne) * 8);
+  std::size_t e = 0;
+  for (const auto& b : mesh.blocks)
+    for (const auto& h : b.elements) {
+      eptr[e++] = static_cast<idx_t>(eind.size());
+      for (auto n : h) eind.push_back(static_cast<idx_t>(n));
+    }
+  eptr[e] = static_cast<idx_t>(eind.size());
+  idx_t n_el = static_cast<idx_t>(ne), n_nodes = static_cast<idx_t>(mesh.num_nodes());
+  idx_t ncommon = 4, nparts = parts, objval = 0;
+  idx_t options[METIS_NOPTIONS];
+  METIS_SetDefaultOptions(options);
+  options[METIS_OPTION_NUMBERING] = 0;
+  options[METIS_OPTION_SEED] = 12345;
+  options[METIS_OPTION_CONTIG] = 1;
+  std::vector<idx_t> epart(static_cast<std::size_t>(ne)), npart(static_cast<std::size_t>(n_nodes));
+  int rc = METIS_PartMeshDual(&n_el, &n_nodes, eptr.data(), eind.data(), nullptr, nullptr,
+                              &ncommon, &nparts, nullptr, options, &objval, epart.data(),
+                              npart.data());
+  if (rc != METIS_OK) {
+    // Contiguity cannot always be met (disconnected parts); retry without it.
+    options[METIS_OPTION_CONTIG] = 0;
+    rc = METIS_PartMeshDual(&n_el, &n_nodes, eptr.data(), eind.data(), nullptr, nullptr, &ncommon,
+                            &nparts, nullptr, options, &objval, epart.data(), npart.data());
+  }
+  if (rc != METIS_OK) throw std::runtime_error("METIS_PartMeshDual failed");
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = static_cast<int>(epart[i]);
+  return out;
+}
+
+long long partition_cut(const Mesh& mesh, const std::vector<int>& part) {
+  // Faces keyed by their sorted node ids; a face seen twice joins two elements.
+  std::map<std::array<std::int64_t, 4>, std::int64_t> faces;
+  long long cut = 0;
+  std::int64_t e = 0;
+  for (const auto& b : mesh.blocks)
+    for (const auto& h : b.elements) {
+      for (const auto& f : hex_faces) {
+        std::array<std::int64_t, 4> k = {h[f[0]], h[f[1]], h[f[2]], h[f[3]]};
+        std::sort(k.begin(), k.end());
+        auto [it, fresh] = faces.emplace(k, e);
+        if (!fresh && part[it->second] != part[e]) ++cut;
+      }
+      ++e;
+    }
+  return cut;
+}
+
+} // namespace anvil

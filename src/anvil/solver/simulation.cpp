@@ -1,0 +1,360 @@
+#include "anvil/solver/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "anvil/parallel/graph_partition.hpp"
+#include "anvil/solver/model.hpp"
+
+namespace anvil {
+
+Simulation::~Simulation() = default;
+
+Simulation::Simulation(const Config& config, const Comm& comm) : config_(config), comm_(comm) {
+  // The global mesh is built on every rank (generators and readers are deterministic);
+  // METIS runs on rank 0 and its answer is broadcast so that every rank agrees.
+  const Mesh mesh = build_mesh(config_);
+  global_nodes_ = mesh.num_nodes();
+  global_elements_ = mesh.num_elements();
+  block_offsets_ = mesh.block_offsets();
+  std::vector<int> owner;
+  if (comm_.rank() == 0) owner = partition_elements(mesh, comm_.size());
+  comm_.broadcast(owner, 0);
+  fe_ = decompose_fe(mesh, owner, comm_.rank(), comm_.size());
+  corner_exchange_ = std::make_unique<CornerExchange>(fe_, comm_);
+
+  // Nodes.
+  const std::size_t nn = fe_.node_gid.size();
+  for (int i = 0; i < 3; ++i) {
+    nodes_.x[i].resize(nn);
+    nodes_.v[i].assign(nn, 0.0);
+    nodes_.f[i].assign(nn, 0.0);
+  }
+  for (std::size_t n = 0; n < nn; ++n)
+    for (int i = 0; i < 3; ++i) nodes_.x[i][n] = mesh.nodes[fe_.node_gid[n]][i];
+  nodes_.x0 = nodes_.x;
+  nodes_.mass.assign(nn, 0.0);
+
+  // Materials and element blocks (one per part).
+  for (const auto& m : config_.materials)
+    materials_.push_back(find_material_model(m.model)->make(m.params));
+  auto material_of = [&](const std::string& name) -> const Material* {
+    for (std::size_t i = 0; i < config_.materials.size(); ++i)
+      if (config_.materials[i].name == name) return materials_[i].get();
+    return nullptr;
+  };
+  for (int i = 0; i < 3; ++i) corner_force_[i].assign(fe_.total_slots(), 0.0);
+  std::vector<double>& corner_mass = corner_force_[0]; // reused once for the mass
+  const double* xs[3] = {nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()};
+  for (std::size_t b = 0; b < config_.parts.size(); ++b) {
+    const auto& part = config_.parts[b];
+    const auto& lb = fe_.blocks[b];
+    HexBlock hb;
+    hb.name = part.name;
+    hb.part = static_cast<int>(b);
+    hb.material = material_of(part.material);
+    hb.hourglass = part.hourglass;
+    hb.bulk_viscosity = part.bulk_viscosity;
+    hb.gid = lb.gid;
+    for (int a = 0; a < 8; ++a) {
+      hb.conn[a].resize(lb.gid.size());
+      for (std::size_t e = 0; e < lb.gid.size(); ++e) hb.conn[a][e] = lb.conn[e][a];
+    }
+    hb.corner_base = lb.corner_base;
+    hb.mass.assign(lb.gid.size(), 0.0);
+    hb.allocate_state();
+    std::vector<double> vol(static_cast<std::size_t>(lb.stride), 0.0);
+    hex_volumes(hb, xs, vol);
+    const double rho = hb.material->elastic().density;
+    for (int e = 0; e < hb.size(); ++e) {
+      if (!(vol[e] > 0))
+        throw InputError(part.mesh.where,
+                         fmt::format("element {} of part {} has a non-positive volume ({:.3g} m^3): "
+                                     "check the node order",
+                                     hb.gid[e] - block_offsets_[b] + 1, part.name, vol[e]));
+      hb.mass[e] = rho * vol[e];
+      hb.volume[e] = vol[e];
+      for (int a = 0; a < 8; ++a) corner_mass[lb.corner_base + static_cast<std::size_t>(a) * lb.stride + e] = hb.mass[e] / 8;
+    }
+    for (int e = hb.size(); e < lb.stride; ++e) hb.mass[e] = hb.mass[hb.size() - 1 >= 0 ? hb.size() - 1 : 0];
+    blocks_.push_back(std::move(hb));
+  }
+  corner_exchange_->exchange({corner_mass.data()});
+  gather_corners(fe_, {corner_mass.data()}, {nodes_.mass.data()});
+  std::fill(corner_mass.begin(), corner_mass.end(), 0.0);
+
+  part_mass_.assign(config_.parts.size(), 0.0);
+  for (const auto& b : blocks_)
+    for (int e = 0; e < b.size(); ++e) part_mass_[b.part] += b.mass[e];
+  comm_.sum(std::span<double>(part_mass_));
+
+  apply_initial_conditions(mesh);
+  apply_boundary_conditions(mesh);
+  locate_probes(mesh);
+
+  // Initial sample: kinetic energy of the initial velocities.
+  kinetic_local_ = 0;
+  for (std::size_t n = 0; n < nn; ++n)
+    if (fe_.node_owned[n])
+      kinetic_local_ += 0.5 * nodes_.mass[n] *
+                        (nodes_.v[0][n] * nodes_.v[0][n] + nodes_.v[1][n] * nodes_.v[1][n] +
+                         nodes_.v[2][n] * nodes_.v[2][n]);
+  probe_local_.assign(6 * config_.probes.size(), 0.0);
+  for (std::size_t p = 0; p < probe_node_.size(); ++p)
+    if (probe_node_[p] >= 0)
+      for (int i = 0; i < 3; ++i) probe_local_[6 * p + 3 + i] = nodes_.v[i][probe_node_[p]];
+  initial_energy_ = comm_.sum(kinetic_local_);
+}
+
+void Simulation::apply_initial_conditions(const Mesh& mesh) {
+  const std::size_t nn = fe_.node_gid.size();
+  for (const auto& ic : config_.initial_conditions) {
+    const auto ids = resolve_selection(mesh, config_, ic.nodes);
+    for (std::size_t n = 0; n < nn; ++n) {
+      if (!std::binary_search(ids.begin(), ids.end(), fe_.node_gid[n])) continue;
+      const Vec3 r = Vec3{nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]} - ic.center;
+      const Vec3 v = ic.velocity + cross(ic.angular_velocity, r);
+      for (int i = 0; i < 3; ++i) nodes_.v[i][n] = v[i];
+    }
+  }
+}
+
+void Simulation::apply_boundary_conditions(const Mesh& mesh) {
+  const std::size_t nn = fe_.node_gid.size();
+  constrained_.assign(nn, 0);
+  for (int i = 0; i < 3; ++i) v_bc_[i].assign(nn, 0.0);
+  for (const auto& bc : config_.boundary_conditions) {
+    const auto ids = resolve_selection(mesh, config_, bc.nodes);
+    for (std::size_t n = 0; n < nn; ++n) {
+      if (!std::binary_search(ids.begin(), ids.end(), fe_.node_gid[n])) continue;
+      for (int i = 0; i < 3; ++i) {
+        const bool on = bc.prescribed ? bc.components[i] : bc.fix[i];
+        if (!on) continue;
+        constrained_[n] |= static_cast<std::uint8_t>(1u << i);
+        v_bc_[i][n] = bc.prescribed ? bc.velocity[i] : 0.0;
+      }
+    }
+  }
+  constrained_nodes_.clear();
+  for (std::size_t n = 0; n < nn; ++n)
+    if (constrained_[n]) {
+      constrained_nodes_.push_back(static_cast<int>(n));
+      for (int i = 0; i < 3; ++i)
+        if (constrained_[n] & (1u << i)) nodes_.v[i][n] = v_bc_[i][n];
+    }
+}
+
+void Simulation::locate_probes(const Mesh& mesh) {
+  (void)mesh;
+  probe_node_.assign(config_.probes.size(), -1);
+  for (std::size_t p = 0; p < config_.probes.size(); ++p) {
+    const Vec3 at = config_.probes[p].at;
+    double best = std::numeric_limits<double>::infinity();
+    std::int64_t best_gid = std::numeric_limits<std::int64_t>::max();
+    int best_local = -1;
+    for (std::size_t n = 0; n < fe_.node_gid.size(); ++n) {
+      if (!fe_.node_owned[n]) continue;
+      const Vec3 d = Vec3{nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]} - at;
+      const double r2 = dot(d, d);
+      if (r2 < best || (r2 == best && fe_.node_gid[n] < best_gid)) {
+        best = r2;
+        best_gid = fe_.node_gid[n];
+        best_local = static_cast<int>(n);
+      }
+    }
+    const double global_best = comm_.min(best);
+    const std::int64_t winner = comm_.min(best == global_best ? best_gid : std::numeric_limits<std::int64_t>::max());
+    if (best_local >= 0 && best_gid == winner) probe_node_[p] = best_local;
+  }
+}
+
+std::string Simulation::describe_element(std::int64_t gid) const {
+  for (std::size_t b = 0; b + 1 < block_offsets_.size(); ++b)
+    if (gid >= block_offsets_[b] && gid < block_offsets_[b + 1])
+      return fmt::format("element {} (part {}, element {} of the part)", gid + 1,
+                         config_.parts[b].name, gid - block_offsets_[b] + 1);
+  return fmt::format("element {}", gid + 1);
+}
+
+bool Simulation::finished() const {
+  return clock_.cycle >= config_.end_cycles || clock_.time >= config_.end_time * (1 - 1e-12);
+}
+
+// ---------------------------------------------------------------------------------------
+// The cycle.
+
+void Simulation::step() {
+  fe_forces(); // 1. FE internal forces (static decomposition)
+  {            // 2. SPH forces: no particles in this version
+    ScopedPhase t(timers_, Phase::sph);
+  }
+  predict(); // 3. v(n+1/2) = v(n-1/2) + dt a(n)
+  {          // 4-5. contact detection and penalty correction: no contact in this version
+    ScopedPhase t(timers_, Phase::contact_search);
+  }
+  update(); // 6. x(n+1), t(n+1), next stable dt
+}
+
+void Simulation::fe_forces() {
+  {
+    ScopedPhase t(timers_, Phase::fe);
+    const NodalView view{{nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()},
+                         {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()}};
+    const CornerView corners{{corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()}};
+    HexResult r;
+    for (auto& b : blocks_)
+      if (b.size() > 0) hex_forces(b, view, clock_.dt_prev, corners, workspace_, r);
+    dt_stable_ = r.dt_stable;
+    dt_element_ = r.stable_gid;
+
+    // One reduction per cycle carries the stable step and the failure flags.
+    const double none = std::numeric_limits<double>::infinity();
+    double red[4] = {r.dt_stable,
+                     r.inverted_gid >= 0 ? static_cast<double>(r.inverted_gid) : none,
+                     r.nonfinite_gid >= 0 ? static_cast<double>(r.nonfinite_gid) : none, 0};
+    comm_.min(std::span<double>(red, 3));
+    if (red[1] != none)
+      throw PhysicsError(describe_element(static_cast<std::int64_t>(red[1])), clock_.time,
+                         "inverted element (non-positive volume)");
+    if (red[2] != none || !std::isfinite(red[0]))
+      throw PhysicsError(red[2] != none ? describe_element(static_cast<std::int64_t>(red[2])) : "the model",
+                         clock_.time, "non-finite stress or force");
+    // The controlling element: smallest gid among the ranks that hold the global minimum.
+    dt_element_ = static_cast<std::int64_t>(
+        comm_.min(r.dt_stable == red[0] ? static_cast<double>(r.stable_gid) : none));
+    dt_stable_ = red[0];
+  }
+  {
+    ScopedPhase t(timers_, Phase::halo);
+    corner_exchange_->exchange({corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()});
+  }
+  {
+    ScopedPhase t(timers_, Phase::fe);
+    gather_corners(fe_, {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()},
+                   {nodes_.f[0].data(), nodes_.f[1].data(), nodes_.f[2].data()});
+  }
+}
+
+void Simulation::predict() {
+  ScopedPhase t(timers_, Phase::predict);
+  double dt = config_.time_step_scale * dt_stable_;
+  if (std::isfinite(config_.end_time) && clock_.time + dt > config_.end_time)
+    dt = std::max(config_.end_time - clock_.time, 0.0);
+  clock_.dt = dt;
+  if (clock_.cycle == 0) clock_.dt_initial = dt;
+  clock_.dt_element = dt_element_;
+  // Central difference with a varying step: the velocity advances over the average of
+  // the intervals on either side of t(n).
+  const double dt_avg = 0.5 * (clock_.dt_prev + dt);
+  const std::size_t nn = nodes_.size();
+
+  // Work of the constraint reactions over this step (before the velocities change).
+  double work = 0;
+  for (int n : constrained_nodes_) {
+    for (int i = 0; i < 3; ++i) {
+      if (!(constrained_[n] & (1u << i))) continue;
+      const double v_old = nodes_.v[i][n];
+      const double v_free = v_old + dt_avg * nodes_.f[i][n] / nodes_.mass[n];
+      const double v_new = v_bc_[i][n];
+      if (fe_.node_owned[n]) work += nodes_.mass[n] * (v_new - v_free) * 0.5 * (v_old + v_new);
+    }
+  }
+  external_work_ += work;
+
+  double ke = 0;
+  for (std::size_t p = 0; p < probe_node_.size(); ++p)
+    if (probe_node_[p] >= 0) {
+      const int n = probe_node_[p];
+      for (int i = 0; i < 3; ++i) {
+        probe_local_[6 * p + i] = nodes_.x[i][n] - nodes_.x0[i][n];
+        probe_local_[6 * p + 3 + i] = nodes_.v[i][n]; // v(n-1/2), averaged below
+      }
+    }
+  double* v[3] = {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()};
+  const double* f[3] = {nodes_.f[0].data(), nodes_.f[1].data(), nodes_.f[2].data()};
+  const double* m = nodes_.mass.data();
+  const std::uint8_t* owned = fe_.node_owned.data();
+  const std::uint8_t* fixed = constrained_.data();
+  for (std::size_t n = 0; n < nn; ++n) {
+    const double inv_m = 1.0 / m[n];
+    double avg2 = 0;
+    for (int i = 0; i < 3; ++i) {
+      const double old = v[i][n];
+      const double nv = (fixed[n] & (1u << i)) ? v_bc_[i][n] : old + dt_avg * f[i][n] * inv_m;
+      v[i][n] = nv;
+      const double a = 0.5 * (old + nv);
+      avg2 += a * a;
+    }
+    if (owned[n]) ke += 0.5 * m[n] * avg2;
+  }
+  // Probe velocity at t(n): mean of the two half-step velocities.
+  for (std::size_t p = 0; p < probe_node_.size(); ++p)
+    if (probe_node_[p] >= 0)
+      for (int i = 0; i < 3; ++i)
+        probe_local_[6 * p + 3 + i] = 0.5 * (probe_local_[6 * p + 3 + i] + v[i][probe_node_[p]]);
+  kinetic_local_ = ke;
+  sample_time_ = clock_.time;
+  sample_cycle_ = clock_.cycle;
+  sample_dt_ = dt;
+}
+
+void Simulation::update() {
+  ScopedPhase t(timers_, Phase::update);
+  const double dt = clock_.dt;
+  const std::size_t nn = nodes_.size();
+  for (int i = 0; i < 3; ++i) {
+    double* x = nodes_.x[i].data();
+    const double* v = nodes_.v[i].data();
+#pragma omp simd
+    for (std::size_t n = 0; n < nn; ++n) x[n] += dt * v[n];
+  }
+  clock_.time += dt;
+  clock_.cycle += 1;
+  clock_.dt_prev = dt;
+}
+
+// ---------------------------------------------------------------------------------------
+// Diagnostics.
+
+Sample Simulation::sample() const {
+  Sample s;
+  s.time = clock_.cycle == 0 ? 0.0 : sample_time_;
+  s.cycle = clock_.cycle == 0 ? 0 : sample_cycle_;
+  s.dt = sample_dt_;
+  double local[4] = {kinetic_local_, 0, 0, external_work_};
+  for (const auto& b : blocks_)
+    for (int e = 0; e < b.size(); ++e) {
+      local[1] += b.internal_energy[e];
+      local[2] += b.hourglass_energy[e];
+    }
+  comm_.sum(std::span<double>(local, 4));
+  s.kinetic = local[0];
+  s.internal = local[1];
+  s.hourglass = local[2];
+  s.external_work = local[3];
+  s.probes = probe_local_;
+  comm_.sum(std::span<double>(s.probes));
+  return s;
+}
+
+double Simulation::balance_error(const Sample& s) const {
+  const double e = s.total();
+  const double scale = std::max({std::abs(e), std::abs(s.external_work), std::abs(initial_energy_), 1e-300});
+  return std::abs(e - initial_energy_ - s.external_work) / scale;
+}
+
+double Simulation::stable_time_step() {
+  const NodalView view{{nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()},
+                       {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()}};
+  const CornerView corners{{corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()}};
+  HexResult r;
+  // With dt_prev = 0 the kernel changes no state: rotation by the identity, no increment.
+  for (auto& b : blocks_)
+    if (b.size() > 0) hex_forces(b, view, 0.0, corners, workspace_, r);
+  return comm_.min(r.dt_stable);
+}
+
+} // namespace anvil

@@ -1,0 +1,135 @@
+// Simulation: owns the model on this rank and advances it one cycle at a time through
+// the paper's six phases (DESIGN.md section 1). It holds all state (no globals): nodes,
+// element blocks, time, and the decompositions with their exchanges.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "anvil/core/timer.hpp"
+#include "anvil/fe/hex_block.hpp"
+#include "anvil/io/config.hpp"
+#include "anvil/mesh/mesh.hpp"
+#include "anvil/parallel/comm.hpp"
+#include "anvil/parallel/fe_decomposition.hpp"
+
+namespace anvil {
+
+// Nodal state on this rank, structure of arrays over local nodes (shared nodes appear on
+// every rank that touches them, with identical values).
+struct NodeState {
+  std::array<std::vector<double>, 3> x;   // position at t(n), m
+  std::array<std::vector<double>, 3> x0;  // reference position, m
+  std::array<std::vector<double>, 3> v;   // velocity at t(n - 1/2) (t(n + 1/2) after a step)
+  std::array<std::vector<double>, 3> f;   // internal force at t(n), N
+  std::vector<double> mass;               // lumped mass, kg
+  std::size_t size() const { return mass.size(); }
+};
+
+// Time and cycle counters of the central-difference scheme.
+struct Clock {
+  double time = 0;          // t(n)
+  std::int64_t cycle = 0;   // n
+  double dt = 0;            // dt(n + 1/2) of the last step taken
+  double dt_prev = 0;       // dt(n - 1/2), the interval the stress update integrates over
+  double dt_initial = 0;    // the first step's dt
+  std::int64_t dt_element = -1; // element controlling dt
+};
+
+// Global energies and probe values at one time (a history row).
+struct Sample {
+  double time = 0;
+  std::int64_t cycle = 0;
+  double dt = 0;
+  double kinetic = 0, internal = 0, hourglass = 0, contact = 0, external_work = 0;
+  double total() const { return kinetic + internal + hourglass + contact; }
+  std::vector<double> probes; // per probe: ux, uy, uz, vx, vy, vz
+};
+
+class Simulation {
+public:
+  // Builds the model from the deck on `comm` (collective). Throws InputError on a bad
+  // model (sets that select nothing, unreadable mesh).
+  Simulation(const Config& config, const Comm& comm);
+  ~Simulation();
+
+  // One cycle: fe_forces, sph_forces, predict, contact_detect, contact_correct, update.
+  // Throws PhysicsError (on every rank) for an inverted element or non-finite state.
+  void step();
+  bool finished() const;
+
+  // Global energies and probes at the time of the last step's forces (collective).
+  // Also valid before the first step (initial state).
+  Sample sample() const;
+  // Energy balance error |E - E(0) - W| / max(E, |W|) for a sample.
+  double balance_error(const Sample& s) const;
+  // Smallest element stable time step at the current state (collective; runs the
+  // element kernel without advancing anything).
+  double stable_time_step();
+
+  const Config& config() const { return config_; }
+  const Comm& comm() const { return comm_; }
+  const Clock& clock() const { return clock_; }
+  const NodeState& nodes() const { return nodes_; }
+  const std::vector<HexBlock>& blocks() const { return blocks_; }
+  const FeDecomposition& fe() const { return fe_; }
+  const PhaseTimers& timers() const { return timers_; }
+  std::int64_t global_nodes() const { return global_nodes_; }
+  std::int64_t global_elements() const { return global_elements_; }
+  const std::vector<double>& part_masses() const { return part_mass_; }
+  // Global element id -> part name (for messages).
+  std::string describe_element(std::int64_t gid) const;
+
+private:
+  void fe_forces();
+  void predict();
+  void update();
+  void apply_initial_conditions(const Mesh& mesh);
+  void apply_boundary_conditions(const Mesh& mesh);
+  void locate_probes(const Mesh& mesh);
+
+  Config config_;
+  const Comm& comm_;
+  FeDecomposition fe_;
+  std::unique_ptr<CornerExchange> corner_exchange_;
+  std::vector<std::unique_ptr<Material>> materials_;
+  std::vector<HexBlock> blocks_;
+  HexWorkspace workspace_;
+  std::array<std::vector<double>, 3> corner_force_;
+  NodeState nodes_;
+  Clock clock_;
+  PhaseTimers timers_;
+
+  // Constraints: per local node a mask of constrained components (fixed or prescribed)
+  // and the prescribed velocity (0 where fixed).
+  std::vector<std::uint8_t> constrained_;
+  std::array<std::vector<double>, 3> v_bc_;
+  std::vector<int> constrained_nodes_; // local nodes with any constraint
+
+  // Diagnostics accumulated by this rank over owned entities.
+  double external_work_ = 0;
+  double initial_energy_ = 0;
+  bool have_initial_energy_ = false;
+
+  // Probes: local node index on the owning rank, -1 elsewhere.
+  std::vector<int> probe_node_;
+
+  // What predict() records for the sample at t(n): kinetic energy of owned nodes at the
+  // mid-point velocity and the probe values (zero on ranks that do not own the probe).
+  double sample_time_ = 0;
+  std::int64_t sample_cycle_ = 0;
+  double sample_dt_ = 0;
+  double kinetic_local_ = 0;
+  std::vector<double> probe_local_;
+
+  double dt_stable_ = 0; // from the last fe_forces
+  std::int64_t dt_element_ = -1;
+  std::int64_t global_nodes_ = 0, global_elements_ = 0;
+  std::vector<std::int64_t> block_offsets_;
+  std::vector<double> part_mass_;
+};
+
+} // namespace anvil

@@ -1,0 +1,114 @@
+// The deck reader: valid decks become typed configuration; every kind of bad input is an
+// InputError naming file, line and key.
+#include <gtest/gtest.h>
+
+#include "anvil/io/deck.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using namespace anvil;
+
+const char* good = R"(title: bar
+termination: {time: 8.0e-5}
+time_step: {scale: 0.9}
+materials:
+  copper: {model: j2_plasticity, density: 8930, youngs_modulus: 117.0e9,
+           poissons_ratio: 0.35, yield_stress: 0.4e9, hardening_modulus: 0.1e9}
+parts:
+  bar:
+    mesh: {generate: cylinder, radius: 3.2e-3, length: 32.4e-3, axis: z, divisions: [8, 40]}
+    material: copper
+    hourglass: {model: viscous, coefficient: 0.05}
+node_sets:
+  impact_face: {part: bar, box: {min: [-1, -1, -1.0e-9], max: [1, 1, 1.0e-9]}}
+initial_conditions:
+  - {part: bar, velocity: [0, 0, -227.0]}
+boundary_conditions:
+  - {set: impact_face, fix: [z]}
+  - {set: bar.top, velocity: [0, 0, 1.0], components: [z]}
+probes:
+  - {name: tip, at: [0, 0, 32.4e-3]}
+output: {fields_every: 1.0e-5, history_every: 1.0e-7}
+)";
+
+TEST(Deck, ParsesTheContractExample) {
+  const Config c = test::deck(good);
+  EXPECT_EQ(c.title, "bar");
+  EXPECT_DOUBLE_EQ(c.end_time, 8.0e-5);
+  ASSERT_EQ(c.materials.size(), 1u);
+  EXPECT_EQ(c.materials[0].model, "j2_plasticity");
+  EXPECT_DOUBLE_EQ(c.materials[0].params.at("yield_stress"), 0.4e9);
+  ASSERT_EQ(c.parts.size(), 1u);
+  EXPECT_EQ(c.parts[0].mesh.kind, MeshConfig::Kind::cylinder);
+  EXPECT_EQ(c.parts[0].mesh.cylinder.divisions[1], 40);
+  EXPECT_DOUBLE_EQ(c.parts[0].hourglass.coefficient, 0.05);
+  ASSERT_EQ(c.boundary_conditions.size(), 2u);
+  EXPECT_TRUE(c.boundary_conditions[0].fix[2]);
+  EXPECT_TRUE(c.boundary_conditions[1].prescribed);
+  EXPECT_TRUE(c.boundary_conditions[1].components[2]);
+  EXPECT_FALSE(c.boundary_conditions[1].components[0]);
+  EXPECT_EQ(c.probes[0].name, "tip");
+}
+
+// Replaces the first occurrence of `from` in the good deck and expects an InputError whose
+// message contains every fragment (file:line and key among them).
+void expect_error(const std::string& from, const std::string& to, std::vector<std::string> fragments) {
+  std::string text = good;
+  const auto pos = text.find(from);
+  ASSERT_NE(pos, std::string::npos) << from;
+  text.replace(pos, from.size(), to);
+  try {
+    test::deck(text, "deck.yaml");
+    FAIL() << "no error for " << to;
+  } catch (const InputError& e) {
+    for (const auto& f : fragments) EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what() << "\n  missing: " << f;
+  }
+}
+
+TEST(Deck, UnknownKeyNamesKeyAndLine) {
+  expect_error("time_step: {scale: 0.9}", "time_step: {scale: 0.9, scael: 1}",
+               {"deck.yaml:3", "time_step.scael", "unknown key"});
+  expect_error("title: bar", "titel: bar", {"deck.yaml:1", "titel"});
+  expect_error("hardening_modulus: 0.1e9", "hardening_modulus: 0.1e9, hardnening: 1",
+               {"deck.yaml:6", "materials.copper.hardnening", "unknown parameter"});
+}
+
+TEST(Deck, WrongTypes) {
+  expect_error("density: 8930", "density: heavy", {"deck.yaml:5", "materials.copper.density", "number"});
+  expect_error("divisions: [8, 40]", "divisions: [8.5, 40]", {"deck.yaml:9", "divisions[0]", "integer"});
+  expect_error("velocity: [0, 0, -227.0]", "velocity: [0, -227.0]", {"deck.yaml:15", "velocity", "three numbers"});
+  expect_error("axis: z", "axis: w", {"deck.yaml:9", "axis"});
+}
+
+TEST(Deck, MissingRequiredValues) {
+  expect_error("yield_stress: 0.4e9, ", "", {"deck.yaml:5", "materials.copper.yield_stress", "missing"});
+  expect_error("termination: {time: 8.0e-5}", "", {"deck.yaml", "termination", "missing"});
+  expect_error("    material: copper\n", "", {"deck.yaml:8", "parts.bar.material", "missing"});
+}
+
+TEST(Deck, ImpossibleValues) {
+  expect_error("density: 8930", "density: -8930", {"deck.yaml:5", "materials.copper.density", "impossible"});
+  expect_error("poissons_ratio: 0.35", "poissons_ratio: 0.5", {"deck.yaml:6", "poissons_ratio", "< 0.5"});
+  expect_error("radius: 3.2e-3", "radius: 0", {"deck.yaml:9", "radius", "positive"});
+  expect_error("scale: 0.9", "scale: 1.5", {"deck.yaml:3", "time_step.scale"});
+}
+
+TEST(Deck, BrokenReferences) {
+  expect_error("material: copper", "material: steel", {"deck.yaml:10", "parts.bar.material", "steel"});
+  expect_error("set: impact_face", "set: impact_fase", {"deck.yaml:17", "impact_fase"});
+  expect_error("set: bar.top", "set: bar.tip", {"deck.yaml:18", "bar.tip", "bar.top"});
+  expect_error("model: j2_plasticity", "model: j3_plasticity", {"deck.yaml:5", "j3_plasticity", "johnson_cook"});
+}
+
+TEST(Deck, MalformedYaml) {
+  expect_error("parts:\n", "parts: [\n", {"deck.yaml:", "malformed YAML"});
+  expect_error("title: bar", "title: bar\ntitle: again", {"deck.yaml:2", "duplicate key"});
+}
+
+TEST(Deck, MissingMeshFile) {
+  expect_error("{generate: cylinder, radius: 3.2e-3, length: 32.4e-3, axis: z, divisions: [8, 40]}",
+               "{file: no_such_mesh.exo}", {"deck.yaml:9", "parts.bar.mesh.file", "does not exist"});
+}
+
+} // namespace
