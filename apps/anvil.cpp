@@ -20,7 +20,8 @@ int check(const std::string& deck, const anvil::Comm& comm) {
   anvil::Simulation sim(config, comm);
   const double dt = sim.stable_time_step();
   if (comm.rank() != 0) return 0;
-  std::printf("deck        %s%s\n", deck.c_str(), config.title.empty() ? "" : fmt::format("  ({})", config.title).c_str());
+  std::printf("deck        %s%s\n", deck.c_str(),
+              config.title.empty() ? "" : fmt::format("  ({})", config.title).c_str());
   std::printf("ranks       %d\n", comm.size());
   std::printf("nodes       %lld\n", static_cast<long long>(sim.global_nodes()));
   std::printf("elements    %lld\n", static_cast<long long>(sim.global_elements()));
@@ -52,7 +53,8 @@ int main(int argc, char** argv) {
   run->add_option("deck", deck, "the YAML deck")->required();
   run->add_option("-o,--output", outdir, "output directory")->capture_default_str();
   run->add_flag("-q,--quiet", quiet, "no progress line");
-  auto* chk = app.add_subcommand("check", "validate a deck and its mesh; print counts, masses, stable dt");
+  auto* chk =
+      app.add_subcommand("check", "validate a deck and its mesh; print counts, masses, stable dt");
   chk->add_option("deck", deck, "the YAML deck")->required();
 
   try {

@@ -12,6 +12,8 @@ double relative_error(double a, double b, double floor) {
   return m < floor ? d : d / m;
 }
 
-Config deck(const std::string& yaml, const std::string& name) { return parse_deck(yaml, name, "."); }
+Config deck(const std::string& yaml, const std::string& name) {
+  return parse_deck(yaml, name, ".");
+}
 
 } // namespace anvil::test

@@ -16,7 +16,11 @@ double relative_error(double a, double b, double floor = 1e-300);
 Config deck(const std::string& yaml, const std::string& name = "test.yaml");
 
 // Source and binary locations (set by CMake).
-inline const char* source_dir() { return ANVIL_SOURCE_DIR; }
-inline const char* anvil_binary() { return ANVIL_BINARY; }
+inline const char* source_dir() {
+  return ANVIL_SOURCE_DIR;
+}
+inline const char* anvil_binary() {
+  return ANVIL_BINARY;
+}
 
 } // namespace anvil::test

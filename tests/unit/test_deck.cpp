@@ -53,7 +53,8 @@ TEST(Deck, ParsesTheContractExample) {
 
 // Replaces the first occurrence of `from` in the good deck and expects an InputError whose
 // message contains every fragment (file:line and key among them).
-void expect_error(const std::string& from, const std::string& to, std::vector<std::string> fragments) {
+void expect_error(const std::string& from, const std::string& to,
+                  std::vector<std::string> fragments) {
   std::string text = good;
   const auto pos = text.find(from);
   ASSERT_NE(pos, std::string::npos) << from;
@@ -62,7 +63,9 @@ void expect_error(const std::string& from, const std::string& to, std::vector<st
     test::deck(text, "deck.yaml");
     FAIL() << "no error for " << to;
   } catch (const InputError& e) {
-    for (const auto& f : fragments) EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what() << "\n  missing: " << f;
+    for (const auto& f : fragments)
+      EXPECT_NE(std::string(e.what()).find(f), std::string::npos)
+          << e.what() << "\n  missing: " << f;
   }
 }
 
@@ -75,30 +78,38 @@ TEST(Deck, UnknownKeyNamesKeyAndLine) {
 }
 
 TEST(Deck, WrongTypes) {
-  expect_error("density: 8930", "density: heavy", {"deck.yaml:5", "materials.copper.density", "number"});
-  expect_error("divisions: [8, 40]", "divisions: [8.5, 40]", {"deck.yaml:9", "divisions[0]", "integer"});
-  expect_error("velocity: [0, 0, -227.0]", "velocity: [0, -227.0]", {"deck.yaml:15", "velocity", "three numbers"});
+  expect_error("density: 8930", "density: heavy",
+               {"deck.yaml:5", "materials.copper.density", "number"});
+  expect_error("divisions: [8, 40]", "divisions: [8.5, 40]",
+               {"deck.yaml:9", "divisions[0]", "integer"});
+  expect_error("velocity: [0, 0, -227.0]", "velocity: [0, -227.0]",
+               {"deck.yaml:15", "velocity", "three numbers"});
   expect_error("axis: z", "axis: w", {"deck.yaml:9", "axis"});
 }
 
 TEST(Deck, MissingRequiredValues) {
-  expect_error("yield_stress: 0.4e9, ", "", {"deck.yaml:5", "materials.copper.yield_stress", "missing"});
+  expect_error("yield_stress: 0.4e9, ", "",
+               {"deck.yaml:5", "materials.copper.yield_stress", "missing"});
   expect_error("termination: {time: 8.0e-5}", "", {"deck.yaml", "termination", "missing"});
   expect_error("    material: copper\n", "", {"deck.yaml:8", "parts.bar.material", "missing"});
 }
 
 TEST(Deck, ImpossibleValues) {
-  expect_error("density: 8930", "density: -8930", {"deck.yaml:5", "materials.copper.density", "impossible"});
-  expect_error("poissons_ratio: 0.35", "poissons_ratio: 0.5", {"deck.yaml:6", "poissons_ratio", "< 0.5"});
+  expect_error("density: 8930", "density: -8930",
+               {"deck.yaml:5", "materials.copper.density", "impossible"});
+  expect_error("poissons_ratio: 0.35", "poissons_ratio: 0.5",
+               {"deck.yaml:6", "poissons_ratio", "< 0.5"});
   expect_error("radius: 3.2e-3", "radius: 0", {"deck.yaml:9", "radius", "positive"});
   expect_error("scale: 0.9", "scale: 1.5", {"deck.yaml:3", "time_step.scale"});
 }
 
 TEST(Deck, BrokenReferences) {
-  expect_error("material: copper", "material: steel", {"deck.yaml:10", "parts.bar.material", "steel"});
+  expect_error("material: copper", "material: steel",
+               {"deck.yaml:10", "parts.bar.material", "steel"});
   expect_error("set: impact_face", "set: impact_fase", {"deck.yaml:17", "impact_fase"});
   expect_error("set: bar.top", "set: bar.tip", {"deck.yaml:18", "bar.tip", "bar.top"});
-  expect_error("model: j2_plasticity", "model: j3_plasticity", {"deck.yaml:5", "j3_plasticity", "johnson_cook"});
+  expect_error("model: j2_plasticity", "model: j3_plasticity",
+               {"deck.yaml:5", "j3_plasticity", "johnson_cook"});
 }
 
 TEST(Deck, MalformedYaml) {
@@ -108,7 +119,8 @@ TEST(Deck, MalformedYaml) {
 
 TEST(Deck, MissingMeshFile) {
   expect_error("{generate: cylinder, radius: 3.2e-3, length: 32.4e-3, axis: z, divisions: [8, 40]}",
-               "{file: no_such_mesh.exo}", {"deck.yaml:9", "parts.bar.mesh.file", "does not exist"});
+               "{file: no_such_mesh.exo}",
+               {"deck.yaml:9", "parts.bar.mesh.file", "does not exist"});
 }
 
 } // namespace

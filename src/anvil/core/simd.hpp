@@ -20,13 +20,19 @@ inline vdouble gather(const double* p, const Index* idx) {
   return vdouble([&](auto l) { return p[idx[l]]; });
 }
 
-inline vdouble load(const double* p) { return vdouble(p, stdx::element_aligned); }
-inline void store(const vdouble& v, double* p) { v.copy_to(p, stdx::element_aligned); }
+inline vdouble load(const double* p) {
+  return vdouble(p, stdx::element_aligned);
+}
+inline void store(const vdouble& v, double* p) {
+  v.copy_to(p, stdx::element_aligned);
+}
 
 } // namespace anvil::simd
 
 namespace anvil::simd {
 // Arrays of per-element data are padded to whole vectors so that kernels never need a
 // scalar tail: the padding repeats the last element.
-inline constexpr int padded_size(int n) { return (n + width - 1) / width * width; }
+inline constexpr int padded_size(int n) {
+  return (n + width - 1) / width * width;
+}
 } // namespace anvil::simd

@@ -23,8 +23,8 @@ enum class Phase {
 };
 
 inline constexpr std::array<std::string_view, static_cast<int>(Phase::count)> phase_names = {
-    "fe",        "sph",      "predict", "contact_search", "contact_force",
-    "update",    "rebalance", "transfer", "halo",          "output"};
+    "fe",     "sph",       "predict",  "contact_search", "contact_force",
+    "update", "rebalance", "transfer", "halo",           "output"};
 
 class PhaseTimers {
 public:
@@ -45,8 +45,7 @@ public:
   ScopedPhase(PhaseTimers& timers, Phase phase)
       : timers_(timers), phase_(phase), start_(PhaseTimers::clock::now()) {}
   ~ScopedPhase() {
-    timers_.add(phase_,
-                std::chrono::duration<double>(PhaseTimers::clock::now() - start_).count());
+    timers_.add(phase_, std::chrono::duration<double>(PhaseTimers::clock::now() - start_).count());
   }
   ScopedPhase(const ScopedPhase&) = delete;
   ScopedPhase& operator=(const ScopedPhase&) = delete;
@@ -58,8 +57,7 @@ private:
 };
 
 inline double wall_seconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 } // namespace anvil

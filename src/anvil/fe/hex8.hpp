@@ -15,10 +15,9 @@ inline constexpr double gamma_base[4][8] = {{1, 1, -1, -1, -1, -1, 1, 1},
                                             {-1, 1, -1, 1, 1, -1, 1, -1}};
 
 // For node a, the nodes that play "2..8" in Flanagan and Belytschko's formula for b_1.
-inline constexpr int fb_perm[8][7] = {{1, 2, 3, 4, 5, 6, 7}, {2, 3, 0, 5, 6, 7, 4},
-                                      {3, 0, 1, 6, 7, 4, 5}, {0, 1, 2, 7, 4, 5, 6},
-                                      {7, 6, 5, 0, 3, 2, 1}, {4, 7, 6, 1, 0, 3, 2},
-                                      {5, 4, 7, 2, 1, 0, 3}, {6, 5, 4, 3, 2, 1, 0}};
+inline constexpr int fb_perm[8][7] = {
+    {1, 2, 3, 4, 5, 6, 7}, {2, 3, 0, 5, 6, 7, 4}, {3, 0, 1, 6, 7, 4, 5}, {0, 1, 2, 7, 4, 5, 6},
+    {7, 6, 5, 0, 3, 2, 1}, {4, 7, 6, 1, 0, 3, 2}, {5, 4, 7, 2, 1, 0, 3}, {6, 5, 4, 3, 2, 1, 0}};
 
 // Gradient operator B_ia = integral over the element of dN_a/dx_i = dV/dx_ia, exact for
 // the trilinear map (Flanagan and Belytschko eq. 79). x[a][i]: node a, coordinate i.

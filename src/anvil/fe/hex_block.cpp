@@ -17,12 +17,25 @@ using simd::padded_size;
 
 // Scratch layout inside HexWorkspace: one array of `chunk` values per entry.
 enum Slot : int {
-  s_d0, s_d1, s_d2, s_d3, s_d4, s_d5, // rate of deformation
+  s_d0,
+  s_d1,
+  s_d2,
+  s_d3,
+  s_d4,
+  s_d5, // rate of deformation
   s_density,
   s_wave_speed,
-  s_power_old,                        // old (rotated) stress : D
+  s_power_old, // old (rotated) stress : D
   s_volume_mid,
-  s_q0, s_q1, s_q2, s_q3, s_q4, s_q5, s_q6, s_q7, s_q8, // Hughes-Winget rotation
+  s_q0,
+  s_q1,
+  s_q2,
+  s_q3,
+  s_q4,
+  s_q5,
+  s_q6,
+  s_q7,
+  s_q8, // Hughes-Winget rotation
   s_count
 };
 
@@ -50,7 +63,8 @@ void HexBlock::allocate_state() {
   volume.assign(p, 0.0);
   for (auto& s : stress) s.assign(p, 0.0);
   if (material && material->has_plastic_strain()) plastic_strain.assign(p, 0.0);
-  if (material && material->has_temperature()) temperature.assign(p, material->initial_temperature());
+  if (material && material->has_temperature())
+    temperature.assign(p, material->initial_temperature());
   if (hourglass.model == HourglassControl::Model::stiffness)
     for (auto& h : hourglass_force) h.assign(p, 0.0);
   internal_energy.assign(p, 0.0);
@@ -192,7 +206,8 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       const vdouble power_new =
           s[0] * d[0] + s[1] * d[1] + s[2] * d[2] + 2.0 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
       const vdouble vmid = simd::load(scratch(s_volume_mid) + l);
-      const vdouble dE = dt * vmid * (0.5 * (simd::load(scratch(s_power_old) + l) + power_new) - q * trd);
+      const vdouble dE =
+          dt * vmid * (0.5 * (simd::load(scratch(s_power_old) + l) + power_new) - q * trd);
       simd::store(simd::load(&b.internal_energy[e]) + dE, &b.internal_energy[e]);
       simd::store(simd::load(&b.hourglass_energy[e]) + dt * hg_power, &b.hourglass_energy[e]);
       simd::store(vol, &b.volume[e]);
@@ -206,7 +221,8 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       vdouble check = dte;
       for (int a = 0; a < 8; ++a)
         for (int i = 0; i < 3; ++i) {
-          simd::store(f[a][i], corners.f[i] + b.corner_base + static_cast<std::size_t>(a) * stride + e);
+          simd::store(f[a][i],
+                      corners.f[i] + b.corner_base + static_cast<std::size_t>(a) * stride + e);
           check += f[a][i];
         }
 
@@ -219,8 +235,7 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
         } else if (!std::isfinite(check[k])) {
           if (result.nonfinite_gid < 0 || id < result.nonfinite_gid) result.nonfinite_gid = id;
         }
-        if (dte[k] < result.dt_stable ||
-            (dte[k] == result.dt_stable && id < result.stable_gid)) {
+        if (dte[k] < result.dt_stable || (dte[k] == result.dt_stable && id < result.stable_gid)) {
           result.dt_stable = dte[k];
           result.stable_gid = id;
         }

@@ -33,24 +33,24 @@ struct BulkViscosity {
 };
 
 struct HexBlock {
-  std::string name;                       // part name
-  int part = 0;                           // part index in the deck
-  const Material* material = nullptr;     // not owned
+  std::string name;                   // part name
+  int part = 0;                       // part index in the deck
+  const Material* material = nullptr; // not owned
   HourglassControl hourglass;
   BulkViscosity bulk_viscosity;
 
-  std::vector<std::int64_t> gid;          // global element ids, ascending
-  std::array<std::vector<int>, 8> conn;   // local node index of each corner
-  std::vector<double> mass;               // kg
-  std::vector<double> volume;             // current volume, m^3
-  std::array<std::vector<double>, 6> stress; // Cauchy stress, Pa
-  std::vector<double> plastic_strain;     // empty unless the material has it
-  std::vector<double> temperature;        // empty unless the material has it
+  std::vector<std::int64_t> gid;                       // global element ids, ascending
+  std::array<std::vector<int>, 8> conn;                // local node index of each corner
+  std::vector<double> mass;                            // kg
+  std::vector<double> volume;                          // current volume, m^3
+  std::array<std::vector<double>, 6> stress;           // Cauchy stress, Pa
+  std::vector<double> plastic_strain;                  // empty unless the material has it
+  std::vector<double> temperature;                     // empty unless the material has it
   std::array<std::vector<double>, 12> hourglass_force; // Q_i,alpha, stiffness form only
-  std::vector<double> internal_energy;    // J, stress work plus bulk viscosity work
-  std::vector<double> hourglass_energy;   // J
-  std::size_t corner_base = 0;            // corner (e, a) of this block lives at slot
-                                          // corner_base + a * size() + e
+  std::vector<double> internal_energy;                 // J, stress work plus bulk viscosity work
+  std::vector<double> hourglass_energy;                // J
+  std::size_t corner_base = 0;                         // corner (e, a) of this block lives at slot
+                                                       // corner_base + a * size() + e
 
   int size() const { return static_cast<int>(gid.size()); }
   // Sizes every state array for `n` elements (connectivity and gid set by the caller).

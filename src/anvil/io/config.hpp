@@ -21,8 +21,8 @@ namespace anvil {
 
 struct MaterialConfig {
   std::string name;
-  std::string model;   // registry name (material.hpp)
-  ParamValues params;  // every parameter of the model, defaults filled in
+  std::string model;  // registry name (material.hpp)
+  ParamValues params; // every parameter of the model, defaults filled in
   SourceLocation where;
 };
 
@@ -48,9 +48,9 @@ struct PartConfig {
 // A set of nodes: a named set (deck `node_sets`, or a generated `PART.SET`), or an
 // inline selection by part and/or box.
 struct Selection {
-  std::string name;                 // named set, or empty for an inline selection
-  std::optional<std::string> part;  // restrict to the nodes of a part
-  std::optional<Box3> box;          // restrict to a box (boundary included)
+  std::string name;                // named set, or empty for an inline selection
+  std::optional<std::string> part; // restrict to the nodes of a part
+  std::optional<Box3> box;         // restrict to a box (boundary included)
   SourceLocation where;
 };
 
@@ -65,8 +65,8 @@ struct InitialCondition {
 struct BoundaryCondition {
   Selection nodes;
   std::array<bool, 3> fix{false, false, false};        // fixed components (velocity 0)
-  bool prescribed = false;                              // a prescribed velocity
-  Vec3 velocity;                                        // its value, m/s
+  bool prescribed = false;                             // a prescribed velocity
+  Vec3 velocity;                                       // its value, m/s
   std::array<bool, 3> components{false, false, false}; // components it prescribes
   SourceLocation where;
 };

@@ -43,7 +43,8 @@ public:
 
   // Children of a map, in file order, after checking the keys against `allowed` (empty:
   // any key) and rejecting duplicates.
-  std::vector<std::pair<std::string, Node>> entries(std::initializer_list<std::string_view> allowed = {}) const {
+  std::vector<std::pair<std::string, Node>>
+  entries(std::initializer_list<std::string_view> allowed = {}) const {
     if (!n_.IsMap()) fail("expected a mapping (key: value pairs)");
     std::vector<std::pair<std::string, Node>> out;
     std::set<std::string> seen;
@@ -58,7 +59,8 @@ public:
           std::find(allowed.begin(), allowed.end(), std::string_view(key)) == allowed.end()) {
         std::string list;
         for (auto a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-        throw InputError({*file_, kline, sub}, fmt::format("unknown key '{}' (expected one of: {})", key, list));
+        throw InputError({*file_, kline, sub},
+                         fmt::format("unknown key '{}' (expected one of: {})", key, list));
       }
       if (!seen.insert(key).second) throw InputError({*file_, kline, sub}, "duplicate key");
       out.emplace_back(key, Node(it->second, sub, file_, kline));
@@ -75,7 +77,8 @@ public:
     if (!n_.IsMap()) fail("expected a mapping (key: value pairs)");
     // Reported at the line of the key that owns this mapping (the part's name, say).
     if (!has(key))
-      throw InputError({*file_, fallback_line_ > 0 ? fallback_line_ : line(), path_.empty() ? key : path_ + "." + key},
+      throw InputError({*file_, fallback_line_ > 0 ? fallback_line_ : line(),
+                        path_.empty() ? key : path_ + "." + key},
                        "required key is missing");
     return child(key);
   }
@@ -107,7 +110,8 @@ public:
   }
   std::int64_t integer() const {
     const double v = number();
-    if (v != std::floor(v) || std::abs(v) > 9e15) fail(fmt::format("expected an integer, got '{}'", str()));
+    if (v != std::floor(v) || std::abs(v) > 9e15)
+      fail(fmt::format("expected an integer, got '{}'", str()));
     return static_cast<std::int64_t>(v);
   }
   double positive() const {
@@ -122,7 +126,8 @@ public:
   }
   template <std::size_t N>
   std::array<int, N> positive_ints() const {
-    if (!n_.IsSequence() || n_.size() != N) fail(fmt::format("expected a list of {} positive integers", N));
+    if (!n_.IsSequence() || n_.size() != N)
+      fail(fmt::format("expected a list of {} positive integers", N));
     std::array<int, N> out{};
     const auto it = items();
     for (std::size_t i = 0; i < N; ++i) {
@@ -157,10 +162,14 @@ private:
 // Generated meshes define these sets; file meshes define their own (checked at setup).
 std::vector<std::string> generated_sets(MeshConfig::Kind kind) {
   switch (kind) {
-  case MeshConfig::Kind::box: return {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
-  case MeshConfig::Kind::cylinder: return {"bottom", "top", "outer"};
-  case MeshConfig::Kind::can: return {"bottom", "top", "inner", "outer"};
-  case MeshConfig::Kind::file: return {};
+  case MeshConfig::Kind::box:
+    return {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+  case MeshConfig::Kind::cylinder:
+    return {"bottom", "top", "outer"};
+  case MeshConfig::Kind::can:
+    return {"bottom", "top", "inner", "outer"};
+  case MeshConfig::Kind::file:
+    return {};
   }
   return {};
 }
@@ -173,7 +182,8 @@ MaterialConfig parse_material(const std::string& name, const Node& n) {
   const MaterialModel* info = find_material_model(model);
   if (!info) {
     std::string list;
-    for (const auto& mm : material_models()) list += (list.empty() ? "" : ", ") + std::string(mm.name);
+    for (const auto& mm : material_models())
+      list += (list.empty() ? "" : ", ") + std::string(mm.name);
     n.child("model").fail(fmt::format("unknown material model '{}' (available: {})", model, list));
   }
   m.model = model;
@@ -191,9 +201,11 @@ MaterialConfig parse_material(const std::string& name, const Node& n) {
     const bool high_ok = spec->max_exclusive ? x < spec->max : x <= spec->max;
     if (!low_ok || !high_ok) {
       std::string range;
-      if (spec->min > -1e299) range += fmt::format("{} {}", spec->min_exclusive ? ">" : ">=", spec->min);
+      if (spec->min > -1e299)
+        range += fmt::format("{} {}", spec->min_exclusive ? ">" : ">=", spec->min);
       if (spec->max < 1e299)
-        range += fmt::format("{}{} {}", range.empty() ? "" : " and ", spec->max_exclusive ? "<" : "<=", spec->max);
+        range += fmt::format("{}{} {}", range.empty() ? "" : " and ",
+                             spec->max_exclusive ? "<" : "<=", spec->max);
       v.fail(fmt::format("{} = {} is impossible: must be {}", key, x, range));
     }
     m.params[key] = x;
@@ -220,7 +232,8 @@ MeshConfig parse_mesh(const Node& n, const std::string& base_dir) {
     std::filesystem::path p(n.child("file").str());
     if (p.is_relative()) p = std::filesystem::path(base_dir) / p;
     mc.file = p.string();
-    if (!std::filesystem::exists(p)) n.child("file").fail(fmt::format("mesh file '{}' does not exist", mc.file));
+    if (!std::filesystem::exists(p))
+      n.child("file").fail(fmt::format("mesh file '{}' does not exist", mc.file));
     return mc;
   }
   const std::string gen = n.required("generate").str();
@@ -231,7 +244,8 @@ MeshConfig parse_mesh(const Node& n, const std::string& base_dir) {
     mc.box.max = n.required("max").vec3();
     mc.box.divisions = n.required("divisions").positive_ints<3>();
     for (int i = 0; i < 3; ++i)
-      if (!(mc.box.max[i] > mc.box.min[i])) n.child("max").fail("max must exceed min in every direction");
+      if (!(mc.box.max[i] > mc.box.min[i]))
+        n.child("max").fail("max must exceed min in every direction");
   } else if (gen == "cylinder") {
     n.check_keys({"generate", "radius", "length", "axis", "origin", "divisions"});
     mc.kind = MeshConfig::Kind::cylinder;
@@ -240,20 +254,23 @@ MeshConfig parse_mesh(const Node& n, const std::string& base_dir) {
     if (n.has("axis")) mc.cylinder.axis = n.child("axis").axis();
     if (n.has("origin")) mc.cylinder.origin = n.child("origin").vec3();
     mc.cylinder.divisions = n.required("divisions").positive_ints<2>();
-    if (mc.cylinder.divisions[0] < 2) n.child("divisions").fail("needs at least 2 elements across the radius");
+    if (mc.cylinder.divisions[0] < 2)
+      n.child("divisions").fail("needs at least 2 elements across the radius");
   } else if (gen == "can") {
     n.check_keys({"generate", "radius", "height", "thickness", "axis", "origin", "divisions"});
     mc.kind = MeshConfig::Kind::can;
     mc.can.radius = n.required("radius").positive();
     mc.can.height = n.required("height").positive();
     mc.can.thickness = n.required("thickness").positive();
-    if (mc.can.thickness >= 2 * mc.can.radius) n.child("thickness").fail("must be less than the diameter");
+    if (mc.can.thickness >= 2 * mc.can.radius)
+      n.child("thickness").fail("must be less than the diameter");
     if (n.has("axis")) mc.can.axis = n.child("axis").axis();
     if (n.has("origin")) mc.can.origin = n.child("origin").vec3();
     mc.can.divisions = n.required("divisions").positive_ints<3>();
     if (mc.can.divisions[0] < 3) n.child("divisions").fail("needs at least 3 elements around");
   } else {
-    n.child("generate").fail(fmt::format("unknown generator '{}' (expected box, cylinder or can)", gen));
+    n.child("generate")
+        .fail(fmt::format("unknown generator '{}' (expected box, cylinder or can)", gen));
   }
   return mc;
 }
@@ -270,9 +287,13 @@ PartConfig parse_part(const std::string& name, const Node& n, const std::string&
     h.check_keys({"model", "coefficient"});
     if (h.has("model")) {
       const std::string m = h.child("model").str();
-      if (m == "viscous") p.hourglass.model = HourglassControl::Model::viscous;
-      else if (m == "stiffness") p.hourglass.model = HourglassControl::Model::stiffness;
-      else h.child("model").fail(fmt::format("unknown hourglass model '{}' (expected viscous or stiffness)", m));
+      if (m == "viscous")
+        p.hourglass.model = HourglassControl::Model::viscous;
+      else if (m == "stiffness")
+        p.hourglass.model = HourglassControl::Model::stiffness;
+      else
+        h.child("model").fail(
+            fmt::format("unknown hourglass model '{}' (expected viscous or stiffness)", m));
     }
     if (h.has("coefficient")) {
       const double c = h.child("coefficient").number();
@@ -328,24 +349,26 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw InputError({name, e.mark.line >= 0 ? e.mark.line + 1 : 0, ""}, "malformed YAML: " + e.msg);
+    throw InputError({name, e.mark.line >= 0 ? e.mark.line + 1 : 0, ""},
+                     "malformed YAML: " + e.msg);
   }
   const Node top(root, "", &c.deck_file, 1);
   if (top.is_null()) throw InputError({name, 1, ""}, "the deck is empty");
-  const auto entries = top.entries({"title", "termination", "time_step", "materials", "parts",
-                                    "particles", "node_sets", "initial_conditions",
-                                    "boundary_conditions", "contact", "rigid_walls", "probes",
-                                    "output"});
+  const auto entries = top.entries(
+      {"title", "termination", "time_step", "materials", "parts", "particles", "node_sets",
+       "initial_conditions", "boundary_conditions", "contact", "rigid_walls", "probes", "output"});
   for (const auto& [key, n] : entries) {
     if (key == "particles" || key == "contact" || key == "rigid_walls")
-      n.fail(fmt::format("'{}' is part of the deck contract but not implemented in anvil {} yet", key, "0.1"));
+      n.fail(fmt::format("'{}' is part of the deck contract but not implemented in anvil {} yet",
+                         key, "0.1"));
   }
 
   if (top.has("title")) c.title = top.child("title").str();
 
   const Node term = top.required("termination");
   term.check_keys({"time", "cycles"});
-  if (!term.has("time") && !term.has("cycles")) term.fail("give an end time, a number of cycles, or both");
+  if (!term.has("time") && !term.has("cycles"))
+    term.fail("give an end time, a number of cycles, or both");
   if (term.has("time")) c.end_time = term.child("time").positive();
   if (term.has("cycles")) {
     c.end_cycles = term.child("cycles").integer();
@@ -370,13 +393,15 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
     if (pname.find('.') != std::string::npos) pn.fail("part names may not contain '.'");
     PartConfig p = parse_part(pname, pn, base_dir);
     if (!c.material(p.material))
-      pn.child("material").fail(fmt::format("material '{}' is not defined under materials", p.material));
+      pn.child("material")
+          .fail(fmt::format("material '{}' is not defined under materials", p.material));
     c.parts.push_back(std::move(p));
   }
   if (c.parts.empty()) top.child("parts").fail("at least one part is needed");
 
   auto part_exists = [&](const std::string& n) {
-    return std::any_of(c.parts.begin(), c.parts.end(), [&](const PartConfig& p) { return p.name == n; });
+    return std::any_of(c.parts.begin(), c.parts.end(),
+                       [&](const PartConfig& p) { return p.name == n; });
   };
   auto check_part = [&](const Selection& s) {
     if (s.part && !part_exists(*s.part))
@@ -398,10 +423,14 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
           if (std::find(sets.begin(), sets.end(), set) != sets.end()) return;
           std::string list;
           for (const auto& x : sets) list += (list.empty() ? "" : ", ") + part + "." + x;
-          throw InputError(s.where, fmt::format("node set '{}' does not exist: part '{}' has {}", s.name, part, list));
+          throw InputError(s.where, fmt::format("node set '{}' does not exist: part '{}' has {}",
+                                                s.name, part, list));
         }
     }
-    throw InputError(s.where, fmt::format("node set '{}' is not defined (define it under node_sets, or use PART.SET)", s.name));
+    throw InputError(
+        s.where,
+        fmt::format("node set '{}' is not defined (define it under node_sets, or use PART.SET)",
+                    s.name));
   };
 
   if (top.has("node_sets")) {
@@ -426,7 +455,8 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
         ic.nodes = parse_set_ref(n.child("set"));
       }
       check_name(ic.nodes);
-      if (!n.has("velocity") && !n.has("angular_velocity")) n.fail("give a velocity, an angular_velocity, or both");
+      if (!n.has("velocity") && !n.has("angular_velocity"))
+        n.fail("give a velocity, an angular_velocity, or both");
       if (n.has("velocity")) ic.velocity = n.child("velocity").vec3();
       if (n.has("angular_velocity")) {
         ic.angular_velocity = n.child("angular_velocity").vec3();
@@ -448,11 +478,14 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
       if (n.has("fix") == n.has("velocity")) n.fail("give exactly one of 'fix' or 'velocity'");
       if (n.has("fix")) {
         bc.fix = n.child("fix").components();
-        if (n.has("components")) n.child("components").fail("components goes with velocity; list fixed components under fix");
+        if (n.has("components"))
+          n.child("components")
+              .fail("components goes with velocity; list fixed components under fix");
       } else {
         bc.prescribed = true;
         bc.velocity = n.child("velocity").vec3();
-        bc.components = n.has("components") ? n.child("components").components() : std::array<bool, 3>{true, true, true};
+        bc.components = n.has("components") ? n.child("components").components()
+                                            : std::array<bool, 3>{true, true, true};
       }
       c.boundary_conditions.push_back(bc);
     }
@@ -463,7 +496,8 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
     for (const auto& n : top.child("probes").items()) {
       n.check_keys({"name", "at"});
       ProbeConfig p{n.required("name").str(), n.required("at").vec3(), n.where()};
-      if (!names.insert(p.name).second) n.child("name").fail(fmt::format("probe name '{}' is used twice", p.name));
+      if (!names.insert(p.name).second)
+        n.child("name").fail(fmt::format("probe name '{}' is used twice", p.name));
       c.probes.push_back(p);
     }
   }

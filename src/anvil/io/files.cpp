@@ -26,7 +26,8 @@ void write_file_atomic(const std::string& path, std::string_view content) {
   }
   ::fsync(fd);
   ::close(fd);
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw InputError("cannot rename '" + tmp + "' to '" + path + "'");
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+    throw InputError("cannot rename '" + tmp + "' to '" + path + "'");
 }
 
 void make_directories(const std::string& path) {

@@ -49,8 +49,9 @@ VtuPiece fe_piece(const Simulation& sim) {
         stress.f64.push_back(s[k]);
       }
       const double m = (s[0] + s[1] + s[2]) / 3;
-      const double j2 = 0.5 * ((s[0] - m) * (s[0] - m) + (s[1] - m) * (s[1] - m) + (s[2] - m) * (s[2] - m)) +
-                        s[3] * s[3] + s[4] * s[4] + s[5] * s[5];
+      const double j2 =
+          0.5 * ((s[0] - m) * (s[0] - m) + (s[1] - m) * (s[1] - m) + (s[2] - m) * (s[2] - m)) +
+          s[3] * s[3] + s[4] * s[4] + s[5] * s[5];
       vm.f64.push_back(std::sqrt(3 * j2));
       pres.f64.push_back(-m);
       ep.f64.push_back(b.plastic_strain.empty() ? 0.0 : b.plastic_strain[e]);
@@ -71,7 +72,8 @@ VtuPiece fe_piece(const Simulation& sim) {
   return p;
 }
 
-Outputs::Outputs(const Simulation& sim, OutputOptions options) : sim_(sim), opt_(std::move(options)) {
+Outputs::Outputs(const Simulation& sim, OutputOptions options)
+    : sim_(sim), opt_(std::move(options)) {
   // Rank 0 creates the directories; the others wait for it.
   std::int64_t ok = 1;
   std::string err;
@@ -94,7 +96,9 @@ Outputs::~Outputs() {
   if (history_) std::fclose(history_);
 }
 
-double Outputs::loop_seconds() const { return wall_seconds() - start_wall_; }
+double Outputs::loop_seconds() const {
+  return wall_seconds() - start_wall_;
+}
 
 void Outputs::begin() {
   start_wall_ = last_progress_wall_ = wall_seconds();
@@ -104,7 +108,8 @@ void Outputs::begin() {
     if (!history_) throw InputError("cannot write " + opt_.directory + "/history.csv");
     std::string h = "time,cycle,dt,kinetic,internal,hourglass,contact,external_work,total";
     for (const auto& p : c.probes)
-      for (const char* f : {"ux", "uy", "uz", "vx", "vy", "vz"}) h += fmt::format(",{}.{}", p.name, f);
+      for (const char* f : {"ux", "uy", "uz", "vx", "vy", "vz"})
+        h += fmt::format(",{}.{}", p.name, f);
     std::fprintf(history_, "%s\n", h.c_str());
     std::fflush(history_);
   }
@@ -115,9 +120,9 @@ void Outputs::begin() {
 
 void Outputs::write_history_row(const Sample& s) {
   if (!history_) return;
-  std::string row = fmt::format("{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", s.time,
-                                s.cycle, s.dt, s.kinetic, s.internal, s.hourglass, s.contact,
-                                s.external_work, s.total());
+  std::string row = fmt::format(
+      "{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", s.time, s.cycle, s.dt,
+      s.kinetic, s.internal, s.hourglass, s.contact, s.external_work, s.total());
   for (double v : s.probes) row += fmt::format(",{:.17g}", v);
   std::fprintf(history_, "%s\n", row.c_str());
   std::fflush(history_);
@@ -149,11 +154,13 @@ void Outputs::write_fields() {
   last_field_cycle_ = clk.cycle;
   const std::string stem = fmt::format("step_{:06d}", field_count_++);
   const VtuPiece piece = fe_piece(sim_);
-  write_vtu(fmt::format("{}/fields/{}_r{:04d}.vtu", opt_.directory, stem, sim_.comm().rank()), piece);
+  write_vtu(fmt::format("{}/fields/{}_r{:04d}.vtu", opt_.directory, stem, sim_.comm().rank()),
+            piece);
   sim_.comm().barrier(); // every piece is complete before the index names it
   if (sim_.comm().rank() == 0) {
     std::vector<std::string> pieces;
-    for (int r = 0; r < sim_.comm().size(); ++r) pieces.push_back(fmt::format("{}_r{:04d}.vtu", stem, r));
+    for (int r = 0; r < sim_.comm().size(); ++r)
+      pieces.push_back(fmt::format("{}_r{:04d}.vtu", stem, r));
     write_pvtu(fmt::format("{}/fields/{}.pvtu", opt_.directory, stem), pieces, piece);
     pvd_.emplace_back(clk.time, fmt::format("fields/{}.pvtu", stem));
     write_pvd(opt_.directory + "/results.pvd", pvd_);
@@ -167,10 +174,13 @@ void Outputs::progress(bool last) {
   double frac = 0;
   if (std::isfinite(c.end_time)) frac = clk.time / c.end_time;
   if (c.end_cycles < std::numeric_limits<std::int64_t>::max())
-    frac = std::max(frac, static_cast<double>(clk.cycle) / static_cast<double>(std::max<std::int64_t>(c.end_cycles, 1)));
+    frac = std::max(frac, static_cast<double>(clk.cycle) /
+                              static_cast<double>(std::max<std::int64_t>(c.end_cycles, 1)));
   frac = std::min(frac, 1.0);
   const double now = wall_seconds();
-  const bool due = tty_ ? (now - last_progress_wall_ >= 0.25) : (frac - last_progress_fraction_ >= 0.1 || now - last_progress_wall_ >= 30);
+  const bool due = tty_
+                       ? (now - last_progress_wall_ >= 0.25)
+                       : (frac - last_progress_fraction_ >= 0.1 || now - last_progress_wall_ >= 30);
   if (!due && !last) return;
   last_progress_wall_ = now;
   last_progress_fraction_ = frac;
@@ -178,10 +188,13 @@ void Outputs::progress(bool last) {
   const double eta = frac > 0 ? elapsed * (1 - frac) / frac : 0;
   const double n = static_cast<double>(sim_.global_elements());
   const double grind = clk.cycle > 0 ? elapsed / static_cast<double>(clk.cycle) / n * 1e6 : 0;
-  const std::string line = fmt::format("cycle {:>8}  t {:.4e} s  dt {:.3e} s  {:5.1f}%  left {:6.1f} s  grind {:.4f} us",
-                                       clk.cycle, clk.time, clk.dt, 100 * frac, eta, grind);
-  if (tty_) std::printf("\r%s%s", line.c_str(), last ? "\n" : "");
-  else std::printf("%s\n", line.c_str());
+  const std::string line =
+      fmt::format("cycle {:>8}  t {:.4e} s  dt {:.3e} s  {:5.1f}%  left {:6.1f} s  grind {:.4f} us",
+                  clk.cycle, clk.time, clk.dt, 100 * frac, eta, grind);
+  if (tty_)
+    std::printf("\r%s%s", line.c_str(), last ? "\n" : "");
+  else
+    std::printf("%s\n", line.c_str());
   std::fflush(stdout);
 }
 
@@ -237,16 +250,13 @@ void Outputs::write_summary(int status, const std::string& message) {
   imb["sph"] = 1.0;
   imb["contact"] = 1.0;
   j["imbalance"] = imb;
-  j["energy"] = {{"time", s.time},
-                 {"kinetic", s.kinetic},
-                 {"internal", s.internal},
-                 {"hourglass", s.hourglass},
-                 {"contact", s.contact},
-                 {"external_work", s.external_work},
-                 {"total", s.total()},
-                 {"balance_error", sim_.balance_error(s)}};
+  j["energy"] = {{"time", s.time},         {"kinetic", s.kinetic},
+                 {"internal", s.internal}, {"hourglass", s.hourglass},
+                 {"contact", s.contact},   {"external_work", s.external_work},
+                 {"total", s.total()},     {"balance_error", sim_.balance_error(s)}};
   json masses = json::object();
-  for (std::size_t i = 0; i < sim_.config().parts.size(); ++i) masses[sim_.config().parts[i].name] = sim_.part_masses()[i];
+  for (std::size_t i = 0; i < sim_.config().parts.size(); ++i)
+    masses[sim_.config().parts[i].name] = sim_.part_masses()[i];
   j["part_mass"] = masses;
   write_file_atomic(opt_.directory + "/summary.json", j.dump(2) + "\n");
 }

@@ -43,25 +43,32 @@ void write_vtu(const std::string& path, const VtuPiece& p) {
   a.header += "      </PointData>\n      <CellData>\n";
   for (const auto& arr : p.cell_data) array_tag(a, arr);
   a.header += "      </CellData>\n      <Points>\n";
-  a.header += fmt::format("        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" offset=\"{}\"/>\n",
+  a.header += fmt::format("        <DataArray type=\"Float64\" NumberOfComponents=\"3\" "
+                          "format=\"appended\" offset=\"{}\"/>\n",
                           a.add(p.points));
   a.header += "      </Points>\n      <Cells>\n";
-  a.header += fmt::format("        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"appended\" offset=\"{}\"/>\n",
+  a.header += fmt::format("        <DataArray type=\"Int64\" Name=\"connectivity\" "
+                          "format=\"appended\" offset=\"{}\"/>\n",
                           a.add(p.connectivity));
-  a.header += fmt::format("        <DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"{}\"/>\n",
-                          a.add(p.offsets));
-  a.header += fmt::format("        <DataArray type=\"UInt8\" Name=\"types\" format=\"appended\" offset=\"{}\"/>\n",
-                          a.add(p.types));
-  a.header += "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _";
+  a.header += fmt::format(
+      "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"{}\"/>\n",
+      a.add(p.offsets));
+  a.header += fmt::format(
+      "        <DataArray type=\"UInt8\" Name=\"types\" format=\"appended\" offset=\"{}\"/>\n",
+      a.add(p.types));
+  a.header += "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n  <AppendedData "
+              "encoding=\"raw\">\n   _";
   std::string out = std::move(a.header);
   out += a.blob;
   out += "\n  </AppendedData>\n</VTKFile>\n";
   write_file_atomic(path, out);
 }
 
-void write_pvtu(const std::string& path, const std::vector<std::string>& pieces, const VtuPiece& layout) {
+void write_pvtu(const std::string& path, const std::vector<std::string>& pieces,
+                const VtuPiece& layout) {
   std::string s = "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" "
-                  "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <PUnstructuredGrid GhostLevel=\"0\">\n";
+                  "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <PUnstructuredGrid "
+                  "GhostLevel=\"0\">\n";
   auto arrays = [&](const std::vector<VtuArray>& list) {
     for (const auto& a : list)
       s += fmt::format("      <PDataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\"/>\n",
@@ -71,14 +78,17 @@ void write_pvtu(const std::string& path, const std::vector<std::string>& pieces,
   arrays(layout.point_data);
   s += "    </PPointData>\n    <PCellData>\n";
   arrays(layout.cell_data);
-  s += "    </PCellData>\n    <PPoints>\n      <PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n    </PPoints>\n";
+  s += "    </PCellData>\n    <PPoints>\n      <PDataArray type=\"Float64\" "
+       "NumberOfComponents=\"3\"/>\n    </PPoints>\n";
   for (const auto& f : pieces) s += fmt::format("    <Piece Source=\"{}\"/>\n", f);
   s += "  </PUnstructuredGrid>\n</VTKFile>\n";
   write_file_atomic(path, s);
 }
 
-void write_pvd(const std::string& path, const std::vector<std::pair<double, std::string>>& entries) {
-  std::string s = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\">\n  <Collection>\n";
+void write_pvd(const std::string& path,
+               const std::vector<std::pair<double, std::string>>& entries) {
+  std::string s =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\">\n  <Collection>\n";
   for (const auto& [t, f] : entries)
     s += fmt::format("    <DataSet timestep=\"{:.17g}\" part=\"0\" file=\"{}\"/>\n", t, f);
   s += "  </Collection>\n</VTKFile>\n";

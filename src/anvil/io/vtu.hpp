@@ -19,16 +19,17 @@ struct VtuArray {
 };
 
 struct VtuPiece {
-  std::vector<double> points;              // x, y, z per point
-  std::vector<std::int64_t> connectivity;  // point indices of every cell
-  std::vector<std::int64_t> offsets;       // end of each cell in connectivity
-  std::vector<std::uint8_t> types;         // VTK cell type per cell (12 hexahedron, 1 vertex)
+  std::vector<double> points;             // x, y, z per point
+  std::vector<std::int64_t> connectivity; // point indices of every cell
+  std::vector<std::int64_t> offsets;      // end of each cell in connectivity
+  std::vector<std::uint8_t> types;        // VTK cell type per cell (12 hexahedron, 1 vertex)
   std::vector<VtuArray> point_data, cell_data;
 };
 
 void write_vtu(const std::string& path, const VtuPiece& piece);
 // Lists `pieces` (file names relative to the .pvtu) with the array layout of `layout`.
-void write_pvtu(const std::string& path, const std::vector<std::string>& pieces, const VtuPiece& layout);
+void write_pvtu(const std::string& path, const std::vector<std::string>& pieces,
+                const VtuPiece& layout);
 // A ParaView collection: (time, file relative to the .pvd) per entry.
 void write_pvd(const std::string& path, const std::vector<std::pair<double, std::string>>& entries);
 

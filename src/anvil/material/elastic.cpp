@@ -24,7 +24,9 @@ ElasticConstants ElasticConstants::from(const ParamValues& p) {
   return c;
 }
 
-std::span<const ParamSpec> Elastic::params() { return elastic_params; }
+std::span<const ParamSpec> Elastic::params() {
+  return elastic_params;
+}
 
 void Elastic::update(const MaterialBatch& b) const {
   const double G2 = 2 * elastic().shear, lam = elastic().lambda;

@@ -15,7 +15,9 @@ constexpr ParamSpec j2_params[] = {
 };
 } // namespace
 
-std::span<const ParamSpec> J2Plasticity::params() { return j2_params; }
+std::span<const ParamSpec> J2Plasticity::params() {
+  return j2_params;
+}
 
 J2Plasticity::J2Plasticity(const ParamValues& p)
     : Material(p), yield_(p.at("yield_stress")), hardening_(p.at("hardening_modulus")) {}

@@ -17,7 +17,8 @@ constexpr ParamSpec jc_params[] = {
     {"m", "-", false, 1, 0, 1e300, true, false, "thermal softening exponent"},
     {"reference_strain_rate", "1/s", false, 1, 0, 1e300, true, false,
      "strain rate at which C has no effect"},
-    {"room_temperature", "K", false, 293, 0, 1e300, true, false, "initial and reference temperature"},
+    {"room_temperature", "K", false, 293, 0, 1e300, true, false,
+     "initial and reference temperature"},
     {"melt_temperature", "K", true, 0, 0, 1e300, true, false, "melting temperature"},
     {"specific_heat", "J/(kg K)", true, 0, 0, 1e300, true, false, "specific heat capacity"},
     {"taylor_quinney", "-", false, 0.9, 0, 1, false, false,
@@ -25,7 +26,9 @@ constexpr ParamSpec jc_params[] = {
 };
 } // namespace
 
-std::span<const ParamSpec> JohnsonCook::params() { return jc_params; }
+std::span<const ParamSpec> JohnsonCook::params() {
+  return jc_params;
+}
 
 JohnsonCook::JohnsonCook(const ParamValues& p)
     : Material(p), A_(p.at("A")), B_(p.at("B")), C_(p.at("C")), n_(p.at("n")), m_(p.at("m")),
@@ -68,12 +71,19 @@ void JohnsonCook::update(const MaterialBatch& b) const {
       double lo = 0, hi = q / (3 * G), x = 0;
       for (int it = 0; it < 60; ++it) {
         const double g = q - 3 * G * x - yield_stress(ep + x, rate, T);
-        if (g > 0) lo = x; else hi = x;
+        if (g > 0)
+          lo = x;
+        else
+          hi = x;
         const double h = 1e-7 * std::max(ep + x, 1e-6);
-        const double slope = -3 * G - (yield_stress(ep + x + h, rate, T) - yield_stress(ep + x, rate, T)) / h;
+        const double slope =
+            -3 * G - (yield_stress(ep + x + h, rate, T) - yield_stress(ep + x, rate, T)) / h;
         double next = x - g / slope;
         if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-        if (std::abs(next - x) <= 1e-14 * std::max(1.0, ep) + 1e-16) { x = next; break; }
+        if (std::abs(next - x) <= 1e-14 * std::max(1.0, ep) + 1e-16) {
+          x = next;
+          break;
+        }
         x = next;
       }
       dgamma = x;

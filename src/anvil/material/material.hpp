@@ -15,13 +15,13 @@ namespace anvil {
 // One batch of points. The caller owns every array; each holds `n` values.
 struct MaterialBatch {
   int n = 0;
-  double dt = 0;                 // time increment, s
-  const double* d[6] = {};       // rate of deformation at the mid-step, 1/s
-  const double* density = {};    // current density, kg/m^3
-  double* stress[6] = {};        // in: old stress already rotated to the new frame; out: new
-  double* plastic_strain = {};   // equivalent plastic strain (models with plasticity)
-  double* temperature = {};      // K (models with thermal softening)
-  double* wave_speed = {};       // out: longitudinal wave speed, m/s
+  double dt = 0;               // time increment, s
+  const double* d[6] = {};     // rate of deformation at the mid-step, 1/s
+  const double* density = {};  // current density, kg/m^3
+  double* stress[6] = {};      // in: old stress already rotated to the new frame; out: new
+  double* plastic_strain = {}; // equivalent plastic strain (models with plasticity)
+  double* temperature = {};    // K (models with thermal softening)
+  double* wave_speed = {};     // out: longitudinal wave speed, m/s
 };
 
 // A deck parameter of a model: name, unit, and the admissible range that the deck reader
@@ -42,9 +42,9 @@ struct ElasticConstants {
   double density = 0;        // reference density, kg/m^3
   double youngs_modulus = 0; // Pa
   double poissons_ratio = 0;
-  double shear = 0;          // G, Pa
-  double bulk = 0;           // K, Pa
-  double lambda = 0;         // Lame's first parameter, Pa
+  double shear = 0;  // G, Pa
+  double bulk = 0;   // K, Pa
+  double lambda = 0; // Lame's first parameter, Pa
   static ElasticConstants from(const ParamValues& p);
   double plane_wave_modulus() const { return lambda + 2 * shear; } // M = K + 4G/3
 };

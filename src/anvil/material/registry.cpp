@@ -24,7 +24,9 @@ const std::array<MaterialModel, 3>& models() {
 }
 } // namespace
 
-std::span<const MaterialModel> material_models() { return models(); }
+std::span<const MaterialModel> material_models() {
+  return models();
+}
 
 const MaterialModel* find_material_model(std::string_view name) {
   for (const auto& m : models())

@@ -13,9 +13,12 @@ namespace {
 // (which keeps the handedness, hence positive element volumes).
 Vec3 orient(const Vec3& p, int axis) {
   switch (axis) {
-  case 0: return {p.z, p.x, p.y};
-  case 1: return {p.y, p.z, p.x};
-  default: return p;
+  case 0:
+    return {p.z, p.x, p.y};
+  case 1:
+    return {p.y, p.z, p.x};
+  default:
+    return p;
   }
 }
 
@@ -107,11 +110,11 @@ Mesh generate_cylinder(const CylinderSpec& s) {
   require(s.divisions[0] >= 2 && s.divisions[1] >= 1,
           "cylinder needs divisions[0] >= 2 (radius) and divisions[1] >= 1 (axis)");
   const int c = std::max(1, s.divisions[0] / 2); // half-count of the central block
-  const int ring = s.divisions[0] - c;            // layers of the outer ring
-  const int n = 2 * c;                            // central block is n x n
-  const int perim = 4 * n;                        // nodes around the block boundary
+  const int ring = s.divisions[0] - c;           // layers of the outer ring
+  const int n = 2 * c;                           // central block is n x n
+  const int perim = 4 * n;                       // nodes around the block boundary
   const double R = s.radius;
-  const double half = R * c / s.divisions[0];     // half-side of the straight block
+  const double half = R * c / s.divisions[0]; // half-side of the straight block
   const double pi = std::numbers::pi;
 
   // Boundary of the central block at polar angle phi: a square bulged part-way towards
@@ -126,11 +129,13 @@ Mesh generate_cylinder(const CylinderSpec& s) {
   std::vector<std::array<double, 2>> pts;
   std::vector<std::array<std::int64_t, 4>> quads;
   // Central block: nodes (i, j), i, j in [0, n], Coons patch between the four edges.
-  auto bid = [&](int i, int j) -> std::int64_t { return static_cast<std::int64_t>(i) * (n + 1) + j; };
-  auto edge_r = [&](double eta) { return inner(pi / 4 * eta); };            // xi = +1
-  auto edge_t = [&](double xi) { return inner(pi / 2 - pi / 4 * xi); };     // eta = +1
-  auto edge_l = [&](double eta) { return inner(pi - pi / 4 * eta); };       // xi = -1
-  auto edge_b = [&](double xi) { return inner(-pi / 2 + pi / 4 * xi); };    // eta = -1
+  auto bid = [&](int i, int j) -> std::int64_t {
+    return static_cast<std::int64_t>(i) * (n + 1) + j;
+  };
+  auto edge_r = [&](double eta) { return inner(pi / 4 * eta); };         // xi = +1
+  auto edge_t = [&](double xi) { return inner(pi / 2 - pi / 4 * xi); };  // eta = +1
+  auto edge_l = [&](double eta) { return inner(pi - pi / 4 * eta); };    // xi = -1
+  auto edge_b = [&](double xi) { return inner(-pi / 2 + pi / 4 * xi); }; // eta = -1
   pts.resize(static_cast<std::size_t>((n + 1) * (n + 1)));
   const auto p00 = edge_b(-1), p10 = edge_b(1), p01 = edge_t(-1), p11 = edge_t(1);
   for (int i = 0; i <= n; ++i)
@@ -159,7 +164,9 @@ Mesh generate_cylinder(const CylinderSpec& s) {
   }
   // Ring: layer 0 is the block boundary, layer `ring` the circle.
   std::vector<std::int64_t> ring_id(static_cast<std::size_t>(perim) * (ring + 1));
-  auto rid = [&](int k, int j) -> std::int64_t& { return ring_id[static_cast<std::size_t>(j) * perim + (k % perim)]; };
+  auto rid = [&](int k, int j) -> std::int64_t& {
+    return ring_id[static_cast<std::size_t>(j) * perim + (k % perim)];
+  };
   for (int k = 0; k < perim; ++k) {
     rid(k, 0) = boundary[k];
     const double phi = -pi / 4 + 2 * pi * k / perim;
@@ -194,7 +201,9 @@ Mesh generate_can(const CanSpec& s) {
           "can divisions need >= 3 around, >= 1 along the axis, >= 1 through the wall");
   std::vector<std::array<double, 2>> pts;
   std::vector<std::array<std::int64_t, 4>> quads;
-  auto id = [&](int k, int j) -> std::int64_t { return static_cast<std::int64_t>(k % na) * (nt + 1) + j; };
+  auto id = [&](int k, int j) -> std::int64_t {
+    return static_cast<std::int64_t>(k % na) * (nt + 1) + j;
+  };
   const double pi = std::numbers::pi;
   for (int k = 0; k < na; ++k) {
     const double phi = 2 * pi * k / na;
@@ -204,7 +213,8 @@ Mesh generate_can(const CanSpec& s) {
     }
   }
   for (int k = 0; k < na; ++k)
-    for (int j = 0; j < nt; ++j) quads.push_back({id(k, j), id(k, j + 1), id(k + 1, j + 1), id(k + 1, j)});
+    for (int j = 0; j < nt; ++j)
+      quads.push_back({id(k, j), id(k, j + 1), id(k + 1, j + 1), id(k + 1, j)});
   Mesh m = extrude(pts, quads, nh, s.height, s.axis, s.origin, "can");
   const auto np = static_cast<std::int64_t>(pts.size());
   auto& inner = m.node_sets["inner"];

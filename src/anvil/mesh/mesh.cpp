@@ -13,7 +13,8 @@ std::int64_t Mesh::num_elements() const {
 
 std::vector<std::int64_t> Mesh::block_offsets() const {
   std::vector<std::int64_t> off(1, 0);
-  for (const auto& b : blocks) off.push_back(off.back() + static_cast<std::int64_t>(b.elements.size()));
+  for (const auto& b : blocks)
+    off.push_back(off.back() + static_cast<std::int64_t>(b.elements.size()));
   return off;
 }
 

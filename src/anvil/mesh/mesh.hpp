@@ -22,16 +22,12 @@ using Hex = std::array<std::int64_t, 8>;
 // Local node numbers of the six faces, each counter-clockwise seen from outside
 // (outward normal by the right-hand rule). Face order is Exodus's side numbering
 // minus one: sides 1-4 around the element, 5 bottom, 6 top.
-inline constexpr std::array<std::array<int, 4>, 6> hex_faces = {{{0, 1, 5, 4},
-                                                                {1, 2, 6, 5},
-                                                                {2, 3, 7, 6},
-                                                                {3, 0, 4, 7},
-                                                                {0, 3, 2, 1},
-                                                                {4, 5, 6, 7}}};
+inline constexpr std::array<std::array<int, 4>, 6> hex_faces = {
+    {{0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}, {0, 3, 2, 1}, {4, 5, 6, 7}}};
 
 struct ElementBlock {
-  std::string name;             // part name (deck) or block name (mesh file)
-  std::vector<Hex> elements;    // connectivity by global node id
+  std::string name;          // part name (deck) or block name (mesh file)
+  std::vector<Hex> elements; // connectivity by global node id
 };
 
 struct SideEntry {
@@ -40,8 +36,8 @@ struct SideEntry {
 };
 
 struct Mesh {
-  std::vector<Vec3> nodes;                                   // coordinates by global id
-  std::vector<ElementBlock> blocks;                          // in global element order
+  std::vector<Vec3> nodes;                                    // coordinates by global id
+  std::vector<ElementBlock> blocks;                           // in global element order
   std::map<std::string, std::vector<std::int64_t>> node_sets; // sorted, unique node ids
   std::map<std::string, std::vector<SideEntry>> side_sets;
 

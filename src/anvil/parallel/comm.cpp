@@ -60,20 +60,25 @@ Requests::Requests(Requests&&) noexcept = default;
 Requests& Requests::operator=(Requests&&) noexcept = default;
 void Requests::wait() {
   if (impl_->list.empty()) return;
-  check(MPI_Waitall(static_cast<int>(impl_->list.size()), impl_->list.data(),
-                    MPI_STATUSES_IGNORE),
+  check(MPI_Waitall(static_cast<int>(impl_->list.size()), impl_->list.data(), MPI_STATUSES_IGNORE),
         "MPI_Waitall");
   impl_->list.clear();
 }
-std::size_t Requests::size() const { return impl_->list.size(); }
+std::size_t Requests::size() const {
+  return impl_->list.size();
+}
 
 Comm::Comm(void* handle, bool owned) : handle_(handle), owned_(owned) {
   MPI_Comm c = to_mpi(handle_);
   MPI_Comm_rank(c, &rank_);
   MPI_Comm_size(c, &size_);
 }
-Comm Comm::world() { return Comm(from_mpi(MPI_COMM_WORLD), false); }
-Comm Comm::self() { return Comm(from_mpi(MPI_COMM_SELF), false); }
+Comm Comm::world() {
+  return Comm(from_mpi(MPI_COMM_WORLD), false);
+}
+Comm Comm::self() {
+  return Comm(from_mpi(MPI_COMM_SELF), false);
+}
 Comm::Comm(Comm&& o) noexcept
     : handle_(o.handle_), owned_(o.owned_), rank_(o.rank_), size_(o.size_) {
   o.handle_ = nullptr;
@@ -116,7 +121,9 @@ Comm Comm::duplicate() const {
   return Comm(from_mpi(out), true);
 }
 
-void Comm::barrier() const { check(MPI_Barrier(to_mpi(handle_)), "MPI_Barrier"); }
+void Comm::barrier() const {
+  check(MPI_Barrier(to_mpi(handle_)), "MPI_Barrier");
+}
 void Comm::abort(int status) const {
   MPI_Abort(to_mpi(handle_), status);
   std::abort();
@@ -126,9 +133,13 @@ namespace {
 template <class T>
 MPI_Datatype mpi_type();
 template <>
-MPI_Datatype mpi_type<double>() { return MPI_DOUBLE; }
+MPI_Datatype mpi_type<double>() {
+  return MPI_DOUBLE;
+}
 template <>
-MPI_Datatype mpi_type<std::int64_t>() { return MPI_INT64_T; }
+MPI_Datatype mpi_type<std::int64_t>() {
+  return MPI_INT64_T;
+}
 
 template <class T>
 void reduce(void* h, std::span<T> v, MPI_Op op) {
@@ -139,12 +150,24 @@ void reduce(void* h, std::span<T> v, MPI_Op op) {
 }
 } // namespace
 
-void Comm::sum(std::span<double> v) const { reduce(handle_, v, MPI_SUM); }
-void Comm::sum(std::span<std::int64_t> v) const { reduce(handle_, v, MPI_SUM); }
-void Comm::min(std::span<double> v) const { reduce(handle_, v, MPI_MIN); }
-void Comm::max(std::span<double> v) const { reduce(handle_, v, MPI_MAX); }
-void Comm::min(std::span<std::int64_t> v) const { reduce(handle_, v, MPI_MIN); }
-void Comm::max(std::span<std::int64_t> v) const { reduce(handle_, v, MPI_MAX); }
+void Comm::sum(std::span<double> v) const {
+  reduce(handle_, v, MPI_SUM);
+}
+void Comm::sum(std::span<std::int64_t> v) const {
+  reduce(handle_, v, MPI_SUM);
+}
+void Comm::min(std::span<double> v) const {
+  reduce(handle_, v, MPI_MIN);
+}
+void Comm::max(std::span<double> v) const {
+  reduce(handle_, v, MPI_MAX);
+}
+void Comm::min(std::span<std::int64_t> v) const {
+  reduce(handle_, v, MPI_MIN);
+}
+void Comm::max(std::span<std::int64_t> v) const {
+  reduce(handle_, v, MPI_MAX);
+}
 
 std::int64_t Comm::exclusive_scan(std::int64_t v) const {
   std::int64_t out = 0;
@@ -153,8 +176,7 @@ std::int64_t Comm::exclusive_scan(std::int64_t v) const {
 }
 
 void Comm::broadcast_bytes(void* data, std::size_t bytes, int root) const {
-  check(MPI_Bcast(data, to_int(bytes, "broadcast"), MPI_BYTE, root, to_mpi(handle_)),
-        "MPI_Bcast");
+  check(MPI_Bcast(data, to_int(bytes, "broadcast"), MPI_BYTE, root, to_mpi(handle_)), "MPI_Bcast");
 }
 void Comm::broadcast(std::string& s, int root) const {
   std::int64_t n = static_cast<std::int64_t>(s.size());
@@ -179,8 +201,8 @@ void Comm::alltoallv_bytes(const void* send, std::span<const std::int64_t> send_
   Requests r;
   for (int q = 0; q < size_; ++q)
     if (recv_bytes[q] > 0)
-      irecv_bytes(static_cast<char*>(recv) + recv_displ[q],
-                  static_cast<std::size_t>(recv_bytes[q]), q, 7001, r);
+      irecv_bytes(static_cast<char*>(recv) + recv_displ[q], static_cast<std::size_t>(recv_bytes[q]),
+                  q, 7001, r);
   for (int q = 0; q < size_; ++q)
     if (send_bytes[q] > 0)
       isend_bytes(static_cast<const char*>(send) + send_displ[q],
@@ -202,8 +224,7 @@ void Comm::sendrecv_bytes(const void* send, std::size_t send_bytes, int dest, vo
                      MPI_STATUS_IGNORE),
         "MPI_Sendrecv");
 }
-void Comm::isend_bytes(const void* data, std::size_t bytes, int dest, int tag,
-                       Requests& r) const {
+void Comm::isend_bytes(const void* data, std::size_t bytes, int dest, int tag, Requests& r) const {
   MPI_Request req;
   check(MPI_Isend(data, to_int(bytes, "isend"), MPI_BYTE, dest, tag, to_mpi(handle_), &req),
         "MPI_Isend");

@@ -66,12 +66,30 @@ public:
   void max(std::span<double> v) const;
   void min(std::span<std::int64_t> v) const;
   void max(std::span<std::int64_t> v) const;
-  double sum(double v) const { sum(std::span<double>(&v, 1)); return v; }
-  double min(double v) const { min(std::span<double>(&v, 1)); return v; }
-  double max(double v) const { max(std::span<double>(&v, 1)); return v; }
-  std::int64_t sum(std::int64_t v) const { sum(std::span<std::int64_t>(&v, 1)); return v; }
-  std::int64_t min(std::int64_t v) const { min(std::span<std::int64_t>(&v, 1)); return v; }
-  std::int64_t max(std::int64_t v) const { max(std::span<std::int64_t>(&v, 1)); return v; }
+  double sum(double v) const {
+    sum(std::span<double>(&v, 1));
+    return v;
+  }
+  double min(double v) const {
+    min(std::span<double>(&v, 1));
+    return v;
+  }
+  double max(double v) const {
+    max(std::span<double>(&v, 1));
+    return v;
+  }
+  std::int64_t sum(std::int64_t v) const {
+    sum(std::span<std::int64_t>(&v, 1));
+    return v;
+  }
+  std::int64_t min(std::int64_t v) const {
+    min(std::span<std::int64_t>(&v, 1));
+    return v;
+  }
+  std::int64_t max(std::int64_t v) const {
+    max(std::span<std::int64_t>(&v, 1));
+    return v;
+  }
   // Exclusive prefix sum over ranks (rank 0 gets 0).
   std::int64_t exclusive_scan(std::int64_t v) const;
 

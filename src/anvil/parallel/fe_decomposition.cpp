@@ -107,7 +107,8 @@ FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, in
     for (auto p = ptr[n]; p < ptr[n + 1]; ++p)
       if (owner[corner[p] / 8] != rank) neighbor_ranks.push_back(owner[corner[p] / 8]);
   std::sort(neighbor_ranks.begin(), neighbor_ranks.end());
-  neighbor_ranks.erase(std::unique(neighbor_ranks.begin(), neighbor_ranks.end()), neighbor_ranks.end());
+  neighbor_ranks.erase(std::unique(neighbor_ranks.begin(), neighbor_ranks.end()),
+                       neighbor_ranks.end());
 
   std::size_t next_remote = d.local_slots;
   for (int q : neighbor_ranks) {
@@ -118,8 +119,10 @@ FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, in
       if (!touches(n, q)) continue;
       for (auto p = ptr[n]; p < ptr[n + 1]; ++p) {
         const int o = owner[corner[p] / 8];
-        if (o == rank) nb.send_slots.push_back(slot_of[p]);
-        else if (o == q) slot_of[p] = static_cast<std::int64_t>(next_remote++);
+        if (o == rank)
+          nb.send_slots.push_back(slot_of[p]);
+        else if (o == q)
+          slot_of[p] = static_cast<std::int64_t>(next_remote++);
       }
     }
     nb.recv_count = next_remote - nb.recv_base;

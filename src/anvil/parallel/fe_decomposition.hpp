@@ -26,16 +26,16 @@ struct FeDecomposition {
   std::vector<std::uint8_t> node_owned; // 1 where this rank owns the node
 
   struct Block {
-    std::vector<std::int64_t> gid;          // owned elements of this mesh block, ascending
-    std::vector<std::array<int, 8>> conn;   // their corners as local node indices
-    std::size_t corner_base = 0;            // slot of corner (e, a): base + a * stride + e
-    int stride = 0;                         // padded element count (simd::padded_size)
+    std::vector<std::int64_t> gid;        // owned elements of this mesh block, ascending
+    std::vector<std::array<int, 8>> conn; // their corners as local node indices
+    std::size_t corner_base = 0;          // slot of corner (e, a): base + a * stride + e
+    int stride = 0;                       // padded element count (simd::padded_size)
   };
   std::vector<Block> blocks; // one per mesh block, possibly empty
 
-  std::size_t local_slots = 0;  // corner slots of owned elements (padding included)
-  std::size_t remote_slots = 0; // corner slots received from other ranks, after local ones
-  std::vector<int> gather_ptr;  // per local node: range in gather_slot (CSR)
+  std::size_t local_slots = 0;           // corner slots of owned elements (padding included)
+  std::size_t remote_slots = 0;          // corner slots received from other ranks, after local ones
+  std::vector<int> gather_ptr;           // per local node: range in gather_slot (CSR)
   std::vector<std::int64_t> gather_slot; // slots in ascending (element gid, corner)
 
   struct Neighbor {

@@ -34,9 +34,8 @@ std::vector<int> partition_elements(const Mesh& mesh, int parts) {
   options[METIS_OPTION_SEED] = 12345;
   options[METIS_OPTION_CONTIG] = 1;
   std::vector<idx_t> epart(static_cast<std::size_t>(ne)), npart(static_cast<std::size_t>(n_nodes));
-  int rc = METIS_PartMeshDual(&n_el, &n_nodes, eptr.data(), eind.data(), nullptr, nullptr,
-                              &ncommon, &nparts, nullptr, options, &objval, epart.data(),
-                              npart.data());
+  int rc = METIS_PartMeshDual(&n_el, &n_nodes, eptr.data(), eind.data(), nullptr, nullptr, &ncommon,
+                              &nparts, nullptr, options, &objval, epart.data(), npart.data());
   if (rc != METIS_OK) {
     // Contiguity cannot always be met (disconnected parts); retry without it.
     options[METIS_OPTION_CONTIG] = 0;

@@ -14,16 +14,21 @@ namespace {
 Mesh part_mesh(const PartConfig& p) {
   try {
     switch (p.mesh.kind) {
-    case MeshConfig::Kind::box: return generate_box(p.mesh.box);
-    case MeshConfig::Kind::cylinder: return generate_cylinder(p.mesh.cylinder);
-    case MeshConfig::Kind::can: return generate_can(p.mesh.can);
-    case MeshConfig::Kind::file: break;
+    case MeshConfig::Kind::box:
+      return generate_box(p.mesh.box);
+    case MeshConfig::Kind::cylinder:
+      return generate_cylinder(p.mesh.cylinder);
+    case MeshConfig::Kind::can:
+      return generate_can(p.mesh.can);
+    case MeshConfig::Kind::file:
+      break;
     }
   } catch (const std::invalid_argument& e) {
     throw InputError(p.mesh.where, e.what());
   }
-  throw InputError(p.mesh.where,
-                   fmt::format("cannot read mesh file '{}': no reader for this format yet", p.mesh.file));
+  throw InputError(
+      p.mesh.where,
+      fmt::format("cannot read mesh file '{}': no reader for this format yet", p.mesh.file));
 }
 
 std::size_t part_index(const Config& c, const std::string& name) {
@@ -41,11 +46,13 @@ Mesh build_mesh(const Config& config) {
     // A part is one block named after the part, whatever the source called it.
     if (m.blocks.size() != 1) {
       ElementBlock merged{p.name, {}};
-      for (auto& b : m.blocks) merged.elements.insert(merged.elements.end(), b.elements.begin(), b.elements.end());
+      for (auto& b : m.blocks)
+        merged.elements.insert(merged.elements.end(), b.elements.begin(), b.elements.end());
       m.blocks = {std::move(merged)};
     }
     m.blocks[0].name = p.name;
-    if (m.blocks[0].elements.empty()) throw InputError(p.mesh.where, "the part's mesh has no elements");
+    if (m.blocks[0].elements.empty())
+      throw InputError(p.mesh.where, "the part's mesh has no elements");
     mesh.append(m, p.name);
   }
   return mesh;
@@ -66,7 +73,8 @@ std::vector<std::int64_t> resolve_selection(const Mesh& mesh, const Config& conf
     std::vector<std::int64_t> candidates;
     if (sel.part) {
       const auto b = part_index(config, *sel.part);
-      if (b == config.parts.size()) throw InputError(sel.where, fmt::format("part '{}' is not defined", *sel.part));
+      if (b == config.parts.size())
+        throw InputError(sel.where, fmt::format("part '{}' is not defined", *sel.part));
       candidates = block_nodes(mesh, b);
     }
     if (sel.box) {

@@ -71,15 +71,18 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     const double rho = hb.material->elastic().density;
     for (int e = 0; e < hb.size(); ++e) {
       if (!(vol[e] > 0))
-        throw InputError(part.mesh.where,
-                         fmt::format("element {} of part {} has a non-positive volume ({:.3g} m^3): "
-                                     "check the node order",
-                                     hb.gid[e] - block_offsets_[b] + 1, part.name, vol[e]));
+        throw InputError(
+            part.mesh.where,
+            fmt::format("element {} of part {} has a non-positive volume ({:.3g} m^3): "
+                        "check the node order",
+                        hb.gid[e] - block_offsets_[b] + 1, part.name, vol[e]));
       hb.mass[e] = rho * vol[e];
       hb.volume[e] = vol[e];
-      for (int a = 0; a < 8; ++a) corner_mass[lb.corner_base + static_cast<std::size_t>(a) * lb.stride + e] = hb.mass[e] / 8;
+      for (int a = 0; a < 8; ++a)
+        corner_mass[lb.corner_base + static_cast<std::size_t>(a) * lb.stride + e] = hb.mass[e] / 8;
     }
-    for (int e = hb.size(); e < lb.stride; ++e) hb.mass[e] = hb.mass[hb.size() - 1 >= 0 ? hb.size() - 1 : 0];
+    for (int e = hb.size(); e < lb.stride; ++e)
+      hb.mass[e] = hb.mass[hb.size() - 1 >= 0 ? hb.size() - 1 : 0];
     blocks_.push_back(std::move(hb));
   }
   corner_exchange_->exchange({corner_mass.data()});
@@ -166,7 +169,8 @@ void Simulation::locate_probes(const Mesh& mesh) {
       }
     }
     const double global_best = comm_.min(best);
-    const std::int64_t winner = comm_.min(best == global_best ? best_gid : std::numeric_limits<std::int64_t>::max());
+    const std::int64_t winner =
+        comm_.min(best == global_best ? best_gid : std::numeric_limits<std::int64_t>::max());
     if (best_local >= 0 && best_gid == winner) probe_node_[p] = best_local;
   }
 }
@@ -203,7 +207,8 @@ void Simulation::fe_forces() {
     ScopedPhase t(timers_, Phase::fe);
     const NodalView view{{nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()},
                          {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()}};
-    const CornerView corners{{corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()}};
+    const CornerView corners{
+        {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()}};
     HexResult r;
     for (auto& b : blocks_)
       if (b.size() > 0) hex_forces(b, view, clock_.dt_prev, corners, workspace_, r);
@@ -212,15 +217,15 @@ void Simulation::fe_forces() {
 
     // One reduction per cycle carries the stable step and the failure flags.
     const double none = std::numeric_limits<double>::infinity();
-    double red[4] = {r.dt_stable,
-                     r.inverted_gid >= 0 ? static_cast<double>(r.inverted_gid) : none,
+    double red[4] = {r.dt_stable, r.inverted_gid >= 0 ? static_cast<double>(r.inverted_gid) : none,
                      r.nonfinite_gid >= 0 ? static_cast<double>(r.nonfinite_gid) : none, 0};
     comm_.min(std::span<double>(red, 3));
     if (red[1] != none)
       throw PhysicsError(describe_element(static_cast<std::int64_t>(red[1])), clock_.time,
                          "inverted element (non-positive volume)");
     if (red[2] != none || !std::isfinite(red[0]))
-      throw PhysicsError(red[2] != none ? describe_element(static_cast<std::int64_t>(red[2])) : "the model",
+      throw PhysicsError(red[2] != none ? describe_element(static_cast<std::int64_t>(red[2]))
+                                        : "the model",
                          clock_.time, "non-finite stress or force");
     // The controlling element: smallest gid among the ranks that hold the global minimum.
     dt_element_ = static_cast<std::int64_t>(
@@ -229,7 +234,8 @@ void Simulation::fe_forces() {
   }
   {
     ScopedPhase t(timers_, Phase::halo);
-    corner_exchange_->exchange({corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()});
+    corner_exchange_->exchange(
+        {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()});
   }
   {
     ScopedPhase t(timers_, Phase::fe);
@@ -342,14 +348,16 @@ Sample Simulation::sample() const {
 
 double Simulation::balance_error(const Sample& s) const {
   const double e = s.total();
-  const double scale = std::max({std::abs(e), std::abs(s.external_work), std::abs(initial_energy_), 1e-300});
+  const double scale =
+      std::max({std::abs(e), std::abs(s.external_work), std::abs(initial_energy_), 1e-300});
   return std::abs(e - initial_energy_ - s.external_work) / scale;
 }
 
 double Simulation::stable_time_step() {
   const NodalView view{{nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()},
                        {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()}};
-  const CornerView corners{{corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()}};
+  const CornerView corners{
+      {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()}};
   HexResult r;
   // With dt_prev = 0 the kernel changes no state: rotation by the identity, no increment.
   for (auto& b : blocks_)

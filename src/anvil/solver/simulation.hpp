@@ -21,21 +21,21 @@ namespace anvil {
 // Nodal state on this rank, structure of arrays over local nodes (shared nodes appear on
 // every rank that touches them, with identical values).
 struct NodeState {
-  std::array<std::vector<double>, 3> x;   // position at t(n), m
-  std::array<std::vector<double>, 3> x0;  // reference position, m
-  std::array<std::vector<double>, 3> v;   // velocity at t(n - 1/2) (t(n + 1/2) after a step)
-  std::array<std::vector<double>, 3> f;   // internal force at t(n), N
-  std::vector<double> mass;               // lumped mass, kg
+  std::array<std::vector<double>, 3> x;  // position at t(n), m
+  std::array<std::vector<double>, 3> x0; // reference position, m
+  std::array<std::vector<double>, 3> v;  // velocity at t(n - 1/2) (t(n + 1/2) after a step)
+  std::array<std::vector<double>, 3> f;  // internal force at t(n), N
+  std::vector<double> mass;              // lumped mass, kg
   std::size_t size() const { return mass.size(); }
 };
 
 // Time and cycle counters of the central-difference scheme.
 struct Clock {
-  double time = 0;          // t(n)
-  std::int64_t cycle = 0;   // n
-  double dt = 0;            // dt(n + 1/2) of the last step taken
-  double dt_prev = 0;       // dt(n - 1/2), the interval the stress update integrates over
-  double dt_initial = 0;    // the first step's dt
+  double time = 0;              // t(n)
+  std::int64_t cycle = 0;       // n
+  double dt = 0;                // dt(n + 1/2) of the last step taken
+  double dt_prev = 0;           // dt(n - 1/2), the interval the stress update integrates over
+  double dt_initial = 0;        // the first step's dt
   std::int64_t dt_element = -1; // element controlling dt
 };
 
