@@ -11,6 +11,9 @@
 namespace anvil {
 
 struct VtuArray {
+  VtuArray() = default;
+  VtuArray(std::string n, int c, bool integer = false)
+      : name(std::move(n)), components(c), is_int(integer) {}
   std::string name;
   int components = 1;
   std::vector<double> f64;       // used when is_int is false
