@@ -1,0 +1,138 @@
+// DESIGN.md section 3: a run on P ranks produces bit-for-bit the trajectory of the run on
+// one rank. The same deck runs on MPI_COMM_WORLD and, on rank 0, on MPI_COMM_SELF; the
+// nodal positions, velocities and element stresses are gathered by global id and
+// compared with exact equality (tolerance: zero).
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <map>
+
+#include "anvil/parallel/comm.hpp"
+#include "anvil/solver/simulation.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using namespace anvil;
+
+// An impact with plasticity, both hourglass forms, a prescribed velocity, a rotation
+// and non-trivial partitions: every code path of the FE cycle.
+const char* deck_text = R"(
+termination: {cycles: 150}
+materials:
+  copper: {model: j2_plasticity, density: 8930, youngs_modulus: 117.0e9,
+           poissons_ratio: 0.35, yield_stress: 0.4e9, hardening_modulus: 0.1e9}
+  steel: {model: johnson_cook, density: 7830, youngs_modulus: 200.0e9, poissons_ratio: 0.29,
+          A: 792.0e6, B: 510.0e6, C: 0.014, n: 0.26, m: 1.03, melt_temperature: 1793.0,
+          specific_heat: 477.0}
+parts:
+  bar:
+    mesh: {generate: cylinder, radius: 3.2e-3, length: 16.0e-3, axis: z, divisions: [4, 10]}
+    material: copper
+    hourglass: {model: viscous, coefficient: 0.1}
+  plate:
+    mesh: {generate: box, min: [-0.01, -0.01, -0.004], max: [0.01, 0.01, -0.001], divisions: [8, 8, 3]}
+    material: steel
+    hourglass: {model: stiffness, coefficient: 0.05}
+initial_conditions:
+  - {part: bar, velocity: [0, 0, -400.0], angular_velocity: [0, 0, 2000.0], center: [0, 0, 0]}
+boundary_conditions:
+  - {set: bar.bottom, fix: [z]}
+  - {set: plate.zmin, velocity: [0, 0, 30.0]}
+)";
+
+struct Snapshot {
+  std::map<std::int64_t, std::array<double, 6>> nodes;    // x, v by node gid
+  std::map<std::int64_t, std::array<double, 8>> elements; // stress, ep, T by element gid
+};
+
+// Collects owned nodes and elements of every rank on rank 0.
+Snapshot gather(const Simulation& sim) {
+  const Comm& comm = sim.comm();
+  std::vector<double> nbuf, ebuf;
+  const auto& nd = sim.nodes();
+  for (std::size_t n = 0; n < nd.size(); ++n) {
+    if (!sim.fe().node_owned[n]) continue;
+    nbuf.push_back(static_cast<double>(sim.fe().node_gid[n]));
+    for (int i = 0; i < 3; ++i) nbuf.push_back(nd.x[i][n]);
+    for (int i = 0; i < 3; ++i) nbuf.push_back(nd.v[i][n]);
+  }
+  for (const auto& b : sim.blocks())
+    for (int e = 0; e < b.size(); ++e) {
+      ebuf.push_back(static_cast<double>(b.gid[e]));
+      for (int k = 0; k < 6; ++k) ebuf.push_back(b.stress[k][e]);
+      ebuf.push_back(b.plastic_strain.empty() ? 0.0 : b.plastic_strain[e]);
+      ebuf.push_back(b.temperature.empty() ? 0.0 : b.temperature[e]);
+    }
+  Snapshot s;
+  auto take = [&](const std::vector<double>& buf) {
+    for (std::size_t k = 0; k < buf.size(); k += 7) {
+      std::array<double, 6> a;
+      std::copy(buf.begin() + k + 1, buf.begin() + k + 7, a.begin());
+      s.nodes[static_cast<std::int64_t>(buf[k])] = a;
+    }
+  };
+  auto take_e = [&](const std::vector<double>& buf) {
+    for (std::size_t k = 0; k < buf.size(); k += 9) {
+      std::array<double, 8> a;
+      std::copy(buf.begin() + k + 1, buf.begin() + k + 9, a.begin());
+      s.elements[static_cast<std::int64_t>(buf[k])] = a;
+    }
+  };
+  if (comm.rank() == 0) {
+    take(nbuf);
+    take_e(ebuf);
+    for (int r = 1; r < comm.size(); ++r) {
+      for (auto* buf : {&nbuf, &ebuf}) {
+        std::int64_t n = 0;
+        comm.recv_bytes(&n, sizeof n, r, 1);
+        buf->resize(static_cast<std::size_t>(n));
+        comm.recv_bytes(buf->data(), buf->size() * sizeof(double), r, 2);
+      }
+      take(nbuf);
+      take_e(ebuf);
+    }
+  } else {
+    for (auto* buf : {&nbuf, &ebuf}) {
+      const std::int64_t n = static_cast<std::int64_t>(buf->size());
+      comm.send_bytes(&n, sizeof n, 0, 1);
+      comm.send_bytes(buf->data(), buf->size() * sizeof(double), 0, 2);
+    }
+  }
+  return s;
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+TEST(Determinism, SameBitsOnAnyRankCount) {
+  const Config config = test::deck(deck_text);
+  const Comm world = Comm::world();
+  Simulation parallel(config, world);
+  while (!parallel.finished()) parallel.step();
+  const Snapshot p = gather(parallel);
+  if (world.rank() != 0) return;
+
+  const Comm self = Comm::self();
+  Simulation serial(config, self);
+  while (!serial.finished()) serial.step();
+  const Snapshot s = gather(serial);
+
+  EXPECT_EQ(parallel.clock().cycle, serial.clock().cycle);
+  EXPECT_TRUE(same_bits(parallel.clock().time, serial.clock().time));
+  ASSERT_EQ(p.nodes.size(), s.nodes.size());
+  ASSERT_EQ(p.elements.size(), s.elements.size());
+  std::int64_t differing = 0;
+  for (const auto& [gid, a] : s.nodes)
+    for (int k = 0; k < 6; ++k)
+      if (!same_bits(a[k], p.nodes.at(gid)[k])) ++differing;
+  for (const auto& [gid, a] : s.elements)
+    for (int k = 0; k < 8; ++k)
+      if (!same_bits(a[k], p.elements.at(gid)[k])) ++differing;
+  EXPECT_EQ(differing, 0) << "values differing from the 1-rank run on " << world.size() << " ranks";
+  // The run must have done something: plastic flow and motion.
+  double max_ep = 0;
+  for (const auto& [gid, a] : s.elements) max_ep = std::max(max_ep, a[6]);
+  EXPECT_GT(max_ep, 0.01);
+}
+
+} // namespace
