@@ -32,23 +32,19 @@ struct Fixture {
     material = find_material_model(model)->make(p);
     block.material = material.get();
     block.hourglass.model = hg;
-    block.gid = fe.blocks[0].gid;
-    for (int a = 0; a < 8; ++a) {
-      block.conn[a].resize(block.gid.size());
-      for (std::size_t e = 0; e < block.gid.size(); ++e) block.conn[a][e] = fe.blocks[0].conn[e][a];
-    }
-    block.mass.assign(block.gid.size(), 7850 * 1e-6);
-    block.allocate_state();
     const std::size_t nn = fe.node_gid.size();
+    for (int i = 0; i < 3; ++i) x[i].resize(nn);
+    for (std::size_t k = 0; k < nn; ++k)
+      for (int i = 0; i < 3; ++i) x[i][k] = mesh.nodes[fe.node_gid[k]][i];
+    const double* xs[3] = {x[0].data(), x[1].data(), x[2].data()};
+    block.init(fe.blocks[0].gid, fe.blocks[0].conn, xs, 0);
     for (int i = 0; i < 3; ++i) {
-      x[i].resize(nn);
       v[i].resize(nn);
       f[i].resize(nn);
       corner[i].assign(fe.total_slots(), 0.0);
     }
     for (std::size_t k = 0; k < nn; ++k) {
       const Vec3 p = mesh.nodes[fe.node_gid[k]];
-      for (int i = 0; i < 3; ++i) x[i][k] = p[i];
       // A compressive, shearing velocity field that drives every element plastic.
       v[0][k] = -50.0 * p.x + 20.0 * p.y;
       v[1][k] = 10.0 * p.z;

@@ -55,20 +55,36 @@ void gather(const HexBlock& b, const NodalView& n, int e, Gathered& g) {
 
 } // namespace
 
-void HexBlock::allocate_state() {
-  const int n = size();
+int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array<int, 8>> corners,
+                   const double* const x[3], std::size_t base) {
+  const int n = static_cast<int>(ids.size());
   const auto p = static_cast<std::size_t>(padded_size(n));
-  for (auto& c : conn) c.resize(p, c.empty() ? 0 : c[n - 1]);
-  mass.resize(p, n > 0 ? mass[n - 1] : 1.0);
+  gid.assign(ids.begin(), ids.end());
+  corner_base = base;
+  for (int a = 0; a < 8; ++a) {
+    conn[a].resize(p);
+    for (std::size_t e = 0; e < p; ++e) conn[a][e] = n > 0 ? corners[std::min<std::size_t>(e, n - 1)][a] : 0;
+  }
   volume.assign(p, 0.0);
+  hex_volumes(*this, x, volume);
+  const double rho = material->elastic().density;
+  mass.assign(p, 0.0);
+  int bad = -1;
+  for (std::size_t e = 0; e < p; ++e) {
+    if (static_cast<int>(e) < n && !(volume[e] > 0) && bad < 0) bad = static_cast<int>(e);
+    mass[e] = rho * volume[e];
+  }
   for (auto& s : stress) s.assign(p, 0.0);
-  if (material && material->has_plastic_strain()) plastic_strain.assign(p, 0.0);
-  if (material && material->has_temperature())
-    temperature.assign(p, material->initial_temperature());
+  plastic_strain.clear();
+  temperature.clear();
+  if (material->has_plastic_strain()) plastic_strain.assign(p, 0.0);
+  if (material->has_temperature()) temperature.assign(p, material->initial_temperature());
+  for (auto& h : hourglass_force) h.clear();
   if (hourglass.model == HourglassControl::Model::stiffness)
     for (auto& h : hourglass_force) h.assign(p, 0.0);
   internal_energy.assign(p, 0.0);
   hourglass_energy.assign(p, 0.0);
+  return bad;
 }
 
 HexWorkspace::HexWorkspace() : buf_(static_cast<std::size_t>(s_count) * chunk, 0.0) {}
@@ -245,7 +261,8 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
 }
 
 void hex_volumes(const HexBlock& b, const double* const x[3], std::span<double> out) {
-  for (int e = 0; e < b.size(); ++e) {
+  const std::size_t n = std::min(out.size(), b.conn[0].size());
+  for (std::size_t e = 0; e < n; ++e) {
     double xe[8][3], B[8][3];
     for (int a = 0; a < 8; ++a)
       for (int i = 0; i < 3; ++i) xe[a][i] = x[i][b.conn[a][e]];

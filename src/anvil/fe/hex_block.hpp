@@ -53,8 +53,13 @@ struct HexBlock {
                                                        // corner_base + a * size() + e
 
   int size() const { return static_cast<int>(gid.size()); }
-  // Sizes every state array for `n` elements (connectivity and gid set by the caller).
-  void allocate_state();
+
+  // Sets the elements (ascending global ids and their corners as local node indices)
+  // and the corner slot base, sizes and zeroes the state (padded to whole vectors), and
+  // sets each element's mass from the material density and its volume at positions x.
+  // Returns the index of the first element with a non-positive volume, or -1.
+  int init(std::span<const std::int64_t> ids, std::span<const std::array<int, 8>> corners,
+           const double* const x[3], std::size_t base);
 };
 
 struct NodalView {

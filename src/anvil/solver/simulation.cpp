@@ -58,31 +58,15 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     hb.material = material_of(part.material);
     hb.hourglass = part.hourglass;
     hb.bulk_viscosity = part.bulk_viscosity;
-    hb.gid = lb.gid;
-    for (int a = 0; a < 8; ++a) {
-      hb.conn[a].resize(lb.gid.size());
-      for (std::size_t e = 0; e < lb.gid.size(); ++e) hb.conn[a][e] = lb.conn[e][a];
-    }
-    hb.corner_base = lb.corner_base;
-    hb.mass.assign(lb.gid.size(), 0.0);
-    hb.allocate_state();
-    std::vector<double> vol(static_cast<std::size_t>(lb.stride), 0.0);
-    hex_volumes(hb, xs, vol);
-    const double rho = hb.material->elastic().density;
-    for (int e = 0; e < hb.size(); ++e) {
-      if (!(vol[e] > 0))
-        throw InputError(
-            part.mesh.where,
-            fmt::format("element {} of part {} has a non-positive volume ({:.3g} m^3): "
-                        "check the node order",
-                        hb.gid[e] - block_offsets_[b] + 1, part.name, vol[e]));
-      hb.mass[e] = rho * vol[e];
-      hb.volume[e] = vol[e];
+    const int bad = hb.init(lb.gid, lb.conn, xs, lb.corner_base);
+    if (bad >= 0)
+      throw InputError(part.mesh.where,
+                       fmt::format("element {} of part {} has a non-positive volume ({:.3g} m^3): "
+                                   "check the node order",
+                                   hb.gid[bad] - block_offsets_[b] + 1, part.name, hb.volume[bad]));
+    for (int e = 0; e < hb.size(); ++e)
       for (int a = 0; a < 8; ++a)
         corner_mass[lb.corner_base + static_cast<std::size_t>(a) * lb.stride + e] = hb.mass[e] / 8;
-    }
-    for (int e = hb.size(); e < lb.stride; ++e)
-      hb.mass[e] = hb.mass[hb.size() - 1 >= 0 ? hb.size() - 1 : 0];
     blocks_.push_back(std::move(hb));
   }
   corner_exchange_->exchange({corner_mass.data()});
