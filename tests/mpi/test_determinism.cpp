@@ -102,7 +102,9 @@ Snapshot gather(const Simulation& sim) {
   return s;
 }
 
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(double a, double b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
 
 TEST(Determinism, SameBitsOnAnyRankCount) {
   const Config config = test::deck(deck_text);

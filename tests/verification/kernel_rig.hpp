@@ -24,7 +24,8 @@ struct KernelRig {
   KernelRig(Mesh m, const std::string& model, const ParamValues& params,
             HourglassControl hourglass = {}, BulkViscosity bulk = {})
       : mesh(std::move(m)) {
-    fe = decompose_fe(mesh, std::vector<int>(static_cast<std::size_t>(mesh.num_elements()), 0), 0, 1);
+    fe = decompose_fe(mesh, std::vector<int>(static_cast<std::size_t>(mesh.num_elements()), 0), 0,
+                      1);
     material = find_material_model(model)->make(params);
     block.material = material.get();
     block.hourglass = hourglass;
@@ -44,7 +45,8 @@ struct KernelRig {
 
   // The FE phase at the current x (t(n)) and v (t(n-1/2)) over dt_prev.
   void forces(double dt_prev) {
-    const NodalView nv{{x[0].data(), x[1].data(), x[2].data()}, {v[0].data(), v[1].data(), v[2].data()}};
+    const NodalView nv{{x[0].data(), x[1].data(), x[2].data()},
+                       {v[0].data(), v[1].data(), v[2].data()}};
     const CornerView cv{{corner[0].data(), corner[1].data(), corner[2].data()}};
     result = HexResult{};
     hex_forces(block, nv, dt_prev, cv, work, result);

@@ -38,24 +38,29 @@ double mode1(double s) {
 double frequency(const std::string& hourglass, double coefficient, double* analytic) {
   const double L = 0.15, h = 0.01, E = 200e9, rho = 7850;
   const double I = h * h * h * h / 12, A = h * h;
-  const double f_eb = 1.87510407 * 1.87510407 / (2 * std::numbers::pi * L * L) * std::sqrt(E * I / (rho * A));
+  const double f_eb =
+      1.87510407 * 1.87510407 / (2 * std::numbers::pi * L * L) * std::sqrt(E * I / (rho * A));
   *analytic = f_eb;
   std::ostringstream d;
   d.precision(17);
   d << "termination: {time: " << 1.15 / f_eb << "}\n"
-    << "materials:\n  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}\n"
-    << "parts:\n  beam:\n    mesh: {generate: box, min: [" << -h / 2 << ", " << -h / 2 << ", 0], max: [" << h / 2 << ", "
-    << h / 2 << ", " << L << "], divisions: [4, 4, 60]}\n    material: steel\n"
+    << "materials:\n  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, "
+       "poissons_ratio: 0.3}\n"
+    << "parts:\n  beam:\n    mesh: {generate: box, min: [" << -h / 2 << ", " << -h / 2
+    << ", 0], max: [" << h / 2 << ", " << h / 2 << ", " << L
+    << "], divisions: [4, 4, 60]}\n    material: steel\n"
     << "    hourglass: {model: " << hourglass << ", coefficient: " << coefficient << "}\n"
     << "    bulk_viscosity: {linear: 0, quadratic: 0}\n";
   d << "node_sets:\n";
   const int bands = 20;
   for (int k = 0; k < bands; ++k)
-    d << "  band" << k << ": {part: beam, box: {min: [-1, -1, " << (k == 0 ? 1e-9 : L * k / bands - 1e-9) << "], max: [1, 1, "
-      << L * (k + 1) / bands + 1e-9 << "]}}\n";
+    d << "  band" << k << ": {part: beam, box: {min: [-1, -1, "
+      << (k == 0 ? 1e-9 : L * k / bands - 1e-9) << "], max: [1, 1, " << L * (k + 1) / bands + 1e-9
+      << "]}}\n";
   d << "initial_conditions:\n";
   const double v0 = 0.5; // m/s at the tip
-  for (int k = 0; k < bands; ++k) d << "  - {set: band" << k << ", velocity: [" << v0 * mode1((k + 0.5) / bands) << ", 0, 0]}\n";
+  for (int k = 0; k < bands; ++k)
+    d << "  - {set: band" << k << ", velocity: [" << v0 * mode1((k + 0.5) / bands) << ", 0, 0]}\n";
   d << "boundary_conditions:\n  - {set: beam.zmin, fix: all}\n";
   d << "probes:\n  - {name: tip, at: [0, 0, " << L << "]}\n";
 
@@ -83,7 +88,8 @@ TEST(Cantilever, FirstBendingFrequencyMatchesEulerBernoulli) {
   const double f = frequency("stiffness", 0.03, &f_eb);
   const double err = (f - f_eb) / f_eb;
   if (Comm::world().rank() == 0)
-    std::printf("cantilever: f = %.3f Hz, Euler-Bernoulli %.3f Hz, error %+.2f%%\n", f, f_eb, 100 * err);
+    std::printf("cantilever: f = %.3f Hz, Euler-Bernoulli %.3f Hz, error %+.2f%%\n", f, f_eb,
+                100 * err);
   EXPECT_LT(std::abs(err), 0.03);
 }
 

@@ -63,7 +63,8 @@ initial_conditions:
   const Sample s = sim.sample();
   EXPECT_GT(s.internal + s.hourglass, 0.05 * e0);
   if (world.rank() == 0)
-    std::printf("energy: %zu cycles, largest deviation %.3e, drift %.3e, final KE %.4g J IE %.4g J HG %.4g J\n",
+    std::printf("energy: %zu cycles, largest deviation %.3e, drift %.3e, final KE %.4g J IE %.4g J "
+                "HG %.4g J\n",
                 e.size(), worst, (last - first) / first, s.kinetic, s.internal, s.hourglass);
 }
 

@@ -55,13 +55,15 @@ void midstep_gradient(double dt, double (&out)[3][3]) {
       inv[i][j] = (A[i1][j1] * A[i2][j2] - A[i1][j2] * A[i2][j1]) / det;
     }
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) out[i][j] = L[i][0] * inv[0][j] + L[i][1] * inv[1][j] + L[i][2] * inv[2][j];
+    for (int j = 0; j < 3; ++j)
+      out[i][j] = L[i][0] * inv[0][j] + L[i][1] * inv[1][j] + L[i][2] * inv[2][j];
 }
 
 class Patch : public ::testing::TestWithParam<HourglassControl::Model> {};
 
 TEST_P(Patch, LinearVelocityGivesUniformStressAndBalancedInteriorNodes) {
-  test::KernelRig rig(distorted_box(3), "elastic", test::elastic_steel(), {GetParam(), 0.1}, no_bulk_viscosity);
+  test::KernelRig rig(distorted_box(3), "elastic", test::elastic_steel(), {GetParam(), 0.1},
+                      no_bulk_viscosity);
   const std::size_t nn = rig.fe.node_gid.size();
   for (std::size_t k = 0; k < nn; ++k)
     for (int i = 0; i < 3; ++i)
@@ -73,16 +75,22 @@ TEST_P(Patch, LinearVelocityGivesUniformStressAndBalancedInteriorNodes) {
   const auto& mat = rig.material->elastic();
   double Lm[3][3];
   midstep_gradient(dt, Lm);
-  const double D[6] = {Lm[0][0], Lm[1][1], Lm[2][2], 0.5 * (Lm[0][1] + Lm[1][0]), 0.5 * (Lm[1][2] + Lm[2][1]),
+  const double D[6] = {Lm[0][0],
+                       Lm[1][1],
+                       Lm[2][2],
+                       0.5 * (Lm[0][1] + Lm[1][0]),
+                       0.5 * (Lm[1][2] + Lm[2][1]),
                        0.5 * (Lm[0][2] + Lm[2][0])};
   const double tr = (D[0] + D[1] + D[2]) * dt;
   double expected[6];
-  for (int k = 0; k < 6; ++k) expected[k] = 2 * mat.shear * D[k] * dt + (k < 3 ? mat.lambda * tr : 0.0);
+  for (int k = 0; k < 6; ++k)
+    expected[k] = 2 * mat.shear * D[k] * dt + (k < 3 ? mat.lambda * tr : 0.0);
   double scale = 0;
   for (double s : expected) scale = std::max(scale, std::abs(s));
   for (int e = 0; e < rig.block.size(); ++e)
     for (int k = 0; k < 6; ++k)
-      EXPECT_NEAR(rig.block.stress[k][e], expected[k], 1e-10 * scale) << "element " << e << " component " << k;
+      EXPECT_NEAR(rig.block.stress[k][e], expected[k], 1e-10 * scale)
+          << "element " << e << " component " << k;
 
   const double force_scale = scale * 0.01 * 0.01; // sigma h^2
   int checked = 0;
@@ -94,19 +102,22 @@ TEST_P(Patch, LinearVelocityGivesUniformStressAndBalancedInteriorNodes) {
   EXPECT_EQ(checked, 8);
   // No hourglass work: the modes of a linear field vanish up to round-off.
   for (int e = 0; e < rig.block.size(); ++e)
-    EXPECT_LE(std::abs(rig.block.hourglass_energy[e]), 1e-12 * std::abs(rig.block.internal_energy[e]));
+    EXPECT_LE(std::abs(rig.block.hourglass_energy[e]),
+              1e-12 * std::abs(rig.block.internal_energy[e]));
 }
 
 // The explicit patch test: boundary nodes driven along v = L X, interior nodes free and
 // started on the same field, 200 cycles of central difference. The interior nodes must
 // stay on the homogeneous deformation x = (I + t L) X and the stress stay uniform.
 TEST_P(Patch, DrivenBoundaryCarriesInteriorAlongHomogeneousDeformation) {
-  test::KernelRig rig(distorted_box(5), "elastic", test::elastic_steel(), {GetParam(), 0.1}, no_bulk_viscosity);
+  test::KernelRig rig(distorted_box(5), "elastic", test::elastic_steel(), {GetParam(), 0.1},
+                      no_bulk_viscosity);
   const std::size_t nn = rig.fe.node_gid.size();
   // Lumped nodal masses by the same exact gather the solver uses.
   std::vector<double> corner_mass(rig.fe.total_slots(), 0.0), mass(nn);
   for (int e = 0; e < rig.block.size(); ++e)
-    for (int a = 0; a < 8; ++a) corner_mass[a * simd::padded_size(rig.block.size()) + e] = rig.block.mass[e] / 8;
+    for (int a = 0; a < 8; ++a)
+      corner_mass[a * simd::padded_size(rig.block.size()) + e] = rig.block.mass[e] / 8;
   gather_corners(rig.fe, {corner_mass.data()}, {mass.data()});
   std::vector<Vec3> X(nn), V(nn);
   for (std::size_t k = 0; k < nn; ++k) {
@@ -131,7 +142,8 @@ TEST_P(Patch, DrivenBoundaryCarriesInteriorAlongHomogeneousDeformation) {
   }
   double err = 0;
   for (std::size_t k = 0; k < nn; ++k)
-    for (int i = 0; i < 3; ++i) err = std::max(err, std::abs(rig.x[i][k] - (X[k][i] + t * V[k][i])));
+    for (int i = 0; i < 3; ++i)
+      err = std::max(err, std::abs(rig.x[i][k] - (X[k][i] + t * V[k][i])));
   EXPECT_LT(err, 1e-12 * 0.03) << "interior nodes left the homogeneous deformation";
   for (int k = 0; k < 6; ++k) {
     double lo = 1e300, hi = -1e300;
@@ -144,6 +156,7 @@ TEST_P(Patch, DrivenBoundaryCarriesInteriorAlongHomogeneousDeformation) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Hourglass, Patch,
-                         ::testing::Values(HourglassControl::Model::viscous, HourglassControl::Model::stiffness));
+                         ::testing::Values(HourglassControl::Model::viscous,
+                                           HourglassControl::Model::stiffness));
 
 } // namespace

@@ -42,13 +42,17 @@ struct RigidRun {
 
 RigidRun spin(const double (&sigma0)[6], HourglassControl::Model hg) {
   test::KernelRig rig(distorted_block(), "j2_plasticity",
-                      {{"density", 7850}, {"youngs_modulus", 200e9}, {"poissons_ratio", 0.3},
-                       {"yield_stress", 250e6}, {"hardening_modulus", 1e9}},
+                      {{"density", 7850},
+                       {"youngs_modulus", 200e9},
+                       {"poissons_ratio", 0.3},
+                       {"yield_stress", 250e6},
+                       {"hardening_modulus", 1e9}},
                       {hg, 0.1});
   for (int e = 0; e < rig.block.size(); ++e)
     for (int k = 0; k < 6; ++k) rig.block.stress[k][e] = sigma0[k];
   const std::size_t nn = rig.fe.node_gid.size();
-  const Vec3 axis = Vec3{1, 2, 3} * (1 / std::sqrt(14.0)), center{0.005, -0.003, 0.01}, drift{3.0, -1.0, 2.0};
+  const Vec3 axis = Vec3{1, 2, 3} * (1 / std::sqrt(14.0)), center{0.005, -0.003, 0.01},
+             drift{3.0, -1.0, 2.0};
   const int steps = 400;
   const double total = 2 * std::numbers::pi / 3, dt = 1e-6;
   std::vector<Vec3> X(nn);
@@ -78,7 +82,9 @@ RigidRun spin(const double (&sigma0)[6], HourglassControl::Model hg) {
   }
   double R[3][3];
   rotation(axis, total, R);
-  const double S[3][3] = {{sigma0[0], sigma0[3], sigma0[5]}, {sigma0[3], sigma0[1], sigma0[4]}, {sigma0[5], sigma0[4], sigma0[2]}};
+  const double S[3][3] = {{sigma0[0], sigma0[3], sigma0[5]},
+                          {sigma0[3], sigma0[1], sigma0[4]},
+                          {sigma0[5], sigma0[4], sigma0[2]}};
   double E[3][3] = {};
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
@@ -89,7 +95,8 @@ RigidRun spin(const double (&sigma0)[6], HourglassControl::Model hg) {
   for (double s : sigma0) out.scale = std::max(out.scale, std::abs(s));
   for (int e = 0; e < rig.block.size(); ++e)
     for (int k = 0; k < 6; ++k)
-      out.max_abs_error = std::max(out.max_abs_error, std::abs(rig.block.stress[k][e] - expected[k]));
+      out.max_abs_error =
+          std::max(out.max_abs_error, std::abs(rig.block.stress[k][e] - expected[k]));
   return out;
 }
 

@@ -24,7 +24,8 @@ TEST(Wave1D, StepWaveArrivesAtTheAnalyticTimeWithTheAnalyticAmplitude) {
   const double c = std::sqrt(M / rho);
   const double t_end = 1.2 * L / c;
   const std::string deck = R"(
-termination: {time: )" + std::to_string(t_end) + R"(}
+termination: {time: )" + std::to_string(t_end) +
+                           R"(}
 materials:
   steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
 parts:
@@ -87,8 +88,8 @@ probes:
   if (world.rank() == 0)
     std::printf("wave: c %.1f m/s, arrival %.4e s (analytic %.4e, error %.3f%%), plateau %.5f m/s, "
                 "stress %.5e Pa (analytic %.5e, error %.3f%%)\n",
-                c, t_half, t_arrival, 100 * (t_half - t_arrival) / t_arrival, sum / n, s_sum / count, expected,
-                100 * (s_sum / count - expected) / std::abs(expected));
+                c, t_half, t_arrival, 100 * (t_half - t_arrival) / t_arrival, sum / n,
+                s_sum / count, expected, 100 * (s_sum / count - expected) / std::abs(expected));
 }
 
 } // namespace

@@ -1,7 +1,7 @@
 // The vector type the hot kernels are written in: `width` doubles processed together,
-// one lane per element (or particle). std::experimental::simd lowers it to AVX2/AVX-512
-// as available; arithmetic is IEEE per lane, so vector and scalar code give the same bits
-// (no FMA contraction: see the top-level CMakeLists).
+// one lane per element (or particle). Arithmetic is IEEE per lane; every element goes
+// through the same vector instructions (arrays are padded to whole vectors), which is
+// what keeps results independent of the partition.
 #pragma once
 
 #include <experimental/simd>
@@ -10,9 +10,11 @@ namespace anvil::simd {
 
 namespace stdx = std::experimental;
 
-inline constexpr int width = 8;
-using vdouble = stdx::fixed_size_simd<double, width>;
-using vmask = stdx::fixed_size_simd_mask<double, width>;
+// The target's native vector of doubles (4 with AVX2, 8 with AVX-512): measured faster
+// here than two native vectors per value (fixed_size_simd<double, 8>).
+using vdouble = stdx::native_simd<double>;
+using vmask = stdx::native_simd_mask<double>;
+inline constexpr int width = static_cast<int>(vdouble::size());
 
 // Loads lane l from p[idx[l]].
 template <class Index>

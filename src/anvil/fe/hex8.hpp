@@ -8,6 +8,10 @@
 
 namespace anvil::hex8 {
 
+// Everything here is small, fixed-size arithmetic: fully unrolled and inlined, so that
+// node permutations and +-1 coefficients become constants.
+#define ANVIL_HEX8_INLINE [[gnu::always_inline]] inline
+
 // Hourglass base vectors Gamma (eta zeta, xi zeta, xi eta, xi eta zeta at the nodes).
 inline constexpr double gamma_base[4][8] = {{1, 1, -1, -1, -1, -1, 1, 1},
                                             {1, -1, -1, 1, -1, 1, 1, -1},
@@ -22,10 +26,10 @@ inline constexpr int fb_perm[8][7] = {
 // Gradient operator B_ia = integral over the element of dN_a/dx_i = dV/dx_ia, exact for
 // the trilinear map (Flanagan and Belytschko eq. 79). x[a][i]: node a, coordinate i.
 template <class V>
-inline void gradient(const V (&x)[8][3], V (&B)[8][3]) {
-  for (int a = 0; a < 8; ++a) {
+ANVIL_HEX8_INLINE void gradient(const V (&x)[8][3], V (&B)[8][3]) {
+  _Pragma("GCC unroll 8") for (int a = 0; a < 8; ++a) {
     const int* p = fb_perm[a];
-    for (int i = 0; i < 3; ++i) {
+    _Pragma("GCC unroll 8") for (int i = 0; i < 3; ++i) {
       const int j = (i + 1) % 3, k = (i + 2) % 3;
       auto y = [&](int n) -> const V& { return x[p[n - 2]][j]; };
       auto z = [&](int n) -> const V& { return x[p[n - 2]][k]; };
@@ -39,51 +43,63 @@ inline void gradient(const V (&x)[8][3], V (&B)[8][3]) {
 
 // Volume from the gradient: V = sum_a x_a B_xa (exact).
 template <class V>
-inline V volume(const V (&x)[8][3], const V (&B)[8][3]) {
+ANVIL_HEX8_INLINE V volume(const V (&x)[8][3], const V (&B)[8][3]) {
   V v = x[0][0] * B[0][0];
-  for (int a = 1; a < 8; ++a) v += x[a][0] * B[a][0];
+  _Pragma("GCC unroll 8") for (int a = 1; a < 8; ++a) v += x[a][0] * B[a][0];
   return v;
 }
 
 // Sum of B_ia^2, the measure of the element's maximum eigenvalue.
 template <class V>
-inline V gradient_norm2(const V (&B)[8][3]) {
+ANVIL_HEX8_INLINE V gradient_norm2(const V (&B)[8][3]) {
   V s = B[0][0] * B[0][0];
-  for (int a = 0; a < 8; ++a)
-    for (int i = (a == 0 ? 1 : 0); i < 3; ++i) s += B[a][i] * B[a][i];
+  _Pragma("GCC unroll 8") for (int a = 0; a < 8; ++a)
+      _Pragma("GCC unroll 8") for (int i = (a == 0 ? 1 : 0); i < 3; ++i) s += B[a][i] * B[a][i];
   return s;
+}
+
+// Sum over the nodes of w_a Gamma_alpha,a for each of the four hourglass base vectors.
+// Gamma's entries are +-1, so this is additions only (multiplication by +-1.0 is exact
+// and the compiler folds it).
+template <class V>
+ANVIL_HEX8_INLINE void gamma_sums(const V (&w)[8], V (&out)[4]) {
+  _Pragma("GCC unroll 8") for (int al = 0; al < 4; ++al) {
+    V s = gamma_base[al][0] * w[0];
+    _Pragma("GCC unroll 8") for (int a = 1; a < 8; ++a) s += gamma_base[al][a] * w[a];
+    out[al] = s;
+  }
 }
 
 // Hourglass shape vectors gamma_alpha = Gamma_alpha - (1/V)(Gamma_alpha . x_i) B_i, which
 // are orthogonal to every linear velocity field on any shape (the property that lets the
 // element pass the patch test with hourglass control on).
 template <class V>
-inline void hourglass_shape(const V (&x)[8][3], const V (&B)[8][3], const V& inv_volume,
-                            V (&g)[4][8]) {
-  for (int al = 0; al < 4; ++al) {
+ANVIL_HEX8_INLINE void hourglass_shape(const V (&x)[8][3], const V (&B)[8][3], const V& inv_volume,
+                                       V (&g)[4][8]) {
+  _Pragma("GCC unroll 8") for (int al = 0; al < 4; ++al) {
     V h[3];
-    for (int i = 0; i < 3; ++i) {
+    _Pragma("GCC unroll 8") for (int i = 0; i < 3; ++i) {
       h[i] = gamma_base[al][0] * x[0][i];
-      for (int a = 1; a < 8; ++a) h[i] += gamma_base[al][a] * x[a][i];
+      _Pragma("GCC unroll 8") for (int a = 1; a < 8; ++a) h[i] += gamma_base[al][a] * x[a][i];
       h[i] *= inv_volume;
     }
-    for (int a = 0; a < 8; ++a)
-      g[al][a] = gamma_base[al][a] - (h[0] * B[a][0] + h[1] * B[a][1] + h[2] * B[a][2]);
+    _Pragma("GCC unroll 8") for (int a = 0; a < 8; ++a) g[al][a] =
+        gamma_base[al][a] - (h[0] * B[a][0] + h[1] * B[a][1] + h[2] * B[a][2]);
   }
 }
 
 // Velocity gradient L_ij = (1/V) sum_a v_ia B_ja split into the rate of deformation
 // d (xx, yy, zz, xy, yz, xz) and the spin's axial vector w (W_zy, W_xz, W_yx).
 template <class V>
-inline void velocity_gradient(const V (&v)[8][3], const V (&B)[8][3], const V& inv_volume,
-                              V (&d)[6], V (&w)[3]) {
+ANVIL_HEX8_INLINE void velocity_gradient(const V (&v)[8][3], const V (&B)[8][3],
+                                         const V& inv_volume, V (&d)[6], V (&w)[3]) {
   V L[3][3];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      V s = v[0][i] * B[0][j];
-      for (int a = 1; a < 8; ++a) s += v[a][i] * B[a][j];
-      L[i][j] = s * inv_volume;
-    }
+  _Pragma("GCC unroll 8") for (int i = 0; i < 3; ++i)
+      _Pragma("GCC unroll 8") for (int j = 0; j < 3; ++j) {
+    V s = v[0][i] * B[0][j];
+    _Pragma("GCC unroll 8") for (int a = 1; a < 8; ++a) s += v[a][i] * B[a][j];
+    L[i][j] = s * inv_volume;
+  }
   d[0] = L[0][0];
   d[1] = L[1][1];
   d[2] = L[2][2];
@@ -100,7 +116,7 @@ inline void velocity_gradient(const V (&v)[8][3], const V (&B)[8][3], const V& i
 // exactly orthogonal and reproduces the rotation of the mid-step configuration, so a
 // rigidly spinning body keeps its stress unchanged but for the rotation.
 template <class V>
-inline void hughes_winget(const V (&w)[3], double dt, V (&Q)[3][3]) {
+ANVIL_HEX8_INLINE void hughes_winget(const V (&w)[3], double dt, V (&Q)[3][3]) {
   const V a0 = (0.5 * dt) * w[0], a1 = (0.5 * dt) * w[1], a2 = (0.5 * dt) * w[2];
   const V k = 2.0 / (1.0 + (a0 * a0 + a1 * a1 + a2 * a2));
   // A = [[0, -a2, a1], [a2, 0, -a0], [-a1, a0, 0]]; A^2 = a a^T - |a|^2 I.
@@ -118,11 +134,12 @@ inline void hughes_winget(const V (&w)[3], double dt, V (&Q)[3][3]) {
 
 // s <- Q s Q^T for a symmetric tensor in (xx, yy, zz, xy, yz, xz) order.
 template <class V>
-inline void rotate_symmetric(const V (&Q)[3][3], V (&s)[6]) {
+ANVIL_HEX8_INLINE void rotate_symmetric(const V (&Q)[3][3], V (&s)[6]) {
   const V S[3][3] = {{s[0], s[3], s[5]}, {s[3], s[1], s[4]}, {s[5], s[4], s[2]}};
   V T[3][3];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) T[i][j] = Q[i][0] * S[0][j] + Q[i][1] * S[1][j] + Q[i][2] * S[2][j];
+  _Pragma("GCC unroll 8") for (int i = 0; i < 3; ++i)
+      _Pragma("GCC unroll 8") for (int j = 0; j < 3; ++j) T[i][j] =
+          Q[i][0] * S[0][j] + Q[i][1] * S[1][j] + Q[i][2] * S[2][j];
   auto r = [&](int i, int j) { return T[i][0] * Q[j][0] + T[i][1] * Q[j][1] + T[i][2] * Q[j][2]; };
   s[0] = r(0, 0);
   s[1] = r(1, 1);

@@ -35,22 +35,39 @@ enum Slot : int {
   s_q5,
   s_q6,
   s_q7,
-  s_q8, // Hughes-Winget rotation
-  s_count
+  s_q8,
+  s_x0,             // 24 gathered positions (3 a + i)
+  s_v0 = s_x0 + 24, // 24 gathered velocities
+  s_count = s_v0 + 24
 };
 
 struct Gathered {
   vdouble x[8][3], v[8][3];
 };
 
-void gather(const HexBlock& b, const NodalView& n, int e, Gathered& g) {
+// Loads the corner positions and velocities of elements e..e+width-1 from the nodes and
+// keeps a copy in the chunk scratch (at lane offset l) for the second pass.
+void gather(const HexBlock& b, const NodalView& n, int e, Gathered& g, double* xs, double* vs,
+            int l) {
+  constexpr int C = HexWorkspace::chunk;
   for (int a = 0; a < 8; ++a) {
     const int* idx = b.conn[a].data() + e;
     for (int i = 0; i < 3; ++i) {
       g.x[a][i] = simd::gather(n.x[i], idx);
       g.v[a][i] = simd::gather(n.v[i], idx);
+      simd::store(g.x[a][i], xs + (3 * a + i) * C + l);
+      simd::store(g.v[a][i], vs + (3 * a + i) * C + l);
     }
   }
+}
+
+void reload(Gathered& g, const double* xs, const double* vs, int l) {
+  constexpr int C = HexWorkspace::chunk;
+  for (int a = 0; a < 8; ++a)
+    for (int i = 0; i < 3; ++i) {
+      g.x[a][i] = simd::load(xs + (3 * a + i) * C + l);
+      g.v[a][i] = simd::load(vs + (3 * a + i) * C + l);
+    }
 }
 
 } // namespace
@@ -63,7 +80,8 @@ int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array
   corner_base = base;
   for (int a = 0; a < 8; ++a) {
     conn[a].resize(p);
-    for (std::size_t e = 0; e < p; ++e) conn[a][e] = n > 0 ? corners[std::min<std::size_t>(e, n - 1)][a] : 0;
+    for (std::size_t e = 0; e < p; ++e)
+      conn[a][e] = n > 0 ? corners[std::min<std::size_t>(e, n - 1)][a] : 0;
   }
   volume.assign(p, 0.0);
   hex_volumes(*this, x, volume);
@@ -109,7 +127,7 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
     // rotate the old stress into the new frame.
     for (int l = 0; l < nc; l += width) {
       const int e = e0 + l;
-      gather(b, nodes, e, g);
+      gather(b, nodes, e, g, scratch(s_x0), scratch(s_v0), l);
       vdouble xm[8][3], B[8][3];
       for (int a = 0; a < 8; ++a)
         for (int i = 0; i < 3; ++i) xm[a][i] = g.x[a][i] - (0.5 * dt) * g.v[a][i];
@@ -152,7 +170,7 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
     // the stable time step.
     for (int l = 0; l < nc; l += width) {
       const int e = e0 + l;
-      gather(b, nodes, e, g);
+      reload(g, scratch(s_x0), scratch(s_v0), l);
       vdouble B[8][3];
       hex8::gradient(g.x, B);
       const vdouble vol = hex8::volume(g.x, B);
@@ -166,57 +184,77 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
         s[k] = simd::load(&b.stress[k][e]);
       }
       const vdouble trd = d[0] + d[1] + d[2];
-      const vdouble len = stdx::cbrt(stdx::abs(vol));
+      // Characteristic length: the element's stable-step length V / sqrt(2 B:B) scaled
+      // by sqrt(3), which is the edge of a cube (and needs no cube root).
+      const vdouble bb = hex8::gradient_norm2(B);
+      const vdouble inv_sqrt_bb = 1.0 / stdx::sqrt(2.0 * bb);
+      const vdouble lc = vol * inv_sqrt_bb;
+      const vdouble len = 1.7320508075688772 * lc;
       const auto compressing = trd < 0.0;
       vdouble q = 0.0, qv = 0.0; // bulk viscosity pressure and its rate term for dt
       stdx::where(compressing, q) = rho * len * (c2 * len * trd * trd - c1 * c * trd);
       stdx::where(compressing, qv) = c1 * c - c2 * len * trd;
 
-      // f_ia = -sigma_ij B_ja, with the bulk viscosity pressure on the diagonal.
-      vdouble f[8][3];
-      const vdouble sxx = s[0] - q, syy = s[1] - q, szz = s[2] - q;
-      for (int a = 0; a < 8; ++a) {
-        f[a][0] = -(sxx * B[a][0] + s[3] * B[a][1] + s[5] * B[a][2]);
-        f[a][1] = -(s[3] * B[a][0] + syy * B[a][1] + s[4] * B[a][2]);
-        f[a][2] = -(s[5] * B[a][0] + s[4] * B[a][1] + szz * B[a][2]);
+      // Hourglass (Flanagan-Belytschko, with gamma = Gamma - h B never formed):
+      //   h_aj = (1/V) sum_b Gamma_ab x_jb, G_ij = sum_b v_ib B_jb,
+      //   q_ia = sum_b v_ib Gamma_ab - G_ij h_aj (the hourglass velocities),
+      //   f_ia = -(sigma_ij - q delta_ij - P_ij) B_ja - sum_al Q_i,al Gamma_al,a,
+      //   P_ij = sum_al Q_i,al h_al,j.
+      vdouble h[4][3], vg[3][4];
+      for (int i = 0; i < 3; ++i) {
+        vdouble col[8], out[4];
+        for (int a = 0; a < 8; ++a) col[a] = g.x[a][i];
+        hex8::gamma_sums(col, out);
+        for (int al = 0; al < 4; ++al) h[al][i] = out[al] * inv;
+        for (int a = 0; a < 8; ++a) col[a] = g.v[a][i];
+        hex8::gamma_sums(col, vg[i]);
       }
-
-      // Hourglass: modes q_i,alpha = sum_a v_ia gamma_alpha,a; resisting forces
-      // -Q_i,alpha gamma_alpha,a.
-      vdouble gam[4][8];
-      hex8::hourglass_shape(g.x, B, inv, gam);
-      const vdouble bb = hex8::gradient_norm2(B);
-      vdouble hg_power = 0.0;
-      for (int al = 0; al < 4; ++al) {
-        vdouble qa[3], Qa[3];
-        for (int i = 0; i < 3; ++i) {
-          qa[i] = g.v[0][i] * gam[al][0];
-          for (int a = 1; a < 8; ++a) qa[i] += g.v[a][i] * gam[al][a];
+      vdouble G[3][3];
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+          vdouble t = g.v[0][i] * B[0][j];
+          for (int a = 1; a < 8; ++a) t += g.v[a][i] * B[a][j];
+          G[i][j] = t;
         }
+      vdouble Qh[3][4];
+      vdouble hg_power = 0.0;
+      const vdouble kv = (0.25 * hg) * rho * c * len * len;
+      const vdouble ks = (hg * M / 3.0) * bb * inv;
+      for (int al = 0; al < 4; ++al) {
+        vdouble qa[3];
+        for (int i = 0; i < 3; ++i)
+          qa[i] = vg[i][al] - (G[i][0] * h[al][0] + G[i][1] * h[al][1] + G[i][2] * h[al][2]);
         if (stiff) {
-          vdouble old[3], rot[3];
+          vdouble old[3];
           for (int i = 0; i < 3; ++i) old[i] = simd::load(&b.hourglass_force[3 * al + i][e]);
           for (int i = 0; i < 3; ++i) {
-            rot[i] = simd::load(scratch(s_q0 + 3 * i) + l) * old[0] +
-                     simd::load(scratch(s_q0 + 3 * i + 1) + l) * old[1] +
-                     simd::load(scratch(s_q0 + 3 * i + 2) + l) * old[2];
-          }
-          const vdouble k = (hg * M / 3.0) * bb * inv;
-          for (int i = 0; i < 3; ++i) {
-            Qa[i] = rot[i] + dt * k * qa[i];
-            simd::store(Qa[i], &b.hourglass_force[3 * al + i][e]);
-            hg_power += 0.5 * (rot[i] + Qa[i]) * qa[i];
+            const vdouble rot = simd::load(scratch(s_q0 + 3 * i) + l) * old[0] +
+                                simd::load(scratch(s_q0 + 3 * i + 1) + l) * old[1] +
+                                simd::load(scratch(s_q0 + 3 * i + 2) + l) * old[2];
+            Qh[i][al] = rot + dt * ks * qa[i];
+            simd::store(Qh[i][al], &b.hourglass_force[3 * al + i][e]);
+            hg_power += 0.5 * (rot + Qh[i][al]) * qa[i];
           }
         } else {
-          const vdouble k = (0.25 * hg) * rho * c * len * len;
           for (int i = 0; i < 3; ++i) {
-            Qa[i] = k * qa[i];
-            hg_power += Qa[i] * qa[i];
+            Qh[i][al] = kv * qa[i];
+            hg_power += Qh[i][al] * qa[i];
           }
         }
-        for (int a = 0; a < 8; ++a)
-          for (int i = 0; i < 3; ++i) f[a][i] -= Qa[i] * gam[al][a];
       }
+      // S = sigma - q I - P (not symmetric once P is in).
+      vdouble S[3][3] = {{s[0] - q, s[3], s[5]}, {s[3], s[1] - q, s[4]}, {s[5], s[4], s[2] - q}};
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          S[i][j] -=
+              Qh[i][0] * h[0][j] + Qh[i][1] * h[1][j] + Qh[i][2] * h[2][j] + Qh[i][3] * h[3][j];
+      vdouble f[8][3];
+      for (int a = 0; a < 8; ++a)
+        for (int i = 0; i < 3; ++i) {
+          vdouble t = S[i][0] * B[a][0] + S[i][1] * B[a][1] + S[i][2] * B[a][2];
+          for (int al = 0; al < 4; ++al) t += hex8::gamma_base[al][a] * Qh[i][al];
+          f[a][i] = -t;
+        }
 
       // Energies over the step just taken (dt = 0 on the first cycle).
       const vdouble power_new =
@@ -229,10 +267,9 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       simd::store(vol, &b.volume[e]);
 
       // Stable time step: Flanagan-Belytschko bound on the maximum eigenvalue,
-      // omega^2 <= 8 c^2 B:B / V^2, reduced for the bulk viscosity.
-      const vdouble lc = vol / stdx::sqrt(2.0 * bb);
-      const vdouble qq = qv;
-      const vdouble dte = lc / (qq + stdx::sqrt(qq * qq + c * c));
+      // omega^2 <= 8 c^2 B:B / V^2, i.e. dt = V / (c sqrt(2 B:B)), reduced for the bulk
+      // viscosity.
+      const vdouble dte = lc / (qv + stdx::sqrt(qv * qv + c * c));
 
       vdouble check = dte;
       for (int a = 0; a < 8; ++a)
