@@ -153,12 +153,14 @@ def use_agg():
     return plt
 
 
-def save_figure(fig, path, dpi=110):
-    """Write `fig` to `path` (directory created if needed); raise ResultsError on failure."""
+def save_figure(fig, path, dpi=110, tight=False):
+    """Write `fig` to `path` (directory created if needed); raise ResultsError on failure.
+    tight=True crops the empty margin (useful around 3-D axes)."""
     directory = os.path.dirname(os.path.abspath(path))
     try:
         os.makedirs(directory, exist_ok=True)
-        fig.savefig(path, dpi=dpi)
+        extra = dict(bbox_inches="tight", pad_inches=0.3) if tight else {}
+        fig.savefig(path, dpi=dpi, **extra)
     except (OSError, ValueError) as e:
         raise ResultsError(f"{path}: cannot write ({e})") from None
 

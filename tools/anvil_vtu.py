@@ -415,6 +415,8 @@ def load_output(outdir, step=None, time=None):
 
     Returns (PvdEntry, Grid).  For a .pvtu/.vtu path the entry's time is NaN.
     """
+    if not os.path.exists(outdir):
+        raise VtuError(f"{outdir}: no such file or directory")
     if os.path.isdir(outdir):
         pvd = os.path.join(outdir, "results.pvd")
         if not os.path.exists(pvd):
