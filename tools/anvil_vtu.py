@@ -130,6 +130,12 @@ def _parse_xml(path, text):
         raise VtuError(f"{path}: malformed XML ({e})") from None
 
 
+def _read_xml(path):
+    """Parse the XML part of `path` (binary appended data cut off) -> root Element."""
+    xml, _ = _split_appended(path, _read_bytes(path))
+    return _parse_xml(path, xml)
+
+
 def _int_attr(path, elem, name):
     """Non-negative integer attribute `name` of `elem`, or raise VtuError."""
     value = elem.get(name)
@@ -319,7 +325,7 @@ def read_pvtu(path):
     Point indices are shifted per piece; piece_of_cell tells which piece a cell came from.
     Every piece must carry the point and cell arrays the .pvtu declares.
     """
-    root = _parse_xml(path, _read_bytes(path))
+    root = _read_xml(path)
     _check_root(path, root, "PUnstructuredGrid")
     grid_el = _find(path, root, "PUnstructuredGrid")
     declared = {
@@ -376,7 +382,7 @@ def read_grid(path):
 
 def read_pvd(path):
     """Read a .pvd collection; return PvdEntry list sorted by time (paths made absolute)."""
-    root = _parse_xml(path, _read_bytes(path))
+    root = _read_xml(path)
     _check_root(path, root, "Collection")
     sets = root.findall("Collection/DataSet")
     if not sets:
