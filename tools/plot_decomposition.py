@@ -341,6 +341,10 @@ def build_title(args, summary, entry, n_faces):
         tf, tu = time_unit(entry.time) if entry.time > 0 else (1e6, "µs")
         when = f", t = {entry.time * tf:.3g} {tu}"
     shape = "undeformed" if args.undeformed else "deformed"
+    if args.elev < 0:
+        shape += ", seen from below"
+    if args.cut is not None:
+        shape += f", cut at {'xyz'[args.cut[0]]} = {args.cut[1]:g} m"
     return f"{head}\n{name}{when} ({shape})"
 
 
