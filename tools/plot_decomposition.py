@@ -280,8 +280,9 @@ def padded_limits(pts, min_ratio=0.45):
     return mid - 0.5 * want, mid + 0.5 * want
 
 
-def draw(quads, rgba, legend, counts, args, title, lf, lu):
-    """Build the figure: quads (m,4,3) in displayed length units, colours, legend."""
+def draw(quads, rgba, legend, counts, args, title, lu):
+    """Build the figure from quads (m,4,3) already in length unit `lu`, their RGBA colours,
+    the legend description of face_colors and per-category element counts."""
     plt = use_agg()
     from matplotlib.patches import Patch
     from matplotlib.ticker import MaxNLocator
@@ -327,7 +328,7 @@ def draw(quads, rgba, legend, counts, args, title, lf, lu):
     return fig
 
 
-def build_title(args, summary, entry, n_faces):
+def build_title(args, summary, entry):
     """Two-line title: deck title, then field, time and shape."""
     head = args.title or title_of(summary, "anvil mesh")
     name = field_label(args.field)[0].split(" [")[0]
@@ -377,11 +378,11 @@ def main(argv=None):
     extent = (points.max(axis=0) - points.min(axis=0)).max()
     lf, lu = length_unit(extent)
     summary = read_summary(args.outdir) if os.path.isdir(args.outdir) else None
-    title = build_title(args, summary, entry, int(front.sum()))
+    title = build_title(args, summary, entry)
     counts = category_counts(grid, args.field, hex_cells) if legend[0] == "categories" else {}
     fig = draw(quads[front] * lf, shade(rgba[front], normals[front], light_vector(args.elev, args.azim),
                0.6 if legend[0] == "categories" else 0.3), legend, counts,
-               args, title, lf, lu)
+               args, title, lu)
     out = args.output or os.path.join(
         args.outdir if os.path.isdir(args.outdir) else ".", f"{args.field}.png")
     save_figure(fig, out, dpi=args.dpi, tight=True)
