@@ -1,0 +1,177 @@
+#!/usr/bin/python3
+"""Shared helpers of anvil's plotting tools: history.csv and summary.json readers,
+unit choices for axes, and command-line error handling.
+
+Public interface:
+    ResultsError                         malformed or missing input (message names the file)
+    read_history(outdir) -> History      the columns of OUTDIR/history.csv as float arrays
+    read_summary(outdir) -> dict | None  OUTDIR/summary.json, or None when absent
+    time_unit(t_max) -> (factor, label)  scale seconds for an axis ("µs", "ms" or "s")
+    length_unit(extent) -> (factor, label)
+    run_main(main)                       call main(); turn errors into exit status 2
+    save_figure(fig, path)               write a PNG, creating the directory
+"""
+
+import json
+import os
+import sys
+from dataclasses import dataclass
+
+import numpy as np
+
+
+class ResultsError(Exception):
+    """Missing, unreadable or malformed anvil output; the message names the file."""
+
+
+@dataclass
+class History:
+    """history.csv: `columns` in file order and `data[name]` a float64 array per column."""
+
+    path: str
+    columns: list
+    data: dict
+
+    def __getitem__(self, name):
+        return self.data[name]
+
+    def __len__(self):
+        return len(self.data[self.columns[0]]) if self.columns else 0
+
+    def probe_columns(self):
+        """The PROBE.FIELD columns (those with a dot in the name), in file order."""
+        return [c for c in self.columns if "." in c]
+
+
+def _history_path(outdir):
+    """OUTDIR/history.csv, or `outdir` itself if it is a file."""
+    return outdir if os.path.isfile(outdir) else os.path.join(outdir, "history.csv")
+
+
+def read_history(outdir):
+    """Read OUTDIR/history.csv (or the .csv file given) into a History.
+
+    A final line without its newline (a run still writing) is dropped with a warning;
+    any other malformed line raises ResultsError naming the file and line.
+    """
+    path = _history_path(outdir)
+    try:
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+    except OSError as e:
+        raise ResultsError(f"{path}: cannot read ({e.strerror or e})") from None
+    lines = text.split("\n")
+    partial = lines.pop() if lines else ""  # text after the last newline
+    if partial.strip():
+        print(f"warning: {path}: ignoring the unterminated last line", file=sys.stderr)
+    if not lines or not lines[0].strip():
+        raise ResultsError(f"{path}: empty file, expected a header line")
+    columns = [c.strip() for c in lines[0].split(",")]
+    for required in ("time", "cycle"):
+        if required not in columns:
+            raise ResultsError(f"{path}: header has no {required!r} column")
+    rows = []
+    for lineno, line in enumerate(lines[1:], start=2):
+        if not line.strip():
+            continue
+        fields = line.split(",")
+        if len(fields) != len(columns):
+            raise ResultsError(
+                f"{path}:{lineno}: {len(fields)} fields, the header has {len(columns)}"
+            )
+        try:
+            rows.append([float(x) for x in fields])
+        except ValueError:
+            raise ResultsError(f"{path}:{lineno}: a field is not a number") from None
+    table = np.array(rows, dtype=np.float64).reshape(len(rows), len(columns))
+    if not rows:
+        raise ResultsError(f"{path}: no data rows")
+    return History(path, columns, {c: table[:, i] for i, c in enumerate(columns)})
+
+
+def read_summary(outdir):
+    """Return OUTDIR/summary.json as a dict, None if absent; ResultsError if malformed."""
+    path = os.path.join(outdir, "summary.json") if os.path.isdir(outdir) else None
+    if path is None or not os.path.exists(path):
+        return None
+    try:
+        with open(path, encoding="utf-8") as f:
+            return json.load(f)
+    except (OSError, ValueError) as e:
+        raise ResultsError(f"{path}: cannot read ({e})") from None
+
+
+def time_unit(t_max):
+    """(factor, label) to show times up to `t_max` seconds: multiply seconds by factor."""
+    t_max = abs(t_max)
+    if 0 < t_max < 1e-3:
+        return 1e6, "µs"
+    if 0 < t_max < 1:
+        return 1e3, "ms"
+    return 1.0, "s"
+
+
+def length_unit(extent):
+    """(factor, label) to show lengths of size `extent` metres."""
+    extent = abs(extent)
+    if 0 < extent < 1e-3:
+        return 1e6, "µm"
+    if 0 < extent < 1:
+        return 1e3, "mm"
+    return 1.0, "m"
+
+
+def title_of(summary, fallback):
+    """A plot title: the deck title from summary.json, else `fallback`."""
+    if summary and summary.get("title"):
+        return str(summary["title"])
+    return fallback
+
+
+def run_description(summary):
+    """One line describing the run (ranks, elements, cycles) from summary.json, or ''."""
+    if not summary:
+        return ""
+    parts = []
+    for key, label in (("ranks", "ranks"), ("elements", "elements"), ("particles", "particles")):
+        if summary.get(key):
+            parts.append(f"{summary[key]:,} {label}")
+    if summary.get("cycles"):
+        parts.append(f"{summary['cycles']:,} cycles")
+    if summary.get("status") and summary["status"] != "completed":
+        parts.append(f"status: {summary['status']}")
+    return ", ".join(parts)
+
+
+def use_agg():
+    """Select matplotlib's file-only Agg backend and return pyplot."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save_figure(fig, path, dpi=110, tight=False):
+    """Write `fig` to `path` (directory created if needed); raise ResultsError on failure.
+    tight=True crops the empty margin (useful around 3-D axes)."""
+    directory = os.path.dirname(os.path.abspath(path))
+    try:
+        os.makedirs(directory, exist_ok=True)
+        extra = dict(bbox_inches="tight", pad_inches=0.3) if tight else {}
+        fig.savefig(path, dpi=dpi, **extra)
+    except (OSError, ValueError) as e:
+        raise ResultsError(f"{path}: cannot write ({e})") from None
+
+
+def run_main(main, prog):
+    """Call main(); print errors from unreadable input as 'PROG: message' and exit 2."""
+    from anvil_vtu import VtuError
+
+    try:
+        status = main()
+    except (ResultsError, VtuError) as e:
+        print(f"{prog}: error: {e}", file=sys.stderr)
+        sys.exit(2)
+    sys.exit(status or 0)

@@ -1,0 +1,127 @@
+#!/usr/bin/python3
+"""Plot the energy history of an anvil run from OUTDIR/history.csv.
+
+Top panel: kinetic, internal, hourglass, contact energy, external work and the total
+(kinetic + internal + hourglass + contact).  Bottom panel: the energy balance error
+|total - E0 - external_work| / max(|total|, |external_work|, |E0|), anvil's definition
+of summary.json's energy.balance_error, with E0 the total of the first history row.
+(anvil's own E0 is the kinetic energy of the initial velocities, which history.csv does
+not hold: its t=0 row already averages v(-1/2) and v(+1/2); the two differ slightly, so
+the final value from summary.json is printed next to the curve.)
+"""
+
+import argparse
+import os
+
+import numpy as np
+
+from anvil_results import (
+    ResultsError,
+    read_history,
+    read_summary,
+    run_description,
+    run_main,
+    save_figure,
+    time_unit,
+    title_of,
+    use_agg,
+)
+
+ENERGY_CURVES = [  # column, label, style
+    ("kinetic", "kinetic", dict(color="tab:blue")),
+    ("internal", "internal", dict(color="tab:orange")),
+    ("hourglass", "hourglass", dict(color="tab:green")),
+    ("contact", "contact", dict(color="tab:red")),
+    ("external_work", "external work", dict(color="tab:purple", linestyle="--")),
+    ("total", "total", dict(color="black", linewidth=2.0)),
+]
+
+
+def parse_args(argv=None):
+    """Command line -> argparse.Namespace (outdir, output)."""
+    p = argparse.ArgumentParser(
+        description="Energy history plot (and balance error) of an anvil run.",
+        epilog="example: plot_history.py out/taylor_bar -o out/taylor_bar/energy.png",
+    )
+    p.add_argument("outdir", help="anvil output directory holding history.csv (or the .csv)")
+    p.add_argument("-o", "--output", help="PNG to write (default OUTDIR/energy.png)")
+    p.add_argument("--title", help="plot title (default: the deck title in summary.json)")
+    return p.parse_args(argv)
+
+
+def balance_error(h):
+    """Relative energy balance error per history row, as anvil defines it (0 at t=0)."""
+    total, work = h["total"], h["external_work"]
+    e0 = total[0]
+    scale = np.maximum.reduce([np.abs(total), np.abs(work), np.full_like(total, abs(e0))])
+    scale = np.maximum(scale, 1e-300)
+    return np.abs(total - e0 - work) / scale
+
+
+def energy_unit(e_max):
+    """(factor, label) for energies of size `e_max` joules."""
+    e_max = abs(e_max)
+    if e_max >= 1e6:
+        return 1e-6, "MJ"
+    if e_max >= 1e3:
+        return 1e-3, "kJ"
+    if 0 < e_max < 1e-3:
+        return 1e3, "mJ"
+    return 1.0, "J"
+
+
+def plot(h, summary, title):
+    """Draw the two panels for History `h`; return the matplotlib Figure."""
+    plt = use_agg()
+    missing = [c for c, _, _ in ENERGY_CURVES if c not in h.data]
+    if missing:
+        raise ResultsError(f"{h.path}: missing energy columns {missing}")
+    tf, tu = time_unit(h["time"].max())
+    t = h["time"] * tf
+    e_max = max(np.abs(h[c]).max() for c, _, _ in ENERGY_CURVES)
+    ef, eu = energy_unit(e_max)
+
+    fig, (ax, axb) = plt.subplots(
+        2, 1, sharex=True, figsize=(7.5, 6.0), gridspec_kw=dict(height_ratios=[3, 1.3])
+    )
+    for col, label, style in ENERGY_CURVES:
+        ax.plot(t, h[col] * ef, label=label, **style)
+    ax.set_ylabel(f"energy [{eu}]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best", fontsize=9, ncol=2, framealpha=0.9)
+    sub = run_description(summary)
+    ax.set_title(title + (f"\n{sub}" if sub else ""), fontsize=11)
+
+    err = balance_error(h) * 100
+    axb.plot(t, err, color="tab:red")
+    axb.set_ylabel("balance error [%]")
+    axb.set_xlabel(f"time [{tu}]")
+    axb.grid(True, alpha=0.3)
+    axb.set_ylim(bottom=0, top=max(err.max() * 1.6, 1e-3))
+    axb.set_xlim(t[0], t[-1])
+    note = f"final {err[-1]:.3g} %, max {err.max():.3g} % (vs first row)"
+    reported = (summary or {}).get("energy", {}).get("balance_error")
+    if isinstance(reported, (int, float)):
+        note += f"\nsummary.json: {reported * 100:.3g} % (vs initial kinetic energy)"
+    axb.text(0.99, 0.94, note, transform=axb.transAxes, ha="right", va="top", fontsize=8.5)
+    fig.align_ylabels([ax, axb])
+    fig.tight_layout()
+    return fig
+
+
+def main(argv=None):
+    """Entry point: read OUTDIR, write the PNG, print its path."""
+    args = parse_args(argv)
+    h = read_history(args.outdir)
+    base = args.outdir if os.path.isdir(args.outdir) else os.path.dirname(args.outdir)
+    summary = read_summary(base or ".")
+    title = args.title or title_of(summary, "anvil energy history")
+    out = args.output or os.path.join(base or ".", "energy.png")
+    fig = plot(h, summary, title)
+    save_figure(fig, out)
+    print(out)
+    return 0
+
+
+if __name__ == "__main__":
+    run_main(main, "plot_history.py")

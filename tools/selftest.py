@@ -1,0 +1,395 @@
+#!/usr/bin/python3
+"""Self-test of anvil's Python plotting tools, needing no anvil run.
+
+Writes a small synthetic output directory in a temporary folder -- a box of hexahedra
+split into two per-rank .vtu pieces written byte for byte as src/anvil/io/vtu.cpp does,
+the .pvtu indices, results.pvd, history.csv and summary.json -- then checks the reader
+(anvil_vtu.py) against the known mesh, checks that malformed input raises clear errors,
+and runs every plot script to a PNG and with bad arguments.
+
+Usage: selftest.py [--keep]   (--keep leaves the temporary directory and prints it)
+Exit status 0 when every check passes, 1 otherwise.
+"""
+
+import argparse
+import json
+import os
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+import traceback
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+
+import anvil_vtu  # noqa: E402
+from plot_decomposition import exterior_faces  # noqa: E402
+
+NX, NY, NZ = 3, 2, 4  # box cells per direction
+RANKS = 2
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+# --------------------------------------------------------------------------- writers (as vtu.cpp)
+
+
+class Appender:
+    """Mirror of vtu.cpp's Appender: XML header text plus a blob of (UInt64 bytes, data)."""
+
+    def __init__(self):
+        self.header, self.blob = "", bytearray()
+
+    def add(self, values, fmt):
+        """Append a UInt64 byte count and the values packed little-endian; return offset."""
+        offset = len(self.blob)
+        data = struct.pack(f"<{len(values)}{fmt}", *values)
+        self.blob += struct.pack("<Q", len(data)) + data
+        return offset
+
+
+def array_tag(a, name, comps, values, is_int):
+    """Mirror of vtu.cpp's array_tag for one named point/cell array."""
+    off = a.add(values, "q" if is_int else "d")
+    a.header += (
+        f'        <DataArray type="{"Int64" if is_int else "Float64"}" Name="{name}" '
+        f'NumberOfComponents="{comps}" format="appended" offset="{off}"/>\n'
+    )
+
+
+def write_vtu(path, piece):
+    """Write `piece` (dict: points, connectivity, offsets, types, point_data, cell_data
+    with data as [(name, comps, flat values, is_int)]) exactly as write_vtu in vtu.cpp."""
+    a = Appender()
+    np_, nc = len(piece["points"]) // 3, len(piece["types"])
+    a.header += ('<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="1.0" '
+                 'byte_order="LittleEndian" header_type="UInt64">\n  <UnstructuredGrid>\n')
+    a.header += f'    <Piece NumberOfPoints="{np_}" NumberOfCells="{nc}">\n'
+    a.header += "      <PointData>\n"
+    for arr in piece["point_data"]:
+        array_tag(a, *arr)
+    a.header += "      </PointData>\n      <CellData>\n"
+    for arr in piece["cell_data"]:
+        array_tag(a, *arr)
+    a.header += "      </CellData>\n      <Points>\n"
+    a.header += ('        <DataArray type="Float64" NumberOfComponents="3" '
+                 f'format="appended" offset="{a.add(piece["points"], "d")}"/>\n')
+    a.header += "      </Points>\n      <Cells>\n"
+    a.header += ('        <DataArray type="Int64" Name="connectivity" '
+                 f'format="appended" offset="{a.add(piece["connectivity"], "q")}"/>\n')
+    a.header += ('        <DataArray type="Int64" Name="offsets" format="appended" '
+                 f'offset="{a.add(piece["offsets"], "q")}"/>\n')
+    a.header += ('        <DataArray type="UInt8" Name="types" format="appended" '
+                 f'offset="{a.add(piece["types"], "B")}"/>\n')
+    a.header += ('      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n  <AppendedData '
+                 'encoding="raw">\n   _')
+    with open(path, "wb") as f:
+        f.write(a.header.encode() + bytes(a.blob) + b"\n  </AppendedData>\n</VTKFile>\n")
+
+
+def write_pvtu(path, pieces, layout):
+    """Mirror of write_pvtu in vtu.cpp."""
+    s = ('<?xml version="1.0"?>\n<VTKFile type="PUnstructuredGrid" version="1.0" '
+         'byte_order="LittleEndian" header_type="UInt64">\n  <PUnstructuredGrid '
+         'GhostLevel="0">\n')
+
+    def arrays(lst):
+        return "".join(
+            f'      <PDataArray type="{"Int64" if i else "Float64"}" Name="{n}" '
+            f'NumberOfComponents="{c}"/>\n' for n, c, _, i in lst)
+
+    s += "    <PPointData>\n" + arrays(layout["point_data"])
+    s += "    </PPointData>\n    <PCellData>\n" + arrays(layout["cell_data"])
+    s += ('    </PCellData>\n    <PPoints>\n      <PDataArray type="Float64" '
+          'NumberOfComponents="3"/>\n    </PPoints>\n')
+    s += "".join(f'    <Piece Source="{f}"/>\n' for f in pieces)
+    s += "  </PUnstructuredGrid>\n</VTKFile>\n"
+    with open(path, "w") as f:
+        f.write(s)
+
+
+def write_pvd(path, entries):
+    """Mirror of write_pvd in vtu.cpp: entries are (time, relative file)."""
+    s = '<?xml version="1.0"?>\n<VTKFile type="Collection" version="1.0">\n  <Collection>\n'
+    s += "".join(f'    <DataSet timestep="{t:.17g}" part="0" file="{f}"/>\n' for t, f in entries)
+    s += "  </Collection>\n</VTKFile>\n"
+    with open(path, "w") as f:
+        f.write(s)
+
+
+# --------------------------------------------------------------------------- synthetic run
+
+
+def box_mesh():
+    """Global box mesh: (points (n,3), hex connectivity (m,8) in VTK order, cell centres)."""
+    h = 1e-3
+    idx = lambda i, j, k: i + (NX + 1) * (j + (NY + 1) * k)  # noqa: E731
+    pts = np.array([(i * h, j * h, k * h) for k in range(NZ + 1) for j in range(NY + 1)
+                    for i in range(NX + 1)])
+    conn = []
+    for k in range(NZ):
+        for j in range(NY):
+            for i in range(NX):
+                conn.append([idx(i, j, k), idx(i + 1, j, k), idx(i + 1, j + 1, k),
+                             idx(i, j + 1, k), idx(i, j, k + 1), idx(i + 1, j, k + 1),
+                             idx(i + 1, j + 1, k + 1), idx(i, j + 1, k + 1)])
+    conn = np.array(conn)
+    return pts, conn, pts[conn].mean(axis=1)
+
+
+def rank_piece(pts, conn, cells, rank, t):
+    """The .vtu piece of `rank` owning global `cells`, at time t (displacement grows with t)."""
+    nodes = np.unique(conn[cells])
+    local = {g: l for l, g in enumerate(nodes)}
+    disp = np.zeros((len(nodes), 3))
+    disp[:, 2] = -0.1 * pts[nodes, 2] * (t / 1e-5)  # squash along z
+    disp[:, 0] = 0.05 * pts[nodes, 0] * (t / 1e-5)
+    x = pts[nodes] + disp
+    lconn = [local[g] for c in cells for g in conn[c]]
+    stress = np.zeros((len(cells), 6))
+    stress[:, 2] = -1e8 * (1 + np.arange(len(cells)))
+    return {
+        "points": x.ravel().tolist(),
+        "connectivity": lconn,
+        "offsets": [8 * (e + 1) for e in range(len(cells))],
+        "types": [12] * len(cells),
+        "point_data": [("displacement", 3, disp.ravel().tolist(), False),
+                       ("velocity", 3, (disp / 1e-5).ravel().tolist(), False),
+                       ("node_id", 1, (nodes + 1).tolist(), True)],
+        "cell_data": [("stress", 6, stress.ravel().tolist(), False),
+                      ("von_mises", 1, (-stress[:, 2]).tolist(), False),
+                      ("pressure", 1, (-stress[:, 2] / 3).tolist(), False),
+                      ("plastic_strain", 1, (0.01 * cells * t / 1e-5).tolist(), False),
+                      ("fe_rank", 1, [rank] * len(cells), True),
+                      ("element_id", 1, (cells + 1).tolist(), True),
+                      ("part", 1, [0] * len(cells), True)],
+    }
+
+
+def write_run(outdir):
+    """Write a complete synthetic anvil output directory; return the expected facts."""
+    os.makedirs(os.path.join(outdir, "fields"))
+    pts, conn, centres = box_mesh()
+    owner = (centres[:, 2] > NZ * 1e-3 / 2).astype(int)  # split along z into 2 ranks
+    times = [1e-5, 0.0]  # deliberately unsorted: the reader must sort the .pvd by time
+    entries = []
+    for step, t in enumerate(sorted(times)):
+        stem = f"step_{step:06d}"
+        names = []
+        for r in range(RANKS):
+            piece = rank_piece(pts, conn, np.flatnonzero(owner == r), r, t)
+            names.append(f"{stem}_r{r:04d}.vtu")
+            write_vtu(os.path.join(outdir, "fields", names[-1]), piece)
+        write_pvtu(os.path.join(outdir, "fields", f"{stem}.pvtu"), names, piece)
+        entries.append((t, f"fields/{stem}.pvtu"))
+    write_pvd(os.path.join(outdir, "results.pvd"), [entries[1], entries[0]])
+    write_history(outdir)
+    with open(os.path.join(outdir, "summary.json"), "w") as f:
+        json.dump({"title": "selftest box", "ranks": RANKS, "elements": len(conn),
+                   "cycles": 100, "status": "completed",
+                   "energy": {"balance_error": 1e-4}}, f)
+    return {"n_cells": len(conn), "n_nodes": len(pts), "owner": owner,
+            "exterior": 2 * (NX * NY + NY * NZ + NX * NZ)}
+
+
+def write_history(outdir):
+    """history.csv with the energy columns and one probe, formatted like outputs.cpp."""
+    cols = "time,cycle,dt,kinetic,internal,hourglass,contact,external_work,total"
+    cols += "".join(f",tip.{f}" for f in ("ux", "uy", "uz", "vx", "vy", "vz"))
+    lines = [cols]
+    for n in range(101):
+        t = n * 1e-7
+        k = 10.0 * (1 - n / 100) ** 2
+        i = 10.0 - k - 0.01 * n / 100
+        hg = 0.01 * n / 100
+        row = [t, n, 1e-7, k, i, hg, 0.0, 0.0, k + i + hg,
+               0, 0, -50.0 * t, 0, 0, -50.0 + 0.1 * n]
+        lines.append(",".join(f"{v:.17g}" for v in row))
+    with open(os.path.join(outdir, "history.csv"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+# --------------------------------------------------------------------------- checks
+
+
+class Checks:
+    """Collects named check results and prints them."""
+
+    def __init__(self):
+        self.failed = []
+
+    def run(self, name, fn, *args):
+        """Run fn(*args); a raised exception (AssertionError or other) is a failure."""
+        try:
+            fn(*args)
+            print(f"ok    {name}")
+        except Exception:  # noqa: BLE001 - report every failure, keep going
+            print(f"FAIL  {name}")
+            traceback.print_exc(limit=3)
+            self.failed.append(name)
+
+
+def check_reader(outdir, facts):
+    """The reader returns the synthetic mesh: sizes, pieces merged, fields, time order."""
+    entries = anvil_vtu.read_pvd(os.path.join(outdir, "results.pvd"))
+    assert [e.time for e in entries] == [0.0, 1e-5], entries
+    entry, g = anvil_vtu.load_output(outdir, step=0)
+    assert entry.time == 0.0
+    assert g.n_cells == facts["n_cells"], g.n_cells
+    assert g.connectivity.shape == (facts["n_cells"], 8)
+    assert set(g.cell_types.tolist()) == {12}
+    assert len(np.unique(g.point_data["node_id"])) == facts["n_nodes"]
+    assert g.n_points > facts["n_nodes"]  # shared nodes appear once per piece
+    assert g.cell_data["stress"].shape == (facts["n_cells"], 6)
+    assert g.point_data["displacement"].shape == (g.n_points, 3)
+    assert g.cell_data["fe_rank"].dtype == np.int64
+    # cells are in piece order: rank 0's then rank 1's
+    assert np.array_equal(g.cell_data["fe_rank"], g.piece_of_cell)
+    assert np.array_equal(np.sort(g.cell_data["element_id"]), np.arange(1, facts["n_cells"] + 1))
+    # points of a cell coincide with the global mesh's (undeformed at t=0)
+    pts, conn, _ = box_mesh()
+    eid = g.cell_data["element_id"] - 1
+    assert np.allclose(g.points[g.connectivity], pts[conn[eid]])
+    last = anvil_vtu.select_entry(entries)
+    near = anvil_vtu.select_entry(entries, time=0.8e-5)
+    assert last.time == near.time == 1e-5
+    _, g1 = anvil_vtu.load_output(outdir, time=1e-5)
+    und = g1.points - g1.point_data["displacement"]
+    assert np.allclose(und[g1.connectivity], pts[conn[g1.cell_data["element_id"] - 1]])
+
+
+def check_single_vtu(outdir, facts):
+    """A single piece reads on its own, and through load_output given its path."""
+    path = os.path.join(outdir, "fields", "step_000000_r0000.vtu")
+    g = anvil_vtu.read_vtu(path)
+    assert g.n_cells == int((facts["owner"] == 0).sum())
+    _, g2 = anvil_vtu.load_output(path)
+    assert g2.n_cells == g.n_cells
+
+
+def check_exterior(outdir, facts):
+    """Exterior faces of the two-piece box: 2(nx ny + ny nz + nx nz), none at the rank
+    boundary, and every normal outward."""
+    _, g = anvil_vtu.load_output(outdir, step=0)
+    conn, _ = g.hex_connectivity()
+    faces, owner = exterior_faces(conn, g.point_data["node_id"])
+    assert len(faces) == facts["exterior"], len(faces)
+    q = g.points[faces]
+    n = np.cross(q[:, 2] - q[:, 0], q[:, 3] - q[:, 1])
+    outward = q.mean(axis=1) - g.points[conn[owner]].mean(axis=1)
+    assert np.all((n * outward).sum(axis=1) > 0)
+
+
+def expect_error(fn, *words):
+    """fn() must raise VtuError whose message contains every word."""
+    try:
+        fn()
+    except anvil_vtu.VtuError as e:
+        for w in words:
+            assert w in str(e), f"{w!r} not in {e}"
+        return
+    raise AssertionError("no VtuError raised")
+
+
+def check_malformed(outdir, tmp):
+    """Truncated, non-XML, missing-piece and wrong-type inputs give VtuError naming files."""
+    good = os.path.join(outdir, "fields", "step_000001_r0001.vtu")
+    data = open(good, "rb").read()
+    bad = os.path.join(tmp, "truncated.vtu")
+    with open(bad, "wb") as f:
+        f.write(data[: len(data) - 200])
+    expect_error(lambda: anvil_vtu.read_vtu(bad), "truncated.vtu")
+    junk = os.path.join(tmp, "junk.vtu")
+    with open(junk, "wb") as f:
+        f.write(b"not xml at all")
+    expect_error(lambda: anvil_vtu.read_vtu(junk), "junk.vtu")
+    expect_error(lambda: anvil_vtu.read_vtu(os.path.join(tmp, "absent.vtu")), "absent.vtu")
+    pvtu = os.path.join(tmp, "lonely.pvtu")
+    text = open(os.path.join(outdir, "fields", "step_000000.pvtu")).read()
+    with open(pvtu, "w") as f:
+        f.write(text)  # its pieces are not next to it
+    expect_error(lambda: anvil_vtu.read_pvtu(pvtu), "lonely.pvtu", "step_000000_r0000.vtu")
+    expect_error(lambda: anvil_vtu.read_pvtu(good), "step_000001_r0001.vtu", "PUnstructuredGrid")
+    expect_error(lambda: anvil_vtu.select_entry(
+        anvil_vtu.read_pvd(os.path.join(outdir, "results.pvd")), step=5), "out of range")
+
+
+def run_tool(args, expect):
+    """Run a tool with /usr/bin/python3 (this interpreter); assert its exit status."""
+    cmd = [sys.executable, os.path.join(HERE, args[0])] + args[1:]
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert r.returncode == expect, (
+        f"{' '.join(cmd)}: exit {r.returncode}, expected {expect}\n{r.stdout}{r.stderr}")
+    if expect == 2:
+        assert "error" in r.stderr, r.stderr
+    return r
+
+
+def check_png(path):
+    """`path` exists and is a non-trivial PNG."""
+    with open(path, "rb") as f:
+        head = f.read(8)
+    assert head == PNG_MAGIC, f"{path} is not a PNG"
+    assert os.path.getsize(path) > 5000, f"{path} is suspiciously small"
+
+
+def check_tools(outdir, tmp):
+    """Every plot script writes a PNG, and fails with status 2 on bad input."""
+    plots = [
+        (["plot_history.py", outdir, "-o", f"{tmp}/energy.png"], "energy.png"),
+        (["plot_decomposition.py", outdir, "-o", f"{tmp}/ranks.png"], "ranks.png"),
+        (["plot_decomposition.py", outdir, "--step", "0", "--undeformed", "-o",
+          f"{tmp}/ranks0.png"], "ranks0.png"),
+        (["plot_decomposition.py", outdir, "--field", "plastic_strain", "--cut", "y=1e-3",
+          "--elev", "-20", "-o", f"{tmp}/eps.png"], "eps.png"),
+        (["plot_decomposition.py", outdir, "--field", "displacement.z", "--time", "1e-5",
+          "-o", f"{tmp}/uz.png"], "uz.png"),
+        (["plot_probe.py", outdir, "tip.uz", "tip.v*", "-o", f"{tmp}/probe.png"], "probe.png"),
+    ]
+    for args, png in plots:
+        run_tool(args, 0)
+        check_png(os.path.join(tmp, png))
+    missing = os.path.join(tmp, "no_such_dir")
+    for bad in (["plot_history.py", missing],
+                ["plot_decomposition.py", missing],
+                ["plot_decomposition.py", outdir, "--field", "nope"],
+                ["plot_decomposition.py", outdir, "--field", "stress"],
+                ["plot_decomposition.py", outdir, "--step", "7"],
+                ["plot_decomposition.py", outdir, "--cut", "w=0"],
+                ["plot_probe.py", outdir, "nope.ux"],
+                ["plot_probe.py", missing, "tip.ux"]):
+        run_tool(bad, 2)
+
+
+def main():
+    """Build the synthetic run, run all checks, return the exit status."""
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--keep", action="store_true", help="keep the temporary directory")
+    args = p.parse_args()
+    tmp = tempfile.mkdtemp(prefix="anvil_tools_selftest_")
+    try:
+        outdir = os.path.join(tmp, "run")
+        facts = write_run(outdir)
+        c = Checks()
+        c.run("reader: pvd, pvtu merge, arrays", check_reader, outdir, facts)
+        c.run("reader: single .vtu piece", check_single_vtu, outdir, facts)
+        c.run("exterior faces across pieces", check_exterior, outdir, facts)
+        c.run("reader: malformed input errors", check_malformed, outdir, tmp)
+        c.run("plot tools: PNGs and exit status 2", check_tools, outdir, tmp)
+    finally:
+        if args.keep:
+            print(f"kept {tmp}")
+        else:
+            shutil.rmtree(tmp, ignore_errors=True)
+    if c.failed:
+        print(f"{len(c.failed)} check(s) failed: {', '.join(c.failed)}")
+        return 1
+    print("all checks passed")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
