@@ -30,7 +30,7 @@ cmake --build build -j "$(nproc)"
 case "$mode" in
   example)
     mpirun -np 2 build/apps/anvil run examples/taylor_bar.yaml -o out/taylor_bar
-    /usr/bin/python3 tools/plot_history.py out/taylor_bar -o out/taylor_bar/energy.png || true
+    /usr/bin/python3 tools/plot_history.py out/taylor_bar -o out/taylor_bar/energy.png
     echo "results: out/taylor_bar (open results.pvd in ParaView; summary.json; history.csv)"
     ;;
   test)

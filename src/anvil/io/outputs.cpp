@@ -113,9 +113,12 @@ void Outputs::begin() {
     std::fprintf(history_, "%s\n", h.c_str());
     std::fflush(history_);
   }
+  // The first row is the state the deck gave, at t = 0 (collective).
+  const Sample initial = sim_.sample();
+  write_history_row(initial);
   write_fields();
   next_fields_ = c.fields_every > 0 ? c.fields_every : std::numeric_limits<double>::infinity();
-  next_history_ = 0;
+  next_history_ = c.history_every;
 }
 
 void Outputs::write_history_row(const Sample& s) {
@@ -134,7 +137,8 @@ void Outputs::after_step() {
   const Clock& clk = sim_.clock();
   const double t_sample = clk.time - clk.dt; // the step's forces were at t(n)
   const bool last = sim_.finished();
-  if (t_sample >= next_history_ * (1 - 1e-12) || last) {
+  // The first step's forces are at t = 0, already written by begin().
+  if (clk.cycle > 1 && (t_sample >= next_history_ * (1 - 1e-12) || last)) {
     last_sample_ = sim_.sample();
     have_sample_ = true;
     write_history_row(last_sample_);
@@ -153,7 +157,8 @@ void Outputs::write_fields() {
   if (last_field_cycle_ == clk.cycle) return;
   last_field_cycle_ = clk.cycle;
   const std::string stem = fmt::format("step_{:06d}", field_count_++);
-  const VtuPiece piece = fe_piece(sim_);
+  VtuPiece piece = fe_piece(sim_);
+  piece.time = clk.time;
   write_vtu(fmt::format("{}/fields/{}_r{:04d}.vtu", opt_.directory, stem, sim_.comm().rank()),
             piece);
   sim_.comm().barrier(); // every piece is complete before the index names it
@@ -250,10 +255,18 @@ void Outputs::write_summary(int status, const std::string& message) {
   imb["sph"] = 1.0;
   imb["contact"] = 1.0;
   j["imbalance"] = imb;
-  j["energy"] = {{"time", s.time},         {"kinetic", s.kinetic},
-                 {"internal", s.internal}, {"hourglass", s.hourglass},
-                 {"contact", s.contact},   {"external_work", s.external_work},
-                 {"total", s.total()},     {"balance_error", sim_.balance_error(s)}};
+  j["energy"] = {{"time", s.time},
+                 {"initial", sim_.initial_energy()},
+                 {"kinetic", s.kinetic},
+                 {"internal", s.internal},
+                 {"hourglass", s.hourglass},
+                 {"contact", s.contact},
+                 {"external_work", s.external_work},
+                 {"total", s.total()},
+                 {"balance_error", sim_.balance_error(s)}};
+  json parts = json::array();
+  for (const auto& p : sim_.config().parts) parts.push_back(p.name);
+  j["parts"] = parts; // part index in the `part` cell field -> name
   json masses = json::object();
   for (std::size_t i = 0; i < sim_.config().parts.size(); ++i)
     masses[sim_.config().parts[i].name] = sim_.part_masses()[i];

@@ -37,6 +37,10 @@ void write_vtu(const std::string& path, const VtuPiece& p) {
   const std::size_t np = p.points.size() / 3, nc = p.types.size();
   a.header += "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
               "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <UnstructuredGrid>\n";
+  a.header +=
+      fmt::format("    <FieldData>\n      <DataArray type=\"Float64\" Name=\"TimeValue\" "
+                  "NumberOfTuples=\"1\" format=\"ascii\">{:.17g}</DataArray>\n    </FieldData>\n",
+                  p.time);
   a.header += fmt::format("    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", np, nc);
   a.header += "      <PointData>\n";
   for (const auto& arr : p.point_data) array_tag(a, arr);

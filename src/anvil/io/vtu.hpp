@@ -27,6 +27,7 @@ struct VtuPiece {
   std::vector<std::int64_t> offsets;      // end of each cell in connectivity
   std::vector<std::uint8_t> types;        // VTK cell type per cell (12 hexahedron, 1 vertex)
   std::vector<VtuArray> point_data, cell_data;
+  double time = 0; // written as the TimeValue field (ParaView reads it)
 };
 
 void write_vtu(const std::string& path, const VtuPiece& piece);

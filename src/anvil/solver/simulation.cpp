@@ -79,21 +79,33 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
   comm_.sum(std::span<double>(part_mass_));
 
   apply_initial_conditions(mesh);
+  // Constraints stop the constrained velocity components at once (a node on a fixed
+  // impact face hits the wall at t = 0): the kinetic energy they remove is work done by
+  // the constraint, so that the energy balance starts from the energy the deck gave.
+  const double ke_given = comm_.sum(owned_kinetic_energy());
   apply_boundary_conditions(mesh);
   locate_probes(mesh);
 
-  // Initial sample: kinetic energy of the initial velocities.
-  kinetic_local_ = 0;
-  for (std::size_t n = 0; n < nn; ++n)
-    if (fe_.node_owned[n])
-      kinetic_local_ += 0.5 * nodes_.mass[n] *
-                        (nodes_.v[0][n] * nodes_.v[0][n] + nodes_.v[1][n] * nodes_.v[1][n] +
-                         nodes_.v[2][n] * nodes_.v[2][n]);
+  // The initial sample (t = 0): kinetic energy of the initial velocities, probes at rest
+  // position with their initial velocity.
+  kinetic_local_ = owned_kinetic_energy();
   probe_local_.assign(6 * config_.probes.size(), 0.0);
   for (std::size_t p = 0; p < probe_node_.size(); ++p)
     if (probe_node_[p] >= 0)
       for (int i = 0; i < 3; ++i) probe_local_[6 * p + 3 + i] = nodes_.v[i][probe_node_[p]];
-  initial_energy_ = comm_.sum(kinetic_local_);
+  initial_energy_ = ke_given;
+  const double ke_kept = comm_.sum(kinetic_local_);
+  if (comm_.rank() == 0) external_work_ = ke_kept - ke_given; // counted once, on rank 0
+}
+
+double Simulation::owned_kinetic_energy() const {
+  double ke = 0;
+  for (std::size_t n = 0; n < nodes_.size(); ++n)
+    if (fe_.node_owned[n])
+      ke += 0.5 * nodes_.mass[n] *
+            (nodes_.v[0][n] * nodes_.v[0][n] + nodes_.v[1][n] * nodes_.v[1][n] +
+             nodes_.v[2][n] * nodes_.v[2][n]);
+  return ke;
 }
 
 void Simulation::apply_initial_conditions(const Mesh& mesh) {

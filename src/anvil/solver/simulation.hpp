@@ -64,8 +64,10 @@ public:
   // Global energies and probes at the time of the last step's forces (collective).
   // Also valid before the first step (initial state).
   Sample sample() const;
-  // Energy balance error |E - E(0) - W| / max(E, |W|) for a sample.
+  // Energy balance error |E - E(0) - W| / max(E, |W|, E(0)) for a sample.
   double balance_error(const Sample& s) const;
+  // E(0): the kinetic energy the initial conditions gave (before constraints).
+  double initial_energy() const { return initial_energy_; }
   // Smallest element stable time step at the current state (collective; runs the
   // element kernel without advancing anything).
   double stable_time_step();
@@ -90,6 +92,7 @@ private:
   void apply_initial_conditions(const Mesh& mesh);
   void apply_boundary_conditions(const Mesh& mesh);
   void locate_probes(const Mesh& mesh);
+  double owned_kinetic_energy() const;
 
   Config config_;
   const Comm& comm_;
