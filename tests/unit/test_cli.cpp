@@ -1,0 +1,149 @@
+// The command line contract (DESIGN.md section 4): --help, --version, exit status 2 with
+// file, line and key for bad input, exit status 3 naming the element and time for a run
+// that fails physically, with the outputs written so far still readable.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "test_support.hpp"
+
+namespace {
+
+struct Result {
+  int status = -1;
+  std::string out; // stdout and stderr together
+};
+
+Result run(const std::string& args) {
+  const std::string cmd = std::string(anvil::test::anvil_binary()) + " " + args + " 2>&1";
+  Result r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  while (std::size_t n = fread(buf, 1, sizeof buf, p)) r.out.append(buf, n);
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+std::string write_temp(const std::string& name, const std::string& text) {
+  const auto dir = std::filesystem::temp_directory_path() / "anvil_cli_test";
+  std::filesystem::create_directories(dir);
+  const auto path = dir / name;
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+TEST(Cli, HelpAndVersion) {
+  auto r = run("--help");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find("run"), std::string::npos);
+  EXPECT_NE(r.out.find("check"), std::string::npos);
+  r = run("--version");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find("anvil 0."), std::string::npos);
+}
+
+TEST(Cli, BadArgumentsExitTwo) {
+  EXPECT_EQ(run("").status, 2);
+  EXPECT_EQ(run("frobnicate").status, 2);
+  EXPECT_EQ(run("run").status, 2);
+  const auto r = run("run /no/such/deck.yaml");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("/no/such/deck.yaml"), std::string::npos);
+}
+
+TEST(Cli, BadDeckNamesFileLineKey) {
+  const auto deck = write_temp("bad.yaml", "termination: {time: 1.0e-5}\nmaterials:\n  m: {model: elastic, density: -1, youngs_modulus: 1.0e9, poissons_ratio: 0.3}\n");
+  const auto r = run("check " + deck);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("bad.yaml:3"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("materials.m.density"), std::string::npos) << r.out;
+}
+
+const char* small_deck = R"(
+termination: {time: 2.0e-6}
+materials:
+  steel: {model: j2_plasticity, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3,
+          yield_stress: 250.0e6, hardening_modulus: 1.0e9}
+parts:
+  block:
+    mesh: {generate: box, min: [0, 0, 0], max: [0.01, 0.01, 0.02], divisions: [3, 3, 6]}
+    material: steel
+initial_conditions:
+  - {part: block, velocity: [0, 0, -50.0]}
+boundary_conditions:
+  - {set: block.zmin, fix: [z]}
+probes:
+  - {name: top, at: [0, 0, 0.02]}
+output: {fields_every: 1.0e-6}
+)";
+
+TEST(Cli, CheckPrintsCountsMassAndTimeStep) {
+  const auto r = run("check " + write_temp("small.yaml", small_deck));
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("elements    54"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("nodes       112"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("mass 0.0157"), std::string::npos) << r.out; // 7850 * 2e-6 m^3
+  EXPECT_NE(r.out.find("stable dt"), std::string::npos) << r.out;
+}
+
+TEST(Cli, RunWritesTheOutputs) {
+  const auto dir = (std::filesystem::temp_directory_path() / "anvil_cli_run").string();
+  std::filesystem::remove_all(dir);
+  const auto r = run("run " + write_temp("small.yaml", small_deck) + " -o " + dir + " -q");
+  ASSERT_EQ(r.status, 0) << r.out;
+  for (const char* f : {"summary.json", "history.csv", "results.pvd"})
+    EXPECT_TRUE(std::filesystem::exists(dir + "/" + f)) << f;
+  std::ifstream h(dir + "/history.csv");
+  std::string header;
+  std::getline(h, header);
+  EXPECT_EQ(header, "time,cycle,dt,kinetic,internal,hourglass,contact,external_work,total,"
+                    "top.ux,top.uy,top.uz,top.vx,top.vy,top.vz");
+  std::stringstream pvd;
+  pvd << std::ifstream(dir + "/results.pvd").rdbuf();
+  EXPECT_NE(pvd.str().find("step_000002.pvtu"), std::string::npos) << pvd.str();
+  std::stringstream summary;
+  summary << std::ifstream(dir + "/summary.json").rdbuf();
+  for (const char* key : {"\"grind_us\"", "\"timers\"", "\"imbalance\"", "\"balance_error\"", "\"status\": \"completed\""})
+    EXPECT_NE(summary.str().find(key), std::string::npos) << key;
+}
+
+// A soft block driven into a fixed face far beyond what the mesh can take inverts an
+// element: exit status 3, the element and time named, summary and fields readable.
+TEST(Cli, InvertedElementStopsWithStatusThree) {
+  const char* crush = R"(
+termination: {time: 1.0e-3}
+materials:
+  putty: {model: j2_plasticity, density: 1000, youngs_modulus: 1.0e8, poissons_ratio: 0.3,
+          yield_stress: 1.0e5}
+parts:
+  block:
+    mesh: {generate: box, min: [0, 0, 0], max: [0.01, 0.01, 0.01], divisions: [4, 4, 4]}
+    material: putty
+    hourglass: {model: viscous, coefficient: 0.0}
+    bulk_viscosity: {linear: 0, quadratic: 0}
+boundary_conditions:
+  - {set: block.zmin, fix: all}
+  - {set: block.zmax, velocity: [40.0, 0, -400.0]}
+output: {fields_every: 1.0e-5}
+)";
+  const auto dir = (std::filesystem::temp_directory_path() / "anvil_cli_crush").string();
+  std::filesystem::remove_all(dir);
+  const auto r = run("run " + write_temp("crush.yaml", crush) + " -o " + dir + " -q");
+  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_NE(r.out.find("element"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("part block"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("at time"), std::string::npos) << r.out;
+  std::stringstream summary;
+  summary << std::ifstream(dir + "/summary.json").rdbuf();
+  EXPECT_NE(summary.str().find("\"status\": \"failed\""), std::string::npos) << summary.str();
+  EXPECT_TRUE(std::filesystem::exists(dir + "/results.pvd"));
+}
+
+} // namespace
