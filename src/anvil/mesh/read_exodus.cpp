@@ -4,6 +4,9 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <limits>
 #include <new>
 #include <stdexcept>
 #include <vector>
@@ -37,6 +40,7 @@ public:
   ExodusFile& operator=(const ExodusFile&) = delete;
 
   int id() const { return id_; }
+  const std::string& path() const { return path_; }
 
   [[noreturn]] void fail(const std::string& message) const {
     throw InputError(SourceLocation{path_, 0, ""}, message);
@@ -61,6 +65,116 @@ private:
   std::string path_;
   int id_ = -1;
 };
+
+// Walks the header of a netCDF classic file (CDF-1, CDF-2 or CDF-5: the formats Exodus
+// writes by default) and returns what is inconsistent with the file's size, or an empty
+// string. The netCDF library trusts the header's counts and allocates by them: a corrupt
+// byte can make it ask for tens of gigabytes before it notices anything wrong. Checking
+// that every count, name, attribute and variable fits in the file first bounds what
+// the library can allocate by the file size. Not a classic file (netCDF-4/HDF5, or not
+// netCDF at all): empty, and the library decides.
+std::string classic_netcdf_problem(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return ""; // ex_open reports it
+  in.seekg(0, std::ios::end);
+  const auto end = in.tellg();
+  if (end < 0) return "";
+  const auto size = static_cast<std::uint64_t>(end);
+  in.seekg(0);
+  char magic[4] = {};
+  if (!in.read(magic, 4) || magic[0] != 'C' || magic[1] != 'D' || magic[2] != 'F') return "";
+  const int version = magic[3];
+  if (version != 1 && version != 2 && version != 5) return "";
+  const int count_bytes = version == 5 ? 8 : 4;  // NON_NEG
+  const int offset_bytes = version == 1 ? 4 : 8; // OFFSET
+  std::uint64_t pos = 4;
+
+  // Big-endian unsigned integer of `n` bytes; false at the end of the file.
+  auto uint = [&](int n, std::uint64_t& v) {
+    unsigned char b[8];
+    if (pos + n > size || !in.read(reinterpret_cast<char*>(b), n)) return false;
+    pos += n;
+    v = 0;
+    for (int i = 0; i < n; ++i) v = (v << 8) | b[i];
+    return true;
+  };
+  auto skip = [&](std::uint64_t n) {
+    if (n > size - pos) return false;
+    pos += n;
+    in.seekg(static_cast<std::streamoff>(pos));
+    return true;
+  };
+  auto padded = [](std::uint64_t n) { return (n + 3) / 4 * 4; };
+  auto name = [&]() {
+    std::uint64_t len = 0;
+    return uint(count_bytes, len) && len <= size && skip(padded(len));
+  };
+  auto type_size = [](std::uint64_t t) -> std::uint64_t {
+    static constexpr std::uint64_t sizes[12] = {0, 1, 1, 2, 4, 4, 8, 1, 2, 4, 8, 8};
+    return t >= 1 && t <= 11 ? sizes[t] : 0;
+  };
+  // A list header: tag and number of elements; ABSENT is tag 0 with 0 elements.
+  auto list = [&](std::uint64_t tag, std::uint64_t& n) {
+    std::uint64_t t = 0;
+    if (!uint(4, t) || !uint(count_bytes, n)) return false;
+    return (t == tag || (t == 0 && n == 0)) && n <= size;
+  };
+  auto attributes = [&]() {
+    std::uint64_t n = 0;
+    if (!list(0x0C, n)) return false;
+    for (std::uint64_t i = 0; i < n; ++i) {
+      std::uint64_t type = 0, count = 0;
+      if (!name() || !uint(4, type) || !uint(count_bytes, count)) return false;
+      const auto ts = type_size(type);
+      if (ts == 0 || count > size / ts || !skip(padded(count * ts))) return false;
+    }
+    return true;
+  };
+
+  std::uint64_t numrecs = 0, ndims = 0, nvars = 0;
+  if (!uint(count_bytes, numrecs)) return "the netCDF header is truncated";
+  const bool streaming = numrecs == (count_bytes == 4 ? 0xFFFFFFFFull : ~0ull);
+  if (!streaming && numrecs > size) return "the netCDF header declares more records than fit";
+  if (!list(0x0A, ndims)) return "the netCDF dimension list is corrupt";
+  std::vector<std::uint64_t> dims;
+  for (std::uint64_t i = 0; i < ndims; ++i) {
+    std::uint64_t len = 0;
+    if (!name() || !uint(count_bytes, len)) return "the netCDF dimension list is corrupt";
+    dims.push_back(len);
+  }
+  if (!attributes()) return "the netCDF global attributes are corrupt";
+  if (!list(0x0B, nvars)) return "the netCDF variable list is corrupt";
+  for (std::uint64_t v = 0; v < nvars; ++v) {
+    std::uint64_t nd = 0;
+    if (!name() || !uint(count_bytes, nd) || nd > size)
+      return "the netCDF variable list is corrupt";
+    std::uint64_t extent = 1; // bytes of one record (record variable) or of all the data
+    bool record = false;
+    for (std::uint64_t d = 0; d < nd; ++d) {
+      std::uint64_t id = 0;
+      if (!uint(count_bytes, id) || id >= dims.size())
+        return "a netCDF variable refers to an undefined dimension";
+      if (dims[id] == 0 && d == 0) {
+        record = true;
+        continue;
+      }
+      if (dims[id] != 0 && extent > size / dims[id])
+        return "a netCDF variable is larger than the file";
+      extent *= dims[id];
+    }
+    std::uint64_t type = 0, vsize = 0, begin = 0;
+    if (!attributes() || !uint(4, type) || !uint(count_bytes, vsize) ||
+        !uint(offset_bytes, begin) || type_size(type) == 0)
+      return "the netCDF variable list is corrupt";
+    if (extent > size / type_size(type)) return "a netCDF variable is larger than the file";
+    extent *= type_size(type);
+    const std::uint64_t records = record ? (streaming ? 0 : numrecs) : 1;
+    if (records > 0 && extent > size / records) return "a netCDF variable is larger than the file";
+    if (begin > size || extent * records > size - begin)
+      return "a netCDF variable lies beyond the end of the file (truncated file?)";
+  }
+  return "";
+}
 
 // Names of the `count` entities of `type` in file order; an empty string where the file
 // gives none.
@@ -108,6 +222,22 @@ Mesh read_all(const ExodusFile& f) {
       init.num_side_sets < 0)
     f.fail("the file header has negative counts");
 
+  // Every entity takes more than a byte in the file, even compressed: a count beyond the
+  // file's size is a corrupt header, caught before it becomes an allocation.
+  std::error_code ec;
+  const auto bytes = std::filesystem::file_size(f.path(), ec);
+  const auto limit =
+      ec ? std::numeric_limits<std::int64_t>::max() : static_cast<std::int64_t>(bytes);
+  auto fits = [&](std::int64_t n, const std::string& what) {
+    if (n > limit)
+      f.fail(fmt::format("the file declares {} {}, more than a file of {} bytes can hold", n, what,
+                         limit));
+  };
+  fits(init.num_nodes, "nodes");
+  fits(init.num_elem_blk, "element blocks");
+  fits(init.num_node_sets, "node sets");
+  fits(init.num_side_sets, "side sets");
+
   Mesh mesh;
   const std::int64_t nn = init.num_nodes;
   if (nn > 0) {
@@ -145,6 +275,8 @@ Mesh read_all(const ExodusFile& f) {
       f.fail(fmt::format("{} has elements of type {} with {} nodes; anvil reads hexahedra "
                          "only (HEX/HEX8, or HEX20/HEX27 by their corners)",
                          label, type_name.empty() ? "(none)" : type_name, npe));
+    fits(count, "elements in " + label);
+    fits(count * npe, "connectivity entries in " + label);
     ElementBlock eb{name, {}};
     if (count > 0) {
       std::vector<std::int64_t> conn(static_cast<std::size_t>(count * npe));
@@ -178,6 +310,7 @@ Mesh read_all(const ExodusFile& f) {
     f.check(ex_get_set_param(f.id(), EX_NODE_SET, ns_ids[s], &count, &factors),
             "the size of " + label);
     if (count < 0) f.fail(label + " has a negative size");
+    fits(count, "entries in " + label);
     std::vector<std::int64_t> ids(static_cast<std::size_t>(count));
     if (count > 0) f.check(ex_get_set(f.id(), EX_NODE_SET, ns_ids[s], ids.data(), nullptr), label);
     for (auto& n : ids) {
@@ -201,6 +334,7 @@ Mesh read_all(const ExodusFile& f) {
     f.check(ex_get_set_param(f.id(), EX_SIDE_SET, ss_ids[s], &count, &factors),
             "the size of " + label);
     if (count < 0) f.fail(label + " has a negative size");
+    fits(count, "entries in " + label);
     std::vector<std::int64_t> elems(static_cast<std::size_t>(count)), sides(elems.size());
     if (count > 0)
       f.check(ex_get_set(f.id(), EX_SIDE_SET, ss_ids[s], elems.data(), sides.data()), label);
@@ -225,6 +359,8 @@ Mesh read_all(const ExodusFile& f) {
 
 Mesh read_exodus(const std::string& path) {
   try {
+    if (const auto problem = classic_netcdf_problem(path); !problem.empty())
+      throw InputError(SourceLocation{path, 0, ""}, "not a readable Exodus II file: " + problem);
     const ExodusFile f(path);
     // Names longer than the library's default of 32 characters would come back cut.
     // The setting is the library's (per process); raising it is harmless for any other
