@@ -260,7 +260,10 @@ private:
 
   [[noreturn]] void fail(const std::string& message) const { fail_at(line_no_, message); }
   [[noreturn]] void fail_at(int line, const std::string& message) const {
-    throw InputError(SourceLocation{name_, line, section_}, message);
+    // A last line without its end of line is the usual sign of a cut-off file.
+    const bool cut = line == line_no_ && line > 1 && pos_ > text_.size() && !line_.empty();
+    throw InputError(SourceLocation{name_, line, section_},
+                     cut ? message + " (the file ends within this line: truncated?)" : message);
   }
 
   // Text from the file for a message: short, and printable whatever the file holds.
@@ -502,6 +505,17 @@ private:
       const std::int64_t type = integer(tokens_[2], "the element type");
       const auto info = element_type(type);
       if (!info) fail(fmt::format("unknown element type {}", type));
+      if (info->dim != dim)
+        fail(fmt::format("a block of {} elements (type {}) in {} {}: the element type's "
+                         "dimension must be the entity's",
+                         info->name, type, dim_word(dim), etag));
+      if (dim == 3 && !is_hex(type))
+        fail(fmt::format("a block of {} elements (type {}) in volume {}{}; anvil reads hexahedra "
+                         "only (type 5, or types 17 and 12 by their corners)",
+                         info->name, type, etag,
+                         phys.empty()
+                             ? std::string()
+                             : fmt::format(" (physical volume '{}')", group_name(3, phys[0]))));
       const std::int64_t n = count(tokens_[3], "the number of elements in the block");
       seen += n;
       if (seen > total)
