@@ -173,6 +173,9 @@ TEST(ReadExodus, Hex20ByItsCorners) {
   ASSERT_EQ(m.num_elements(), 1);
   EXPECT_EQ(m.blocks[0].elements[0], (Hex{0, 1, 2, 3, 4, 5, 6, 7}));
   EXPECT_NEAR(hex_volume(corners(m, m.blocks[0].elements[0])), 1.0, 1e-14);
+  // Names beyond Exodus's default length of 32 come back whole.
+  EXPECT_EQ(m.node_sets.at("bottom_face_of_the_cube_with_a_long_set_name"),
+            (std::vector<std::int64_t>{0, 1, 2, 3, 8, 9, 10, 11}));
 }
 
 // Expects read_exodus(path) to throw an InputError whose message has every fragment.

@@ -108,10 +108,13 @@ void write_box(const std::string& path, const std::string& fault, int format = 0
   check(ex_close(id), "ex_close");
 }
 
-// One 20-node hexahedron on the unit cube: the reader keeps the 8 corners.
+// One 20-node hexahedron on the unit cube: the reader keeps the 8 corners. Its block
+// type is in lower case and its node set has a name longer than Exodus's default of 32
+// characters.
 void write_hex20(const std::string& path) {
   const int id = create(path);
-  check(ex_put_init(id, "anvil reader test: one HEX20", 3, 20, 1, 1, 0, 0), "ex_put_init");
+  check(ex_set_max_name_length(id, 64), "ex_set_max_name_length");
+  check(ex_put_init(id, "anvil reader test: one HEX20", 3, 20, 1, 1, 1, 0), "ex_put_init");
   // Corners in Exodus order, then the 12 mid-edge nodes (positions only matter for volume).
   const double c[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
                           {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
@@ -125,10 +128,14 @@ void write_hex20(const std::string& path) {
     z.push_back(0.5 * (c[e[0]][2] + c[e[1]][2]));
   }
   check(ex_put_coord(id, x.data(), y.data(), z.data()), "ex_put_coord");
-  check(ex_put_block(id, EX_ELEM_BLOCK, 1, "HEX20", 1, 20, 0, 0, 0), "ex_put_block");
+  check(ex_put_block(id, EX_ELEM_BLOCK, 1, "hex20", 1, 20, 0, 0, 0), "ex_put_block");
   std::vector<int> conn(20);
   for (int i = 0; i < 20; ++i) conn[i] = i + 1;
   check(ex_put_conn(id, EX_ELEM_BLOCK, 1, conn.data(), nullptr, nullptr), "conn");
+  std::vector<int> bottom = {1, 2, 3, 4, 9, 10, 11, 12}; // corners and mid-edges at z = 0
+  check(ex_put_set_param(id, EX_NODE_SET, 2, 8, 0), "ns param");
+  check(ex_put_set(id, EX_NODE_SET, 2, bottom.data(), nullptr), "ns");
+  check(ex_put_name(id, EX_NODE_SET, 2, "bottom_face_of_the_cube_with_a_long_set_name"), "ns name");
   check(ex_close(id), "ex_close");
 }
 
