@@ -119,7 +119,6 @@ using EntityKey = std::pair<int, std::int64_t>; // (dimension, tag)
 
 struct HexRecord {
   Hex nodes;          // 0-based node positions
-  std::int64_t tag;   // Gmsh element tag
   std::int64_t group; // 3-D physical tag of its block, 0 for none
 };
 
@@ -478,7 +477,7 @@ private:
       set.insert(set.end(), node_ids_.begin(), node_ids_.end());
     }
     if (dim != 3) return;
-    HexRecord h{{}, etag, phys.empty() ? 0 : phys[0]};
+    HexRecord h{{}, phys.empty() ? 0 : phys[0]};
     std::copy_n(node_ids_.begin(), 8, h.nodes.begin());
     // MSH 2 writes an element once per physical group it belongs to: the copies add set
     // membership (done above), not elements.
