@@ -9,7 +9,7 @@ here=$(cd "$(dirname "$0")/.." && pwd)
 cd "$here"
 
 packages=(build-essential cmake clang-format libopenmpi-dev openmpi-bin libmetis-dev
-          libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev libgtest-dev
+          libexodusii-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev libgtest-dev
           libbenchmark-dev python3-matplotlib python3-numpy)
 if [ "${ANVIL_SKIP_APT:-0}" != 1 ]; then
   missing=()

@@ -1,15 +1,32 @@
 #include "anvil/solver/model.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <filesystem>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
 #include "anvil/mesh/generators.hpp"
+#include "anvil/mesh/read_exodus.hpp"
+#include "anvil/mesh/read_gmsh.hpp"
 
 namespace anvil {
 
 namespace {
+
+using MeshReader = Mesh (*)(const std::string& path);
+
+// The reader for a mesh file, chosen by its extension (case-insensitive); null if none.
+MeshReader mesh_reader(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".exo" || ext == ".e" || ext == ".g" || ext == ".gen" || ext == ".ex2")
+    return &read_exodus;
+  if (ext == ".msh") return &read_gmsh;
+  return nullptr;
+}
 
 Mesh part_mesh(const PartConfig& p) {
   try {
@@ -26,9 +43,18 @@ Mesh part_mesh(const PartConfig& p) {
   } catch (const std::invalid_argument& e) {
     throw InputError(p.mesh.where, e.what());
   }
-  throw InputError(
-      p.mesh.where,
-      fmt::format("cannot read mesh file '{}': no reader for this format yet", p.mesh.file));
+  const auto reader = mesh_reader(p.mesh.file);
+  if (!reader)
+    throw InputError(p.mesh.where,
+                     fmt::format("cannot read mesh file '{}': unknown format (expected "
+                                 ".exo, .e, .g, .gen or .ex2 for Exodus II, .msh for Gmsh)",
+                                 p.mesh.file));
+  try {
+    return reader(p.mesh.file);
+  } catch (const InputError& e) {
+    // The reader names the mesh file and line; the deck location says which part.
+    throw InputError(p.mesh.where, e.what());
+  }
 }
 
 std::size_t part_index(const Config& c, const std::string& name) {

@@ -1,0 +1,382 @@
+#include "anvil/mesh/read_exodus.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <new>
+#include <stdexcept>
+#include <vector>
+
+#include <exodusII.h>
+#include <fmt/format.h>
+
+#include "anvil/core/error.hpp"
+
+namespace anvil {
+
+namespace {
+
+// The open file and its path; closes the file when the reader leaves by any path, so
+// that an InputError thrown halfway does not leak a netCDF handle.
+class ExodusFile {
+public:
+  explicit ExodusFile(const std::string& path) : path_(path) {
+    int cpu_word_size = sizeof(double), io_word_size = 0;
+    float version = 0;
+    // 64-bit integers through the API whatever the file stores: ids and counts of large
+    // meshes do not fit an int, and one integer type keeps the code below simple.
+    id_ =
+        ex_open(path.c_str(), EX_READ | EX_ALL_INT64_API, &cpu_word_size, &io_word_size, &version);
+    if (id_ < 0) fail("cannot open as an Exodus II file" + library_message());
+  }
+  ~ExodusFile() {
+    if (id_ >= 0) ex_close(id_);
+  }
+  ExodusFile(const ExodusFile&) = delete;
+  ExodusFile& operator=(const ExodusFile&) = delete;
+
+  int id() const { return id_; }
+  const std::string& path() const { return path_; }
+
+  [[noreturn]] void fail(const std::string& message) const {
+    throw InputError(SourceLocation{path_, 0, ""}, message);
+  }
+
+  // Throws unless `rc` reports success (Exodus: negative is an error, positive a warning).
+  void check(int rc, const std::string& what) const {
+    if (rc < 0) fail(fmt::format("cannot read {}{}", what, library_message()));
+  }
+
+private:
+  // The Exodus library's own explanation of its last error, for the user.
+  static std::string library_message() {
+    const char* msg = nullptr;
+    const char* func = nullptr;
+    int code = 0;
+    ex_get_err(&msg, &func, &code);
+    if (!msg || !*msg) return "";
+    return fmt::format(" ({})", msg);
+  }
+
+  std::string path_;
+  int id_ = -1;
+};
+
+// Walks the header of a netCDF classic file (CDF-1, CDF-2 or CDF-5: the formats Exodus
+// writes by default) and returns what is inconsistent with the file's size, or an empty
+// string. The netCDF library trusts the header's counts and allocates by them: a corrupt
+// byte can make it ask for tens of gigabytes before it notices anything wrong. Checking
+// that every count, name, attribute and variable fits in the file first bounds what
+// the library can allocate by the file size. Not a classic file (netCDF-4/HDF5, or not
+// netCDF at all): empty, and the library decides.
+std::string classic_netcdf_problem(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return ""; // ex_open reports it
+  in.seekg(0, std::ios::end);
+  const auto end = in.tellg();
+  if (end < 0) return "";
+  const auto size = static_cast<std::uint64_t>(end);
+  in.seekg(0);
+  char magic[4] = {};
+  if (!in.read(magic, 4) || magic[0] != 'C' || magic[1] != 'D' || magic[2] != 'F') return "";
+  const int version = magic[3];
+  if (version != 1 && version != 2 && version != 5) return "";
+  const int count_bytes = version == 5 ? 8 : 4;  // NON_NEG
+  const int offset_bytes = version == 1 ? 4 : 8; // OFFSET
+  std::uint64_t pos = 4;
+
+  // Big-endian unsigned integer of `n` bytes; false at the end of the file.
+  auto uint = [&](int n, std::uint64_t& v) {
+    unsigned char b[8];
+    if (pos + n > size || !in.read(reinterpret_cast<char*>(b), n)) return false;
+    pos += n;
+    v = 0;
+    for (int i = 0; i < n; ++i) v = (v << 8) | b[i];
+    return true;
+  };
+  auto skip = [&](std::uint64_t n) {
+    if (n > size - pos) return false;
+    pos += n;
+    in.seekg(static_cast<std::streamoff>(pos));
+    return true;
+  };
+  auto padded = [](std::uint64_t n) { return (n + 3) / 4 * 4; };
+  auto name = [&]() {
+    std::uint64_t len = 0;
+    return uint(count_bytes, len) && len <= size && skip(padded(len));
+  };
+  auto type_size = [](std::uint64_t t) -> std::uint64_t {
+    static constexpr std::uint64_t sizes[12] = {0, 1, 1, 2, 4, 4, 8, 1, 2, 4, 8, 8};
+    return t >= 1 && t <= 11 ? sizes[t] : 0;
+  };
+  // A list header: tag and number of elements; ABSENT is tag 0 with 0 elements.
+  auto list = [&](std::uint64_t tag, std::uint64_t& n) {
+    std::uint64_t t = 0;
+    if (!uint(4, t) || !uint(count_bytes, n)) return false;
+    return (t == tag || (t == 0 && n == 0)) && n <= size;
+  };
+  auto attributes = [&]() {
+    std::uint64_t n = 0;
+    if (!list(0x0C, n)) return false;
+    for (std::uint64_t i = 0; i < n; ++i) {
+      std::uint64_t type = 0, count = 0;
+      if (!name() || !uint(4, type) || !uint(count_bytes, count)) return false;
+      const auto ts = type_size(type);
+      if (ts == 0 || count > size / ts || !skip(padded(count * ts))) return false;
+    }
+    return true;
+  };
+
+  std::uint64_t numrecs = 0, ndims = 0, nvars = 0;
+  if (!uint(count_bytes, numrecs)) return "the netCDF header is truncated";
+  const bool streaming = numrecs == (count_bytes == 4 ? 0xFFFFFFFFull : ~0ull);
+  if (!streaming && numrecs > size) return "the netCDF header declares more records than fit";
+  if (!list(0x0A, ndims)) return "the netCDF dimension list is corrupt";
+  std::vector<std::uint64_t> dims;
+  for (std::uint64_t i = 0; i < ndims; ++i) {
+    std::uint64_t len = 0;
+    if (!name() || !uint(count_bytes, len)) return "the netCDF dimension list is corrupt";
+    dims.push_back(len);
+  }
+  if (!attributes()) return "the netCDF global attributes are corrupt";
+  if (!list(0x0B, nvars)) return "the netCDF variable list is corrupt";
+  for (std::uint64_t v = 0; v < nvars; ++v) {
+    std::uint64_t nd = 0;
+    if (!name() || !uint(count_bytes, nd) || nd > size)
+      return "the netCDF variable list is corrupt";
+    std::uint64_t extent = 1; // bytes of one record (record variable) or of all the data
+    bool record = false;
+    for (std::uint64_t d = 0; d < nd; ++d) {
+      std::uint64_t id = 0;
+      if (!uint(count_bytes, id) || id >= dims.size())
+        return "a netCDF variable refers to an undefined dimension";
+      if (dims[id] == 0 && d == 0) {
+        record = true;
+        continue;
+      }
+      if (dims[id] != 0 && extent > size / dims[id])
+        return "a netCDF variable is larger than the file";
+      extent *= dims[id];
+    }
+    std::uint64_t type = 0, vsize = 0, begin = 0;
+    if (!attributes() || !uint(4, type) || !uint(count_bytes, vsize) ||
+        !uint(offset_bytes, begin) || type_size(type) == 0)
+      return "the netCDF variable list is corrupt";
+    if (extent > size / type_size(type)) return "a netCDF variable is larger than the file";
+    extent *= type_size(type);
+    const std::uint64_t records = record ? (streaming ? 0 : numrecs) : 1;
+    if (records > 0 && extent > size / records) return "a netCDF variable is larger than the file";
+    if (begin > size || extent * records > size - begin)
+      return "a netCDF variable lies beyond the end of the file (truncated file?)";
+  }
+  return "";
+}
+
+// Names of the `count` entities of `type` in file order; an empty string where the file
+// gives none.
+std::vector<std::string> entity_names(const ExodusFile& f, ex_entity_type type, std::int64_t count,
+                                      const char* what) {
+  std::vector<std::string> out(static_cast<std::size_t>(count));
+  if (count == 0) return out;
+  const auto len = std::max<std::int64_t>(ex_inquire_int(f.id(), EX_INQ_MAX_READ_NAME_LENGTH), 32);
+  std::vector<std::vector<char>> storage(out.size(), std::vector<char>(len + 1, '\0'));
+  std::vector<char*> ptrs;
+  for (auto& s : storage) ptrs.push_back(s.data());
+  f.check(ex_get_names(f.id(), type, ptrs.data()), what);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    storage[i].back() = '\0';
+    out[i] = storage[i].data();
+    // Names padded with blanks by some writers are the same names.
+    while (!out[i].empty() && std::isspace(static_cast<unsigned char>(out[i].back())))
+      out[i].pop_back();
+  }
+  return out;
+}
+
+std::vector<std::int64_t> entity_ids(const ExodusFile& f, ex_entity_type type, std::int64_t count,
+                                     const char* what) {
+  std::vector<std::int64_t> ids(static_cast<std::size_t>(count));
+  if (count > 0) f.check(ex_get_ids(f.id(), type, ids.data()), what);
+  return ids;
+}
+
+// Hexahedra by their corners: the first 8 nodes of HEX20 and HEX27 are the corners in
+// the same order as HEX8 (Exodus II manual, element topologies).
+bool is_hex(const std::string& type, std::int64_t nodes_per_element) {
+  std::string t;
+  for (char c : type) t += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  if (t.rfind("HEX", 0) != 0) return false;
+  return nodes_per_element == 8 || nodes_per_element == 20 || nodes_per_element == 27;
+}
+
+Mesh read_all(const ExodusFile& f) {
+  ex_init_params init{};
+  f.check(ex_get_init_ext(f.id(), &init), "the file header");
+  if (init.num_dim != 3)
+    f.fail(fmt::format("the mesh is {}-dimensional; anvil reads 3-D meshes only", init.num_dim));
+  if (init.num_nodes < 0 || init.num_elem < 0 || init.num_elem_blk < 0 || init.num_node_sets < 0 ||
+      init.num_side_sets < 0)
+    f.fail("the file header has negative counts");
+
+  // Every entity takes more than a byte in the file, even compressed: a count beyond the
+  // file's size is a corrupt header, caught before it becomes an allocation.
+  std::error_code ec;
+  const auto bytes = std::filesystem::file_size(f.path(), ec);
+  const auto limit =
+      ec ? std::numeric_limits<std::int64_t>::max() : static_cast<std::int64_t>(bytes);
+  auto fits = [&](std::int64_t n, const std::string& what) {
+    if (n > limit)
+      f.fail(fmt::format("the file declares {} {}, more than a file of {} bytes can hold", n, what,
+                         limit));
+  };
+  fits(init.num_nodes, "nodes");
+  fits(init.num_elem_blk, "element blocks");
+  fits(init.num_node_sets, "node sets");
+  fits(init.num_side_sets, "side sets");
+
+  Mesh mesh;
+  const std::int64_t nn = init.num_nodes;
+  if (nn > 0) {
+    std::vector<double> x(nn), y(nn), z(nn);
+    f.check(ex_get_coord(f.id(), x.data(), y.data(), z.data()), "the node coordinates");
+    mesh.nodes.resize(nn);
+    for (std::int64_t i = 0; i < nn; ++i) {
+      if (!std::isfinite(x[i]) || !std::isfinite(y[i]) || !std::isfinite(z[i]))
+        f.fail(fmt::format("node {} has a non-finite coordinate", i + 1));
+      mesh.nodes[i] = Vec3{x[i], y[i], z[i]};
+    }
+  }
+
+  // Element blocks, in file order: the file's element numbering runs through them.
+  const auto block_ids = entity_ids(f, EX_ELEM_BLOCK, init.num_elem_blk, "the element block ids");
+  const auto block_names =
+      entity_names(f, EX_ELEM_BLOCK, init.num_elem_blk, "the element block names");
+  std::int64_t elements = 0;
+  for (std::size_t b = 0; b < block_ids.size(); ++b) {
+    const std::int64_t bid = block_ids[b];
+    const std::string name = block_names[b].empty() ? fmt::format("block_{}", bid) : block_names[b];
+    const std::string label = fmt::format("element block '{}' (id {})", name, bid);
+    // Larger than MAX_STR_LENGTH + 1, which is all the library writes.
+    std::vector<char> type(256, '\0');
+    std::int64_t count = 0, npe = 0, edges = 0, faces = 0, attrs = 0;
+    f.check(
+        ex_get_block(f.id(), EX_ELEM_BLOCK, bid, type.data(), &count, &npe, &edges, &faces, &attrs),
+        "the parameters of " + label);
+    type.back() = '\0';
+    const std::string type_name = type.data();
+    if (count < 0 || npe < 0) f.fail(label + " has negative counts");
+    const bool hex = is_hex(type_name, npe);
+    if (!hex && count == 0) continue; // nothing to number, nothing to reject
+    if (!hex)
+      f.fail(fmt::format("{} has elements of type {} with {} nodes; anvil reads hexahedra "
+                         "only (HEX/HEX8, or HEX20/HEX27 by their corners)",
+                         label, type_name.empty() ? "(none)" : type_name, npe));
+    fits(count, "elements in " + label);
+    fits(count * npe, "connectivity entries in " + label);
+    ElementBlock eb{name, {}};
+    if (count > 0) {
+      std::vector<std::int64_t> conn(static_cast<std::size_t>(count * npe));
+      f.check(ex_get_conn(f.id(), EX_ELEM_BLOCK, bid, conn.data(), nullptr, nullptr),
+              "the connectivity of " + label);
+      eb.elements.resize(static_cast<std::size_t>(count));
+      for (std::int64_t e = 0; e < count; ++e)
+        for (int a = 0; a < 8; ++a) {
+          const std::int64_t n = conn[e * npe + a];
+          if (n < 1 || n > nn)
+            f.fail(fmt::format("{}: element {} (element {} of the block) uses node {}, but the "
+                               "file has nodes 1 to {}",
+                               label, elements + e + 1, e + 1, n, nn));
+          eb.elements[e][a] = n - 1;
+        }
+    }
+    elements += count;
+    mesh.blocks.push_back(std::move(eb));
+  }
+  if (elements != init.num_elem)
+    f.fail(fmt::format("the header declares {} elements but the blocks hold {}", init.num_elem,
+                       elements));
+
+  const auto ns_ids = entity_ids(f, EX_NODE_SET, init.num_node_sets, "the node set ids");
+  const auto ns_names = entity_names(f, EX_NODE_SET, init.num_node_sets, "the node set names");
+  for (std::size_t s = 0; s < ns_ids.size(); ++s) {
+    const std::string name =
+        ns_names[s].empty() ? fmt::format("nodeset_{}", ns_ids[s]) : ns_names[s];
+    const std::string label = fmt::format("node set '{}' (id {})", name, ns_ids[s]);
+    std::int64_t count = 0, factors = 0;
+    f.check(ex_get_set_param(f.id(), EX_NODE_SET, ns_ids[s], &count, &factors),
+            "the size of " + label);
+    if (count < 0) f.fail(label + " has a negative size");
+    fits(count, "entries in " + label);
+    std::vector<std::int64_t> ids(static_cast<std::size_t>(count));
+    if (count > 0) f.check(ex_get_set(f.id(), EX_NODE_SET, ns_ids[s], ids.data(), nullptr), label);
+    for (auto& n : ids) {
+      if (n < 1 || n > nn)
+        f.fail(fmt::format("{} contains node {}, but the file has nodes 1 to {}", label, n, nn));
+      --n;
+    }
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    if (!mesh.node_sets.emplace(name, std::move(ids)).second)
+      f.fail(fmt::format("two node sets are named '{}'", name));
+  }
+
+  const auto ss_ids = entity_ids(f, EX_SIDE_SET, init.num_side_sets, "the side set ids");
+  const auto ss_names = entity_names(f, EX_SIDE_SET, init.num_side_sets, "the side set names");
+  for (std::size_t s = 0; s < ss_ids.size(); ++s) {
+    const std::string name =
+        ss_names[s].empty() ? fmt::format("sideset_{}", ss_ids[s]) : ss_names[s];
+    const std::string label = fmt::format("side set '{}' (id {})", name, ss_ids[s]);
+    std::int64_t count = 0, factors = 0;
+    f.check(ex_get_set_param(f.id(), EX_SIDE_SET, ss_ids[s], &count, &factors),
+            "the size of " + label);
+    if (count < 0) f.fail(label + " has a negative size");
+    fits(count, "entries in " + label);
+    std::vector<std::int64_t> elems(static_cast<std::size_t>(count)), sides(elems.size());
+    if (count > 0)
+      f.check(ex_get_set(f.id(), EX_SIDE_SET, ss_ids[s], elems.data(), sides.data()), label);
+    std::vector<SideEntry> entries;
+    entries.reserve(elems.size());
+    for (std::size_t i = 0; i < elems.size(); ++i) {
+      if (elems[i] < 1 || elems[i] > elements)
+        f.fail(fmt::format("{} refers to element {}, but the file has elements 1 to {}", label,
+                           elems[i], elements));
+      if (sides[i] < 1 || sides[i] > 6)
+        f.fail(fmt::format("{} refers to side {} of element {}; a hexahedron has sides 1 to 6",
+                           label, sides[i], elems[i]));
+      entries.push_back({elems[i] - 1, static_cast<int>(sides[i] - 1)});
+    }
+    if (!mesh.side_sets.emplace(name, std::move(entries)).second)
+      f.fail(fmt::format("two side sets are named '{}'", name));
+  }
+  return mesh;
+}
+
+} // namespace
+
+Mesh read_exodus(const std::string& path) {
+  try {
+    if (const auto problem = classic_netcdf_problem(path); !problem.empty())
+      throw InputError(SourceLocation{path, 0, ""}, "not a readable Exodus II file: " + problem);
+    const ExodusFile f(path);
+    // Names longer than the library's default of 32 characters would come back cut.
+    // The setting is the library's (per process); raising it is harmless for any other
+    // reader, and the cap keeps a corrupt header from asking for absurd buffers.
+    const auto used = ex_inquire_int(f.id(), EX_INQ_DB_MAX_USED_NAME_LENGTH);
+    if (used > 32)
+      ex_set_max_name_length(f.id(), static_cast<int>(std::min<std::int64_t>(used, 255)));
+    return read_all(f);
+  } catch (const std::bad_alloc&) {
+    // Counts in a corrupt header can ask for more memory than there is.
+    throw InputError(SourceLocation{path, 0, ""},
+                     "the file declares more entities than fit in memory (corrupt header?)");
+  } catch (const std::length_error&) {
+    throw InputError(SourceLocation{path, 0, ""},
+                     "the file declares more entities than fit in memory (corrupt header?)");
+  }
+}
+
+} // namespace anvil
