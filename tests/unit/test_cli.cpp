@@ -59,7 +59,9 @@ TEST(Cli, BadArgumentsExitTwo) {
 }
 
 TEST(Cli, BadDeckNamesFileLineKey) {
-  const auto deck = write_temp("bad.yaml", "termination: {time: 1.0e-5}\nmaterials:\n  m: {model: elastic, density: -1, youngs_modulus: 1.0e9, poissons_ratio: 0.3}\n");
+  const auto deck =
+      write_temp("bad.yaml", "termination: {time: 1.0e-5}\nmaterials:\n  m: {model: elastic, "
+                             "density: -1, youngs_modulus: 1.0e9, poissons_ratio: 0.3}\n");
   const auto r = run("check " + deck);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.out.find("bad.yaml:3"), std::string::npos) << r.out;
@@ -110,7 +112,8 @@ TEST(Cli, RunWritesTheOutputs) {
   EXPECT_NE(pvd.str().find("step_000002.pvtu"), std::string::npos) << pvd.str();
   std::stringstream summary;
   summary << std::ifstream(dir + "/summary.json").rdbuf();
-  for (const char* key : {"\"grind_us\"", "\"timers\"", "\"imbalance\"", "\"balance_error\"", "\"status\": \"completed\""})
+  for (const char* key : {"\"grind_us\"", "\"timers\"", "\"imbalance\"", "\"balance_error\"",
+                          "\"status\": \"completed\""})
     EXPECT_NE(summary.str().find(key), std::string::npos) << key;
 }
 

@@ -17,7 +17,6 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
   // The global mesh is built on every rank (generators and readers are deterministic);
   // METIS runs on rank 0 and its answer is broadcast so that every rank agrees.
   const Mesh mesh = build_mesh(config_);
-  global_nodes_ = mesh.num_nodes();
   global_elements_ = mesh.num_elements();
   block_offsets_ = mesh.block_offsets();
   std::vector<int> owner;
@@ -25,6 +24,9 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
   comm_.broadcast(owner, 0);
   fe_ = decompose_fe(mesh, owner, comm_.rank(), comm_.size());
   corner_exchange_ = std::make_unique<CornerExchange>(fe_, comm_);
+  // Nodes that no element uses (mid-side nodes of imported quadratic elements, stray
+  // points) take no part in the run and are not counted.
+  global_nodes_ = comm_.sum(fe_.num_owned_nodes());
 
   // Nodes.
   const std::size_t nn = fe_.node_gid.size();
@@ -59,11 +61,16 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     hb.hourglass = part.hourglass;
     hb.bulk_viscosity = part.bulk_viscosity;
     const int bad = hb.init(lb.gid, lb.conn, xs, lb.corner_base);
-    if (bad >= 0)
+    // Every rank must throw, not only the one holding the element.
+    const std::int64_t none = std::numeric_limits<std::int64_t>::max();
+    const std::int64_t bad_gid = comm_.min(bad >= 0 ? hb.gid[bad] : none);
+    if (bad_gid != none) {
+      const double v = comm_.min(bad >= 0 && hb.gid[bad] == bad_gid ? hb.volume[bad] : 1e300);
       throw InputError(part.mesh.where,
                        fmt::format("element {} of part {} has a non-positive volume ({:.3g} m^3): "
                                    "check the node order",
-                                   hb.gid[bad] - block_offsets_[b] + 1, part.name, hb.volume[bad]));
+                                   bad_gid - block_offsets_[b] + 1, part.name, v));
+    }
     for (int e = 0; e < hb.size(); ++e)
       for (int a = 0; a < 8; ++a)
         corner_mass[lb.corner_base + static_cast<std::size_t>(a) * lb.stride + e] = hb.mass[e] / 8;
