@@ -67,23 +67,27 @@ void JohnsonCook::update(const MaterialBatch& b) const {
     const double T = b.temperature[p];
     double dgamma = 0;
     if (q > yield_stress(ep, rate, T)) {
-      // Solve g(x) = q - 3 G x - sigma_y(ep + x) = 0 on [0, q / 3G]; g is decreasing.
-      double lo = 0, hi = q / (3 * G), x = 0;
-      for (int it = 0; it < 60; ++it) {
-        const double g = q - 3 * G * x - yield_stress(ep + x, rate, T);
+      // Solve g(x) = q - 3 G x - sigma_y(ep + x) = 0. g decreases; g(0) > 0 and, since
+      // hardening only raises sigma_y, g < 0 at the perfectly plastic increment
+      // (q - sigma_y(ep)) / 3G, which brackets the root and is a good start (the slope of
+      // ep^n is infinite at ep = 0, on the other side). Newton steps that leave the bracket
+      // are replaced by bisection; converged when g is at round-off level of q.
+      const double rate_factor = 1 + C_ * std::log(std::max(rate / rate0_, 1.0));
+      const double ts = std::clamp((T - room_) / (melt_ - room_), 0.0, 1.0);
+      const double factor = rate_factor * (1 - std::pow(ts, m_));
+      double lo = 0, hi = (q - (A_ + B_ * std::pow(std::max(ep, 0.0), n_)) * factor) / (3 * G),
+             x = hi;
+      for (int it = 0; it < 100; ++it) {
+        const double e = std::max(ep + x, 1e-300);
+        const double g = q - 3 * G * x - (A_ + B_ * std::pow(e, n_)) * factor;
+        if (std::abs(g) <= 1e-14 * q || hi - lo <= 1e-16 * hi) break;
         if (g > 0)
           lo = x;
         else
           hi = x;
-        const double h = 1e-7 * std::max(ep + x, 1e-6);
-        const double slope =
-            -3 * G - (yield_stress(ep + x + h, rate, T) - yield_stress(ep + x, rate, T)) / h;
+        const double slope = -3 * G - B_ * n_ * std::pow(e, n_ - 1) * factor;
         double next = x - g / slope;
         if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-        if (std::abs(next - x) <= 1e-14 * std::max(1.0, ep) + 1e-16) {
-          x = next;
-          break;
-        }
         x = next;
       }
       dgamma = x;
