@@ -71,6 +71,25 @@ struct BoundaryCondition {
   SourceLocation where;
 };
 
+// General contact (DESIGN.md section 4): node-to-face penalty contact among the exterior
+// faces of the listed parts, self-contact included.
+struct ContactConfig {
+  std::vector<std::string> parts;   // empty: all parts
+  double penalty_scale = 0.1;       // k = scale K A^2 / V of the face's element
+  double friction = 0;              // Coulomb coefficient
+  double depth_fraction = 0.5;      // deepest penetration treated, in element depths V / A
+  double rebalance_threshold = 1.2; // recompute the contact RCB when max/mean load exceeds it
+  SourceLocation where;
+};
+
+// A planar rigid wall: nodes stay on the side the normal points to.
+struct RigidWallConfig {
+  Vec3 point;
+  Vec3 normal; // unit
+  double friction = 0;
+  SourceLocation where;
+};
+
 struct ProbeConfig {
   std::string name;
   Vec3 at;
@@ -91,6 +110,8 @@ struct Config {
   std::vector<InitialCondition> initial_conditions;
   std::vector<BoundaryCondition> boundary_conditions;
   std::vector<ProbeConfig> probes;
+  std::vector<ContactConfig> contact; // at most one
+  std::vector<RigidWallConfig> rigid_walls;
 
   const MaterialConfig* material(const std::string& name) const;
 };

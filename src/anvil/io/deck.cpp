@@ -358,7 +358,7 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
       {"title", "termination", "time_step", "materials", "parts", "particles", "node_sets",
        "initial_conditions", "boundary_conditions", "contact", "rigid_walls", "probes", "output"});
   for (const auto& [key, n] : entries) {
-    if (key == "particles" || key == "contact" || key == "rigid_walls")
+    if (key == "particles")
       n.fail(fmt::format("'{}' is part of the deck contract but not implemented in anvil {} yet",
                          key, "0.1"));
   }
@@ -499,6 +499,67 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
       if (!names.insert(p.name).second)
         n.child("name").fail(fmt::format("probe name '{}' is used twice", p.name));
       c.probes.push_back(p);
+    }
+  }
+
+  if (top.has("contact")) {
+    const auto items = top.child("contact").items();
+    if (items.size() > 1)
+      items[1].fail("one contact definition is supported (general contact among its parts)");
+    for (const auto& n : items) {
+      n.check_keys(
+          {"type", "parts", "penalty_scale", "friction", "depth_fraction", "rebalance_threshold"});
+      ContactConfig cc;
+      cc.where = n.where();
+      const std::string type = n.has("type") ? n.child("type").str() : "general";
+      if (type != "general")
+        n.child("type").fail(fmt::format("unknown contact type '{}' (expected general)", type));
+      if (n.has("parts")) {
+        const Node p = n.child("parts");
+        if (!(p.is_scalar() && p.str() == "all")) {
+          for (const auto& it : p.items()) {
+            const std::string name = it.str();
+            if (!part_exists(name))
+              it.fail(fmt::format("part '{}' is not defined under parts", name));
+            cc.parts.push_back(name);
+          }
+          if (cc.parts.empty()) p.fail("give a list of parts or 'all'");
+        }
+      }
+      if (n.has("penalty_scale")) cc.penalty_scale = n.child("penalty_scale").positive();
+      if (n.has("friction")) {
+        cc.friction = n.child("friction").number();
+        if (cc.friction < 0) n.child("friction").fail("must not be negative");
+      }
+      if (n.has("depth_fraction")) {
+        cc.depth_fraction = n.child("depth_fraction").positive();
+        if (cc.depth_fraction > 1)
+          n.child("depth_fraction").fail("must be at most 1 (an element depth)");
+      }
+      if (n.has("rebalance_threshold")) {
+        cc.rebalance_threshold = n.child("rebalance_threshold").number();
+        if (!(cc.rebalance_threshold >= 1))
+          n.child("rebalance_threshold").fail("must be at least 1");
+      }
+      c.contact.push_back(cc);
+    }
+  }
+
+  if (top.has("rigid_walls")) {
+    for (const auto& n : top.child("rigid_walls").items()) {
+      n.check_keys({"point", "normal", "friction"});
+      RigidWallConfig w;
+      w.where = n.where();
+      w.point = n.required("point").vec3();
+      const Vec3 nrm = n.required("normal").vec3();
+      const double len = norm(nrm);
+      if (!(len > 0)) n.child("normal").fail("the normal must not be zero");
+      w.normal = nrm * (1 / len);
+      if (n.has("friction")) {
+        w.friction = n.child("friction").number();
+        if (w.friction < 0) n.child("friction").fail("must not be negative");
+      }
+      c.rigid_walls.push_back(w);
     }
   }
 

@@ -127,6 +127,7 @@ void Outputs::write_history_row(const Sample& s) {
       "{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", s.time, s.cycle, s.dt,
       s.kinetic, s.internal, s.hourglass, s.contact, s.external_work, s.total());
   for (double v : s.probes) row += fmt::format(",{:.17g}", v);
+  for (double v : s.wall_force) row += fmt::format(",{:.17g}", v);
   std::fprintf(history_, "%s\n", row.c_str());
   std::fflush(history_);
 }

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "anvil/contact/rigid_wall.hpp"
 #include "anvil/parallel/graph_partition.hpp"
 #include "anvil/solver/model.hpp"
 
@@ -85,6 +86,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     for (int e = 0; e < b.size(); ++e) part_mass_[b.part] += b.mass[e];
   comm_.sum(std::span<double>(part_mass_));
 
+  wall_impulse_.assign(config_.rigid_walls.size(), 0.0);
   apply_initial_conditions(mesh);
   // Constraints stop the constrained velocity components at once (a node on a fixed
   // impact face hits the wall at t = 0): the kinetic energy they remove is work done by
@@ -199,10 +201,11 @@ void Simulation::step() {
     ScopedPhase t(timers_, Phase::sph);
   }
   predict(); // 3. v(n+1/2) = v(n-1/2) + dt a(n)
-  {          // 4-5. contact detection and penalty correction: no contact in this version
+  {          // 4. contact detection (contact decomposition)
     ScopedPhase t(timers_, Phase::contact_search);
   }
-  update(); // 6. x(n+1), t(n+1), next stable dt
+  correct(); // 5. penalty contact forces and rigid walls correct the velocities
+  update();  // 6. x(n+1), t(n+1), next stable dt
 }
 
 void Simulation::fe_forces() {
@@ -258,6 +261,7 @@ void Simulation::predict() {
   // Central difference with a varying step: the velocity advances over the average of
   // the intervals on either side of t(n).
   const double dt_avg = 0.5 * (clock_.dt_prev + dt);
+  dt_avg_ = dt_avg;
   const std::size_t nn = nodes_.size();
 
   // Work of the constraint reactions over this step (before the velocities change).
@@ -310,6 +314,19 @@ void Simulation::predict() {
   sample_dt_ = dt;
 }
 
+void Simulation::correct() {
+  ScopedPhase t(timers_, Phase::contact_force);
+  if (config_.rigid_walls.empty()) return;
+  std::fill(wall_impulse_.begin(), wall_impulse_.end(), 0.0);
+  const WallNodes wn{{nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()},
+                     {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()},
+                     nodes_.mass.data(),
+                     constrained_.data(),
+                     fe_.node_owned.data(),
+                     nodes_.size()};
+  external_work_ += apply_rigid_walls(config_.rigid_walls, clock_.dt, wn, wall_impulse_);
+}
+
 void Simulation::update() {
   ScopedPhase t(timers_, Phase::update);
   const double dt = clock_.dt;
@@ -346,6 +363,10 @@ Sample Simulation::sample() const {
   s.external_work = local[3];
   s.probes = probe_local_;
   comm_.sum(std::span<double>(s.probes));
+  s.wall_force.assign(wall_impulse_.size(), 0.0);
+  for (std::size_t w = 0; w < wall_impulse_.size(); ++w)
+    s.wall_force[w] = dt_avg_ > 0 ? wall_impulse_[w] / dt_avg_ : 0.0;
+  comm_.sum(std::span<double>(s.wall_force));
   return s;
 }
 

@@ -46,7 +46,8 @@ struct Sample {
   double dt = 0;
   double kinetic = 0, internal = 0, hourglass = 0, contact = 0, external_work = 0;
   double total() const { return kinetic + internal + hourglass + contact; }
-  std::vector<double> probes; // per probe: ux, uy, uz, vx, vy, vz
+  std::vector<double> probes;     // per probe: ux, uy, uz, vx, vy, vz
+  std::vector<double> wall_force; // per rigid wall: normal force, N
 };
 
 class Simulation {
@@ -88,6 +89,7 @@ public:
 private:
   void fe_forces();
   void predict();
+  void correct();
   void update();
   void apply_initial_conditions(const Mesh& mesh);
   void apply_boundary_conditions(const Mesh& mesh);
@@ -111,6 +113,10 @@ private:
   std::vector<std::uint8_t> constrained_;
   std::array<std::vector<double>, 3> v_bc_;
   std::vector<int> constrained_nodes_; // local nodes with any constraint
+
+  // Rigid walls: normal impulse given to owned nodes in the last step, per wall.
+  std::vector<double> wall_impulse_;
+  double dt_avg_ = 0; // the velocity step of the last cycle (mean of the two intervals)
 
   // Diagnostics accumulated by this rank over owned entities.
   double external_work_ = 0;

@@ -1,0 +1,43 @@
+#include "anvil/contact/penalty.hpp"
+
+#include <cmath>
+
+#include "anvil/contact/geometry.hpp"
+
+namespace anvil {
+
+void penalty_forces(const std::vector<ContactNodeItem>& nodes,
+                    const std::vector<ContactFaceItem>& faces,
+                    const std::vector<ContactPair>& pairs, const PenaltyOptions& opt,
+                    std::vector<ContactForceItem>& items, std::vector<int>& dest) {
+  for (const auto& p : pairs) {
+    const auto& n = nodes[static_cast<std::size_t>(p.node)];
+    const auto& f = faces[static_cast<std::size_t>(p.face)];
+    const auto N = quad_shape(p.xi, p.eta);
+    const double fn = f.stiffness * (-p.gap);
+    Vec3 F = fn * p.normal;
+    if (opt.friction > 0 && opt.dt > 0) {
+      Vec3 vr{n.v[0], n.v[1], n.v[2]};
+      double inv_m = 1 / n.mass;
+      for (int a = 0; a < 4; ++a) {
+        vr -= N[a] * Vec3{f.v[a][0], f.v[a][1], f.v[a][2]};
+        inv_m += N[a] * N[a] / f.mass[a];
+      }
+      const Vec3 vt = vr - dot(vr, p.normal) * p.normal;
+      const double speed = norm(vt);
+      if (speed > 0) {
+        const double stick = speed / (inv_m * opt.dt); // stops the sliding in one step
+        const double ft = std::min(opt.friction * fn, stick);
+        F -= (ft / speed) * vt;
+      }
+    }
+    items.push_back({n.gid, n.gid, {F.x, F.y, F.z}});
+    dest.push_back(n.owner);
+    for (int a = 0; a < 4; ++a) {
+      items.push_back({f.node[a], n.gid, {-N[a] * F.x, -N[a] * F.y, -N[a] * F.z}});
+      dest.push_back(f.owner[a]);
+    }
+  }
+}
+
+} // namespace anvil

@@ -1,0 +1,31 @@
+// Planar rigid walls (LS-DYNA's *RIGIDWALL_PLANAR): a kinematic constraint applied to the
+// predicted motion. A node whose predicted position x(n) + dt v lies behind a wall gets
+// the normal velocity that puts it exactly on the wall at t(n+1); Coulomb friction then
+// reduces its tangential velocity by at most mu times the normal velocity change. The
+// wall can push but never pull, so bodies leave it freely. MPI-free; every copy of a
+// shared node computes the same correction.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "anvil/io/config.hpp"
+
+namespace anvil {
+
+struct WallNodes {
+  const double* x[3]; // positions at t(n)
+  double* v[3];       // in: predicted v(n+1/2); out: corrected
+  const double* mass;
+  const std::uint8_t* constrained; // bit i: component i is constrained and left alone
+  const std::uint8_t* owned;       // diagnostics count owned nodes only
+  std::size_t size;
+};
+
+// Corrects the velocities; adds to impulse[w] the normal impulse wall w gave to owned
+// nodes (N s) and returns the work the walls did on owned nodes over the step (J).
+double apply_rigid_walls(const std::vector<RigidWallConfig>& walls, double dt, WallNodes nodes,
+                         std::vector<double>& impulse);
+
+} // namespace anvil

@@ -1,0 +1,61 @@
+// Contact detection inside one rank of the contact decomposition, knowing nothing of MPI:
+// global search by binning (a bucket sort of face capture boxes on a uniform grid, in the
+// spirit of Benson and Hallquist 1990), then the detailed check of Heinstein et al. (1993):
+// the normal projection of each node onto each candidate face, the penetration, and the
+// best face (least penetration, ties by face global id). The result depends only on the
+// nodes and faces given, not on their order or on which rank holds them.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "anvil/core/vec3.hpp"
+
+namespace anvil {
+
+// A contact node in the contact decomposition (trivially copyable: moved by Migration).
+struct ContactNodeItem {
+  std::int64_t gid; // global node id
+  int owner;        // FE rank that owns the node
+  double x[3];      // predicted position x* = x(n) + dt v(n+1/2)
+  double v[3];      // predicted velocity v(n+1/2)
+  double mass;      // lumped nodal mass
+};
+
+// A contact face with everything the check and the forces need.
+struct ContactFaceItem {
+  std::int64_t gid;     // global face id (ExteriorFaces order)
+  std::int64_t node[4]; // global node ids, counter-clockwise seen from outside
+  int owner[4];         // FE owner rank of each node
+  double x[4][3];       // predicted node positions
+  double v[4][3];       // predicted node velocities
+  double mass[4];       // nodal masses
+  double stiffness;     // penalty stiffness, N/m
+  double depth;         // largest penetration treated as contact, m
+};
+
+struct ContactPair {
+  int node = 0;           // index into the node list
+  int face = 0;           // index into the face list
+  double xi = 0, eta = 0; // foot of the normal on the face
+  double gap = 0;         // signed distance along the normal (< 0: penetration), m
+  Vec3 normal;            // unit outward normal of the face at the foot
+};
+
+struct SearchOptions {
+  double parametric_tolerance = 0.02; // the foot may lie this far outside [-1, 1]^2
+};
+
+// Scratch space kept between cycles (no allocation in steady state).
+struct SearchWorkspace {
+  std::vector<int> cell_start, cell_faces, face_cells;
+  std::vector<double> box; // 6 per face: capture box
+};
+
+// Finds, for every node, the face it penetrates (if any): pairs in ascending node index.
+// A node never pairs with a face it belongs to.
+void find_contacts(const std::vector<ContactNodeItem>& nodes,
+                   const std::vector<ContactFaceItem>& faces, const SearchOptions& options,
+                   SearchWorkspace& work, std::vector<ContactPair>& pairs);
+
+} // namespace anvil

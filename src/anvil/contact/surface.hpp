@@ -1,0 +1,29 @@
+// Contact surfaces: the exterior quadrilateral faces of hexahedral parts (faces that
+// belong to exactly one element of the whole mesh) and the nodes on them.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "anvil/mesh/mesh.hpp"
+
+namespace anvil {
+
+struct ExteriorFaces {
+  // Face f: element `element[f]` (global id), its side `side[f]` (index into hex_faces),
+  // nodes `nodes[f]` (global ids, counter-clockwise seen from outside). Ordered by
+  // (element, side): the position is the face's global id.
+  std::vector<std::int64_t> element;
+  std::vector<int> side;
+  std::vector<std::array<std::int64_t, 4>> nodes;
+  std::vector<std::int64_t> contact_nodes; // sorted, unique global ids of the faces' nodes
+
+  std::size_t size() const { return element.size(); }
+};
+
+// Exterior faces of the blocks with `selected[b]` true. A face is exterior when no other
+// element of the whole mesh (any block) has the same four nodes.
+ExteriorFaces exterior_faces(const Mesh& mesh, const std::vector<bool>& selected);
+
+} // namespace anvil
