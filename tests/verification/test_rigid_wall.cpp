@@ -5,7 +5,7 @@
 // with velocity v0 reversed, c = sqrt((lambda + 2 mu) / rho).
 // Tolerances: contact duration (force below half its plateau) within 2% of 2L/c; mean
 // plateau force within 2% of rho c v0 A; rebound velocity of the centre of mass within 2%
-// of v0. The artificial bulk viscosity is off, as for every elastic-wave check here: it is
+// of v0. The artificial bulk viscosity is off (as in the energy check): it is
 // a dissipative device for shocks, and with LS-DYNA's default coefficients it takes 5% of
 // the energy out of this event (rebound at 0.975 v0, measured).
 #include <gtest/gtest.h>
