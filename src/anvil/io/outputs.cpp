@@ -62,11 +62,18 @@ VtuPiece fe_piece(const Simulation& sim) {
       part.i64.push_back(b.part);
     }
   }
+  // Contact decomposition: the RCB rank of the element's (first) exterior face, -1 for
+  // elements without one.
+  VtuArray contact_rank{"contact_rank", 1, true};
+  if (sim.contact())
+    for (const auto& per_block : sim.contact()->element_contact_rank(sim.blocks()))
+      for (int r : per_block) contact_rank.i64.push_back(r);
   // Every rank must list the same arrays: temperature appears when any part has it.
   const bool temp_anywhere = sim.comm().max(static_cast<std::int64_t>(any_temp)) > 0;
   p.cell_data = {std::move(stress), std::move(vm), std::move(pres), std::move(ep)};
   if (temp_anywhere) p.cell_data.push_back(std::move(temp));
   p.cell_data.push_back(std::move(rank));
+  if (sim.contact()) p.cell_data.push_back(std::move(contact_rank));
   p.cell_data.push_back(std::move(eid));
   p.cell_data.push_back(std::move(part));
   return p;
@@ -222,6 +229,8 @@ void Outputs::write_summary(int status, const std::string& message) {
   comm.max(std::span<double>(tmax));
   comm.sum(std::span<double>(tsum));
   const Sample s = have_sample_ ? last_sample_ : sim_.sample();
+  const ContactStats contact_stats = sim_.contact() ? sim_.contact()->stats() : ContactStats{};
+  const double bytes_max = comm.max(contact_stats.bytes_sent);
   if (comm.rank() != 0) return;
   using nlohmann::json;
   const Clock& clk = sim_.clock();
@@ -254,8 +263,21 @@ void Outputs::write_summary(int status, const std::string& message) {
   };
   imb["fe"] = ratio(Phase::fe);
   imb["sph"] = 1.0;
-  imb["contact"] = 1.0;
+  {
+    const double cmax = tmax[static_cast<int>(Phase::contact_search)] + tmax[static_cast<int>(Phase::contact_force)];
+    const double cmean = (tsum[static_cast<int>(Phase::contact_search)] + tsum[static_cast<int>(Phase::contact_force)]) / comm.size();
+    imb["contact"] = cmean > 0 ? cmax / cmean : 1.0;
+  }
   j["imbalance"] = imb;
+  if (contact_stats.cycles > 0) {
+    j["contact"] = {{"cycles", contact_stats.cycles},
+                    {"rebalances", contact_stats.rebalances},
+                    {"pairs_last_cycle", contact_stats.pairs},
+                    {"load_imbalance_last", contact_stats.imbalance},
+                    {"load_imbalance_max", contact_stats.imbalance_max},
+                    {"max_penetration", contact_stats.max_penetration},
+                    {"bytes_sent_per_rank_per_cycle_max", bytes_max / static_cast<double>(contact_stats.cycles)}};
+  }
   j["energy"] = {{"time", s.time},
                  {"initial", sim_.initial_energy()},
                  {"kinetic", s.kinetic},

@@ -61,6 +61,7 @@ FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, in
       g2l[n] = static_cast<int>(d.node_gid.size());
       d.node_gid.push_back(n);
       d.node_owned.push_back(min_rank(n) == rank ? 1 : 0);
+      d.node_owner.push_back(min_rank(n));
     }
 
   // Owned elements per block and their corner slots.
@@ -126,6 +127,8 @@ FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, in
       }
     }
     nb.recv_count = next_remote - nb.recv_base;
+    for (std::size_t i = 0; i < d.node_gid.size(); ++i)
+      if (touches(d.node_gid[i], q)) nb.shared.push_back(static_cast<int>(i));
     d.neighbors.push_back(std::move(nb));
   }
   d.remote_slots = next_remote - d.local_slots;
@@ -165,6 +168,46 @@ void CornerExchange::exchange(const std::vector<double*>& arrays) {
   req.wait();
   for (std::size_t j = 0; j < d_.remote_slots; ++j)
     for (std::size_t c = 0; c < k; ++c) arrays[c][d_.local_slots + j] = recv_[j * k + c];
+}
+
+NodeExchange::NodeExchange(const FeDecomposition& d, const Comm& comm) : d_(d), comm_(comm) {
+  std::size_t n = 0;
+  for (const auto& nb : d.neighbors) n += nb.shared.size();
+  send_.resize(3 * n);
+  recv_.resize(3 * n);
+}
+
+void NodeExchange::from_owners(const std::vector<double*>& arrays) {
+  if (d_.neighbors.empty()) return;
+  const std::size_t k = arrays.size();
+  Requests req;
+  // Per neighbour: we send the shared nodes we own, receive those it owns, both in
+  // ascending gid, so the two sides agree on the layout without telling each other.
+  std::size_t off = 0;
+  for (const auto& nb : d_.neighbors) {
+    std::size_t nr = 0;
+    for (int i : nb.shared) nr += d_.node_owner[i] == nb.rank;
+    comm_.irecv(std::span<double>(recv_.data() + off, nr * k), nb.rank, 12, req);
+    off += nb.shared.size() * k;
+  }
+  off = 0;
+  for (const auto& nb : d_.neighbors) {
+    std::size_t ns = 0;
+    for (int i : nb.shared)
+      if (d_.node_owner[i] == d_.rank)
+        for (std::size_t c = 0; c < k; ++c) send_[off + ns++] = arrays[c][i];
+    comm_.isend(std::span<const double>(send_.data() + off, ns), nb.rank, 12, req);
+    off += nb.shared.size() * k;
+  }
+  req.wait();
+  off = 0;
+  for (const auto& nb : d_.neighbors) {
+    std::size_t j = 0;
+    for (int i : nb.shared)
+      if (d_.node_owner[i] == nb.rank)
+        for (std::size_t c = 0; c < k; ++c) arrays[c][i] = recv_[off + j++];
+    off += nb.shared.size() * k;
+  }
 }
 
 void gather_corners(const FeDecomposition& d, const std::vector<const double*>& corner,

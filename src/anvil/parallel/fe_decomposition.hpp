@@ -24,6 +24,7 @@ struct FeDecomposition {
 
   std::vector<std::int64_t> node_gid;   // global id of each local node, ascending
   std::vector<std::uint8_t> node_owned; // 1 where this rank owns the node
+  std::vector<int> node_owner;          // owning rank of each local node (lowest toucher)
 
   struct Block {
     std::vector<std::int64_t> gid;        // owned elements of this mesh block, ascending
@@ -43,6 +44,7 @@ struct FeDecomposition {
     std::vector<std::int64_t> send_slots; // our corner slots it needs, in agreed order
     std::size_t recv_base = 0;            // first remote slot it fills
     std::size_t recv_count = 0;
+    std::vector<int> shared;              // local nodes both ranks hold, ascending gid
   };
   std::vector<Neighbor> neighbors; // ascending rank
 
@@ -61,6 +63,20 @@ public:
   CornerExchange(const FeDecomposition& d, const Comm& comm);
   // Fills the remote slots of `components` arrays of total_slots() values each.
   void exchange(const std::vector<double*>& arrays);
+
+private:
+  const FeDecomposition& d_;
+  const Comm& comm_;
+  std::vector<double> send_, recv_;
+};
+
+// Copies nodal values from each shared node's owner to the other ranks that hold it
+// (for values computed on owners only, such as contact forces).
+class NodeExchange {
+public:
+  NodeExchange(const FeDecomposition& d, const Comm& comm);
+  // `arrays` hold one value per local node; non-owned shared entries are overwritten.
+  void from_owners(const std::vector<double*>& arrays);
 
 private:
   const FeDecomposition& d_;

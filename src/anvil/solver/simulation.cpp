@@ -87,6 +87,10 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
   comm_.sum(std::span<double>(part_mass_));
 
   wall_impulse_.assign(config_.rigid_walls.size(), 0.0);
+  if (!config_.contact.empty()) {
+    contact_ = std::make_unique<ContactPhase>(config_.contact[0], mesh, fe_, blocks_, comm_);
+    for (auto& f : contact_force_) f.assign(nn, 0.0);
+  }
   apply_initial_conditions(mesh);
   // Constraints stop the constrained velocity components at once (a node on a fixed
   // impact face hits the wall at t = 0): the kinetic energy they remove is work done by
@@ -314,7 +318,39 @@ void Simulation::predict() {
   sample_dt_ = dt;
 }
 
+void Simulation::sph_forces() {
+  ScopedPhase t(timers_, Phase::sph); // no particles in this version
+}
+
+ContactNodes Simulation::contact_view() {
+  return {{nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()},
+          {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()},
+          nodes_.mass.data(),
+          {contact_force_[0].data(), contact_force_[1].data(), contact_force_[2].data()}};
+}
+
+void Simulation::detect_contacts() {
+  if (contact_) contact_->detect(contact_view(), clock_.dt, timers_);
+}
+
 void Simulation::correct() {
+  if (contact_) {
+    contact_->forces(contact_view(), clock_.dt, timers_);
+    ScopedPhase t(timers_, Phase::contact_force);
+    // The penalty impulse acts over the velocity step: dv = dt_avg f / m.
+    double work = 0;
+    for (std::size_t n = 0; n < nodes_.size(); ++n) {
+      const double inv_m = dt_avg_ / nodes_.mass[n];
+      for (int i = 0; i < 3; ++i) {
+        const double f = contact_force_[i][n];
+        if (f == 0.0 || (constrained_[n] & (1u << i))) continue;
+        const double old = nodes_.v[i][n];
+        nodes_.v[i][n] = old + inv_m * f;
+        if (fe_.node_owned[n]) work += f * dt_avg_ * 0.5 * (old + nodes_.v[i][n]);
+      }
+    }
+    contact_energy_ -= work;
+  }
   ScopedPhase t(timers_, Phase::contact_force);
   if (config_.rigid_walls.empty()) return;
   std::fill(wall_impulse_.begin(), wall_impulse_.end(), 0.0);
@@ -350,13 +386,14 @@ Sample Simulation::sample() const {
   s.time = clock_.cycle == 0 ? 0.0 : sample_time_;
   s.cycle = clock_.cycle == 0 ? 0 : sample_cycle_;
   s.dt = sample_dt_;
-  double local[4] = {kinetic_local_, 0, 0, external_work_};
+  double local[5] = {kinetic_local_, 0, 0, external_work_, contact_energy_};
   for (const auto& b : blocks_)
     for (int e = 0; e < b.size(); ++e) {
       local[1] += b.internal_energy[e];
       local[2] += b.hourglass_energy[e];
     }
-  comm_.sum(std::span<double>(local, 4));
+  comm_.sum(std::span<double>(local, 5));
+  s.contact = local[4];
   s.kinetic = local[0];
   s.internal = local[1];
   s.hourglass = local[2];

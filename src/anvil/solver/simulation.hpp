@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "anvil/contact/contact_phase.hpp"
 #include "anvil/core/timer.hpp"
 #include "anvil/fe/hex_block.hpp"
 #include "anvil/io/config.hpp"
@@ -80,6 +81,7 @@ public:
   const std::vector<HexBlock>& blocks() const { return blocks_; }
   const FeDecomposition& fe() const { return fe_; }
   const PhaseTimers& timers() const { return timers_; }
+  const ContactPhase* contact() const { return contact_.get(); }
   std::int64_t global_nodes() const { return global_nodes_; }
   std::int64_t global_elements() const { return global_elements_; }
   const std::vector<double>& part_masses() const { return part_mass_; }
@@ -88,8 +90,11 @@ public:
 
 private:
   void fe_forces();
+  void sph_forces();
   void predict();
+  void detect_contacts();
   void correct();
+  ContactNodes contact_view();
   void update();
   void apply_initial_conditions(const Mesh& mesh);
   void apply_boundary_conditions(const Mesh& mesh);
@@ -113,6 +118,12 @@ private:
   std::vector<std::uint8_t> constrained_;
   std::array<std::vector<double>, 3> v_bc_;
   std::vector<int> constrained_nodes_; // local nodes with any constraint
+
+  // Contact (null without a contact definition): the contact decomposition and the
+  // contact force per local node of the current cycle.
+  std::unique_ptr<ContactPhase> contact_;
+  std::array<std::vector<double>, 3> contact_force_;
+  double contact_energy_ = 0; // penalty energy stored plus friction dissipated, owned nodes
 
   // Rigid walls: normal impulse given to owned nodes in the last step, per wall.
   std::vector<double> wall_impulse_;

@@ -1,0 +1,237 @@
+#include "anvil/contact/contact_phase.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace anvil {
+
+ContactPhase::~ContactPhase() = default;
+
+ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const FeDecomposition& fe,
+                           const std::vector<HexBlock>& blocks, const Comm& comm)
+    : config_(config), fe_(fe), comm_(comm), rcb_(comm) {
+  global_nodes_ = mesh.num_nodes();
+  std::vector<bool> selected(mesh.blocks.size(), config.parts.empty());
+  for (const auto& name : config.parts)
+    for (std::size_t b = 0; b < mesh.blocks.size(); ++b)
+      if (mesh.blocks[b].name == name) selected[b] = true;
+  const ExteriorFaces surf = exterior_faces(mesh, selected);
+
+  auto local = [&](std::int64_t gid) {
+    const auto it = std::lower_bound(fe.node_gid.begin(), fe.node_gid.end(), gid);
+    return (it != fe.node_gid.end() && *it == gid) ? static_cast<int>(it - fe.node_gid.begin()) : -1;
+  };
+  for (auto gid : surf.contact_nodes) {
+    const int l = local(gid);
+    if (l >= 0 && fe.node_owned[l]) my_nodes_.push_back(l);
+  }
+  // Faces of owned elements, with the penalty stiffness k = scale K A^2 / V and the
+  // contact depth fraction V / A of their element, from the initial geometry.
+  const auto offsets = mesh.block_offsets();
+  for (std::size_t f = 0; f < surf.size(); ++f) {
+    const std::int64_t el = surf.element[f];
+    const auto b = static_cast<std::size_t>(std::upper_bound(offsets.begin(), offsets.end(), el) - offsets.begin() - 1);
+    const auto& gids = blocks[b].gid;
+    const auto it = std::lower_bound(gids.begin(), gids.end(), el);
+    if (it == gids.end() || *it != el) continue;
+    const auto e = static_cast<std::size_t>(it - gids.begin());
+    std::array<int, 4> ln;
+    std::array<Vec3, 4> p;
+    for (int a = 0; a < 4; ++a) {
+      ln[a] = local(surf.nodes[f][a]);
+      p[a] = mesh.nodes[surf.nodes[f][a]];
+    }
+    const double area = 0.5 * norm(cross(p[2] - p[0], p[3] - p[1]));
+    const double vol = blocks[b].volume[e];
+    const double K = blocks[b].material->elastic().bulk;
+    my_face_gid_.push_back(static_cast<std::int64_t>(f));
+    my_face_nodes_.push_back(ln);
+    my_face_stiffness_.push_back(config.penalty_scale * K * area * area / vol);
+    my_face_depth_.push_back(config.depth_fraction * vol / area);
+    my_face_element_.emplace_back(el, surf.side[f]);
+  }
+  my_face_rank_.assign(my_face_gid_.size(), comm.rank());
+  exchange_ = std::make_unique<NodeExchange>(fe, comm);
+}
+
+void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers) {
+  ++stats_.cycles;
+  auto predicted = [&](int l, int i) { return nd.x[i][l] + dt * nd.v[i][l]; };
+
+  // Items leaving the FE decomposition: owned contact nodes, faces of owned elements.
+  node_out_.resize(my_nodes_.size());
+  for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
+    const int l = my_nodes_[k];
+    auto& it = node_out_[k];
+    it.gid = fe_.node_gid[static_cast<std::size_t>(l)];
+    it.owner = comm_.rank();
+    for (int i = 0; i < 3; ++i) {
+      it.x[i] = predicted(l, i);
+      it.v[i] = nd.v[i][l];
+    }
+    it.mass = nd.mass[l];
+  }
+  const std::size_t nf = my_face_gid_.size();
+  std::vector<ContactFaceItem>& faces = face_local_;
+  faces.resize(nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    auto& it = faces[f];
+    it.gid = my_face_gid_[f];
+    for (int a = 0; a < 4; ++a) {
+      const int l = my_face_nodes_[f][a];
+      it.node[a] = fe_.node_gid[static_cast<std::size_t>(l)];
+      it.owner[a] = fe_.node_owner[static_cast<std::size_t>(l)];
+      for (int i = 0; i < 3; ++i) {
+        it.x[a][i] = predicted(l, i);
+        it.v[a][i] = nd.v[i][l];
+      }
+      it.mass[a] = nd.mass[l];
+    }
+    it.stiffness = my_face_stiffness_[f];
+    it.depth = my_face_depth_[f];
+  }
+
+  // Rebalance: RCB of node positions and face centroids, unit weights.
+  if (rebalance_due_) {
+    ScopedPhase t(timers, Phase::rebalance);
+    const std::size_t np = node_out_.size() + nf;
+    px_.resize(np);
+    py_.resize(np);
+    pz_.resize(np);
+    pid_.resize(np);
+    for (std::size_t k = 0; k < node_out_.size(); ++k) {
+      px_[k] = node_out_[k].x[0];
+      py_[k] = node_out_[k].x[1];
+      pz_[k] = node_out_[k].x[2];
+      pid_[k] = node_out_[k].gid;
+    }
+    for (std::size_t f = 0; f < nf; ++f) {
+      double c[3] = {0, 0, 0};
+      for (int a = 0; a < 4; ++a)
+        for (int i = 0; i < 3; ++i) c[i] += 0.25 * faces[f].x[a][i];
+      const std::size_t k = node_out_.size() + f;
+      px_[k] = c[0];
+      py_[k] = c[1];
+      pz_[k] = c[2];
+      pid_[k] = global_nodes_ + faces[f].gid;
+    }
+    const RcbPoints pts{px_, py_, pz_, pid_, {}};
+    if (partitioned_) rcb_.repartition(pts);
+    else rcb_.partition(pts);
+    partitioned_ = true;
+    rebalance_due_ = false;
+    ++stats_.rebalances;
+  }
+
+  {
+    ScopedPhase t(timers, Phase::transfer);
+    node_dest_.resize(node_out_.size());
+    for (std::size_t k = 0; k < node_out_.size(); ++k)
+      node_dest_[k] = rcb_.owner({node_out_[k].x[0], node_out_[k].x[1], node_out_[k].x[2]});
+    // Faces go to every rank their capture box touches (ghosts), as copies.
+    face_dest_.clear();
+    face_out_.clear();
+    for (std::size_t f = 0; f < nf; ++f) {
+      Box3 box;
+      double c[3] = {0, 0, 0};
+      for (int i = 0; i < 3; ++i) {
+        double lo = faces[f].x[0][i], hi = lo;
+        for (int a = 0; a < 4; ++a) {
+          lo = std::min(lo, faces[f].x[a][i]);
+          hi = std::max(hi, faces[f].x[a][i]);
+          c[i] += 0.25 * faces[f].x[a][i];
+        }
+        box.lo[i] = lo - faces[f].depth;
+        box.hi[i] = hi + faces[f].depth;
+      }
+      my_face_rank_[f] = rcb_.owner({c[0], c[1], c[2]});
+      rcb_.overlapping(box, ranks_);
+      for (int r : ranks_) {
+        face_out_.push_back(faces[f]);
+        face_dest_.push_back(r);
+      }
+    }
+    node_plan_.build(comm_, node_dest_);
+    face_plan_.build(comm_, face_dest_);
+    node_plan_.forward(node_out_, node_in_);
+    face_plan_.forward(face_out_, face_in_);
+    stats_.bytes_sent += static_cast<double>(node_out_.size() * sizeof(ContactNodeItem) +
+                                             face_out_.size() * sizeof(ContactFaceItem));
+  }
+
+  {
+    ScopedPhase t(timers, Phase::contact_search);
+    find_contacts(node_in_, face_in_, SearchOptions{}, search_, pairs_);
+  }
+}
+
+void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers) {
+  const std::size_t nn = fe_.node_gid.size();
+  for (int i = 0; i < 3; ++i) std::fill(nd.force[i], nd.force[i] + nn, 0.0);
+  {
+    ScopedPhase t(timers, Phase::contact_force);
+    force_out_.clear();
+    force_dest_.clear();
+    penalty_forces(node_in_, face_in_, pairs_, {config_.friction, dt}, force_out_, force_dest_);
+    double deepest = 0;
+    for (const auto& p : pairs_) deepest = std::max(deepest, -p.gap);
+    // Load of this rank: nodes searched plus faces held; one reduction for the balance
+    // test, the pair count and the deepest penetration.
+    double red[4] = {static_cast<double>(node_in_.size() + face_in_.size()), 0, static_cast<double>(pairs_.size()), deepest};
+    red[1] = red[0];
+    double mx[2] = {red[0], red[3]};
+    comm_.max(std::span<double>(mx, 2));
+    comm_.sum(std::span<double>(red + 1, 2));
+    const double mean = red[1] / comm_.size();
+    stats_.imbalance = mean > 0 ? mx[0] / mean : 1.0;
+    stats_.imbalance_max = std::max(stats_.imbalance_max, stats_.imbalance);
+    stats_.pairs = static_cast<std::int64_t>(red[2]);
+    stats_.max_penetration = std::max(stats_.max_penetration, mx[1]);
+    rebalance_due_ = stats_.imbalance > config_.rebalance_threshold;
+  }
+
+  {
+    ScopedPhase t(timers, Phase::transfer);
+    force_plan_.build(comm_, force_dest_);
+    force_plan_.forward(force_out_, force_in_);
+    stats_.bytes_sent += static_cast<double>(force_out_.size() * sizeof(ContactForceItem));
+  }
+
+  {
+    ScopedPhase t(timers, Phase::contact_force);
+    // Owners add the contributions to each node in ascending (node, pair node): the sum
+    // no longer depends on where the pairs were found.
+    std::sort(force_in_.begin(), force_in_.end(), [](const ContactForceItem& a, const ContactForceItem& b) {
+      return a.target != b.target ? a.target < b.target : a.slave < b.slave;
+    });
+    for (const auto& it : force_in_) {
+      const auto pos = std::lower_bound(fe_.node_gid.begin(), fe_.node_gid.end(), it.target);
+      const auto l = static_cast<std::size_t>(pos - fe_.node_gid.begin());
+      for (int i = 0; i < 3; ++i) nd.force[i][l] += it.f[i];
+    }
+  }
+  {
+    ScopedPhase t(timers, Phase::transfer);
+    exchange_->from_owners({nd.force[0], nd.force[1], nd.force[2]});
+  }
+}
+
+std::vector<std::vector<int>> ContactPhase::element_contact_rank(const std::vector<HexBlock>& blocks) const {
+  std::vector<std::vector<int>> out(blocks.size());
+  for (std::size_t b = 0; b < blocks.size(); ++b) out[b].assign(static_cast<std::size_t>(blocks[b].size()), -1);
+  for (std::size_t f = 0; f < my_face_gid_.size(); ++f) {
+    const auto [el, side] = my_face_element_[f];
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+      const auto& g = blocks[b].gid;
+      const auto it = std::lower_bound(g.begin(), g.end(), el);
+      if (it != g.end() && *it == el) {
+        auto& slot = out[b][static_cast<std::size_t>(it - g.begin())];
+        if (slot < 0) slot = my_face_rank_[f];
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+} // namespace anvil

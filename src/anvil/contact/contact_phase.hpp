@@ -1,0 +1,100 @@
+// The paper's contact decomposition (steps 4 and 5 of the cycle). Every cycle the contact
+// nodes (owned copies) and the exterior faces (from their elements' owners) are moved from
+// the static FE decomposition to a dynamic RCB decomposition of node positions and face
+// centroids: a node to the rank whose box holds its predicted position, a face to every
+// rank whose box its capture box overlaps (ghosting). Each rank searches its own nodes
+// against the faces it holds, computes penalty forces, and sends each force to the FE
+// owner of the node it acts on; owners sum them in ascending pair id and pass the sums to
+// the other ranks that hold the node. The RCB is recomputed only when the load imbalance
+// exceeds a threshold (incrementally, from the previous cuts).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "anvil/contact/penalty.hpp"
+#include "anvil/contact/search.hpp"
+#include "anvil/contact/surface.hpp"
+#include "anvil/core/timer.hpp"
+#include "anvil/fe/hex_block.hpp"
+#include "anvil/io/config.hpp"
+#include "anvil/parallel/comm.hpp"
+#include "anvil/parallel/fe_decomposition.hpp"
+#include "anvil/parallel/migration.hpp"
+#include "anvil/parallel/rcb.hpp"
+
+namespace anvil {
+
+struct ContactStats {
+  std::int64_t cycles = 0;
+  std::int64_t rebalances = 0;      // RCB recomputations
+  std::int64_t pairs = 0;           // node-face pairs in the last cycle (all ranks)
+  double imbalance = 1;             // last cycle's max/mean contact work per rank
+  double imbalance_max = 1;         // the largest seen
+  double bytes_sent = 0;            // this rank, all cycles (transfers and forces)
+  double max_penetration = 0;       // largest gap behind a face, over all cycles, m
+};
+
+// FE-side view of the nodes the contact phase reads and writes.
+struct ContactNodes {
+  const double* x[3];       // positions at t(n)
+  const double* v[3];       // predicted velocities v(n+1/2)
+  const double* mass;
+  double* force[3];         // out: contact force per local node (N), zero where none
+};
+
+class ContactPhase {
+public:
+  // Builds the surfaces of the deck's contact parts from the global mesh (every rank holds
+  // it at setup) and the element data of this rank's blocks. Collective.
+  ContactPhase(const ContactConfig& config, const Mesh& mesh, const FeDecomposition& fe,
+               const std::vector<HexBlock>& blocks, const Comm& comm);
+  ~ContactPhase();
+
+  // Step 4 for the motion predicted over dt: moves nodes and faces to the contact
+  // decomposition (rebalancing it when due) and finds the node-face pairs. Collective.
+  void detect(const ContactNodes& nodes, double dt, PhaseTimers& timers);
+  // Step 5: penalty forces of the pairs, returned to the FE owners, summed in ascending
+  // pair id and copied to every rank holding the node: fills `nodes.force`. Collective.
+  void forces(const ContactNodes& nodes, double dt, PhaseTimers& timers);
+
+  const ContactStats& stats() const { return stats_; }
+  // RCB owner rank of each face of each owned element, -1 where the element has none
+  // (first exterior face by side), per block and element (for the contact_rank field).
+  std::vector<std::vector<int>> element_contact_rank(const std::vector<HexBlock>& blocks) const;
+
+private:
+  const ContactConfig config_;
+  const FeDecomposition& fe_;
+  const Comm& comm_;
+  std::int64_t global_nodes_ = 0; // offset that keeps face point ids apart from node ids
+
+  // FE side (this rank): contact nodes it owns and faces of elements it owns.
+  std::vector<int> my_nodes_;                     // local node indices
+  std::vector<std::int64_t> my_face_gid_;
+  std::vector<std::array<int, 4>> my_face_nodes_; // local node indices
+  std::vector<double> my_face_stiffness_, my_face_depth_;
+  std::vector<std::pair<std::int64_t, int>> my_face_element_; // (element gid, side)
+  std::vector<int> my_face_rank_;                 // contact rank of the centroid, last cycle
+
+  Rcb rcb_;
+  bool partitioned_ = false;
+  bool rebalance_due_ = true;
+
+  // Buffers reused every cycle.
+  std::vector<double> px_, py_, pz_, pw_;
+  std::vector<std::int64_t> pid_;
+  std::vector<ContactNodeItem> node_out_, node_in_;
+  std::vector<ContactFaceItem> face_local_, face_out_, face_in_; // per face, per copy, received
+  std::vector<int> node_dest_, face_dest_, ranks_;
+  std::vector<ContactPair> pairs_;
+  std::vector<ContactForceItem> force_out_, force_in_;
+  std::vector<int> force_dest_;
+  SearchWorkspace search_;
+  Migration node_plan_, face_plan_, force_plan_;
+  std::unique_ptr<NodeExchange> exchange_;
+  ContactStats stats_;
+};
+
+} // namespace anvil
