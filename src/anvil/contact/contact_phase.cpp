@@ -19,7 +19,8 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
 
   auto local = [&](std::int64_t gid) {
     const auto it = std::lower_bound(fe.node_gid.begin(), fe.node_gid.end(), gid);
-    return (it != fe.node_gid.end() && *it == gid) ? static_cast<int>(it - fe.node_gid.begin()) : -1;
+    return (it != fe.node_gid.end() && *it == gid) ? static_cast<int>(it - fe.node_gid.begin())
+                                                   : -1;
   };
   for (auto gid : surf.contact_nodes) {
     const int l = local(gid);
@@ -30,7 +31,8 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
   const auto offsets = mesh.block_offsets();
   for (std::size_t f = 0; f < surf.size(); ++f) {
     const std::int64_t el = surf.element[f];
-    const auto b = static_cast<std::size_t>(std::upper_bound(offsets.begin(), offsets.end(), el) - offsets.begin() - 1);
+    const auto b = static_cast<std::size_t>(std::upper_bound(offsets.begin(), offsets.end(), el) -
+                                            offsets.begin() - 1);
     const auto& gids = blocks[b].gid;
     const auto it = std::lower_bound(gids.begin(), gids.end(), el);
     if (it == gids.end() || *it != el) continue;
@@ -51,6 +53,7 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
     my_face_element_.emplace_back(el, surf.side[f]);
   }
   my_face_rank_.assign(my_face_gid_.size(), comm.rank());
+  last_face_.assign(fe.node_gid.size(), -1);
   exchange_ = std::make_unique<NodeExchange>(fe, comm);
 }
 
@@ -70,6 +73,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       it.v[i] = nd.v[i][l];
     }
     it.mass = nd.mass[l];
+    it.last_face = last_face_[static_cast<std::size_t>(l)];
   }
   const std::size_t nf = my_face_gid_.size();
   std::vector<ContactFaceItem>& faces = face_local_;
@@ -116,8 +120,10 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       pid_[k] = global_nodes_ + faces[f].gid;
     }
     const RcbPoints pts{px_, py_, pz_, pid_, {}};
-    if (partitioned_) rcb_.repartition(pts);
-    else rcb_.partition(pts);
+    if (partitioned_)
+      rcb_.repartition(pts);
+    else
+      rcb_.partition(pts);
     partitioned_ = true;
     rebalance_due_ = false;
     ++stats_.rebalances;
@@ -141,8 +147,8 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
           hi = std::max(hi, faces[f].x[a][i]);
           c[i] += 0.25 * faces[f].x[a][i];
         }
-        box.lo[i] = lo - faces[f].depth;
-        box.hi[i] = hi + faces[f].depth;
+        box.lo[i] = lo - 2 * faces[f].depth;
+        box.hi[i] = hi + 2 * faces[f].depth;
       }
       my_face_rank_[f] = rcb_.owner({c[0], c[1], c[2]});
       rcb_.overlapping(box, ranks_);
@@ -177,7 +183,8 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
     for (const auto& p : pairs_) deepest = std::max(deepest, -p.gap);
     // Load of this rank: nodes searched plus faces held; one reduction for the balance
     // test, the pair count and the deepest penetration.
-    double red[4] = {static_cast<double>(node_in_.size() + face_in_.size()), 0, static_cast<double>(pairs_.size()), deepest};
+    double red[4] = {static_cast<double>(node_in_.size() + face_in_.size()), 0,
+                     static_cast<double>(pairs_.size()), deepest};
     red[1] = red[0];
     double mx[2] = {red[0], red[3]};
     comm_.max(std::span<double>(mx, 2));
@@ -201,13 +208,16 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
     ScopedPhase t(timers, Phase::contact_force);
     // Owners add the contributions to each node in ascending (node, pair node): the sum
     // no longer depends on where the pairs were found.
-    std::sort(force_in_.begin(), force_in_.end(), [](const ContactForceItem& a, const ContactForceItem& b) {
-      return a.target != b.target ? a.target < b.target : a.slave < b.slave;
-    });
+    std::sort(force_in_.begin(), force_in_.end(),
+              [](const ContactForceItem& a, const ContactForceItem& b) {
+                return a.target != b.target ? a.target < b.target : a.slave < b.slave;
+              });
+    for (int l : my_nodes_) last_face_[static_cast<std::size_t>(l)] = -1;
     for (const auto& it : force_in_) {
       const auto pos = std::lower_bound(fe_.node_gid.begin(), fe_.node_gid.end(), it.target);
       const auto l = static_cast<std::size_t>(pos - fe_.node_gid.begin());
       for (int i = 0; i < 3; ++i) nd.force[i][l] += it.f[i];
+      if (it.target == it.slave) last_face_[l] = it.face;
     }
   }
   {
@@ -216,9 +226,11 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
   }
 }
 
-std::vector<std::vector<int>> ContactPhase::element_contact_rank(const std::vector<HexBlock>& blocks) const {
+std::vector<std::vector<int>>
+ContactPhase::element_contact_rank(const std::vector<HexBlock>& blocks) const {
   std::vector<std::vector<int>> out(blocks.size());
-  for (std::size_t b = 0; b < blocks.size(); ++b) out[b].assign(static_cast<std::size_t>(blocks[b].size()), -1);
+  for (std::size_t b = 0; b < blocks.size(); ++b)
+    out[b].assign(static_cast<std::size_t>(blocks[b].size()), -1);
   for (std::size_t f = 0; f < my_face_gid_.size(); ++f) {
     const auto [el, side] = my_face_element_[f];
     for (std::size_t b = 0; b < blocks.size(); ++b) {

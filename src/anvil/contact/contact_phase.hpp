@@ -28,20 +28,20 @@ namespace anvil {
 
 struct ContactStats {
   std::int64_t cycles = 0;
-  std::int64_t rebalances = 0;      // RCB recomputations
-  std::int64_t pairs = 0;           // node-face pairs in the last cycle (all ranks)
-  double imbalance = 1;             // last cycle's max/mean contact work per rank
-  double imbalance_max = 1;         // the largest seen
-  double bytes_sent = 0;            // this rank, all cycles (transfers and forces)
-  double max_penetration = 0;       // largest gap behind a face, over all cycles, m
+  std::int64_t rebalances = 0; // RCB recomputations
+  std::int64_t pairs = 0;      // node-face pairs in the last cycle (all ranks)
+  double imbalance = 1;        // last cycle's max/mean contact work per rank
+  double imbalance_max = 1;    // the largest seen
+  double bytes_sent = 0;       // this rank, all cycles (transfers and forces)
+  double max_penetration = 0;  // largest gap behind a face, over all cycles, m
 };
 
 // FE-side view of the nodes the contact phase reads and writes.
 struct ContactNodes {
-  const double* x[3];       // positions at t(n)
-  const double* v[3];       // predicted velocities v(n+1/2)
+  const double* x[3]; // positions at t(n)
+  const double* v[3]; // predicted velocities v(n+1/2)
   const double* mass;
-  double* force[3];         // out: contact force per local node (N), zero where none
+  double* force[3]; // out: contact force per local node (N), zero where none
 };
 
 class ContactPhase {
@@ -71,12 +71,13 @@ private:
   std::int64_t global_nodes_ = 0; // offset that keeps face point ids apart from node ids
 
   // FE side (this rank): contact nodes it owns and faces of elements it owns.
-  std::vector<int> my_nodes_;                     // local node indices
+  std::vector<int> my_nodes_;           // local node indices
+  std::vector<std::int64_t> last_face_; // per local node: face contacted last cycle
   std::vector<std::int64_t> my_face_gid_;
   std::vector<std::array<int, 4>> my_face_nodes_; // local node indices
   std::vector<double> my_face_stiffness_, my_face_depth_;
   std::vector<std::pair<std::int64_t, int>> my_face_element_; // (element gid, side)
-  std::vector<int> my_face_rank_;                 // contact rank of the centroid, last cycle
+  std::vector<int> my_face_rank_; // contact rank of the centroid, last cycle
 
   Rcb rcb_;
   bool partitioned_ = false;

@@ -31,10 +31,10 @@ void penalty_forces(const std::vector<ContactNodeItem>& nodes,
         F -= (ft / speed) * vt;
       }
     }
-    items.push_back({n.gid, n.gid, {F.x, F.y, F.z}});
+    items.push_back({n.gid, n.gid, f.gid, {F.x, F.y, F.z}});
     dest.push_back(n.owner);
     for (int a = 0; a < 4; ++a) {
-      items.push_back({f.node[a], n.gid, {-N[a] * F.x, -N[a] * F.y, -N[a] * F.z}});
+      items.push_back({f.node[a], n.gid, -1, {-N[a] * F.x, -N[a] * F.y, -N[a] * F.z}});
       dest.push_back(f.owner[a]);
     }
   }

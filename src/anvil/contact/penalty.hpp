@@ -19,6 +19,7 @@ namespace anvil {
 struct ContactForceItem {
   std::int64_t target; // node receiving the force (global id)
   std::int64_t slave;  // the pair's node, the key of the summation order
+  std::int64_t face;   // the pair's face on the slave's own item, -1 on the face nodes'
   double f[3];         // N
 };
 

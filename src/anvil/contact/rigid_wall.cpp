@@ -30,7 +30,9 @@ double apply_rigid_walls(const std::vector<RigidWallConfig>& walls, double dt, W
       for (int i = 0; i < 3; ++i) nd.v[i][k] = vn[i];
       if (nd.owned[k]) {
         impulse[w] += nd.mass[k] * dvn;
-        work += nd.mass[k] * dot(vn - v, 0.5 * (v + vn));
+        // Impulse times the mean of the step's start and end velocities.
+        const Vec3 v0{nd.v_start[0][k], nd.v_start[1][k], nd.v_start[2][k]};
+        work += nd.mass[k] * dot(vn - v, 0.5 * (v0 + vn));
       }
     }
   }

@@ -15,8 +15,9 @@
 namespace anvil {
 
 struct WallNodes {
-  const double* x[3]; // positions at t(n)
-  double* v[3];       // in: predicted v(n+1/2); out: corrected
+  const double* x[3];       // positions at t(n)
+  double* v[3];             // in: predicted v(n+1/2); out: corrected
+  const double* v_start[3]; // v(n-1/2), for the work of the wall impulses
   const double* mass;
   const std::uint8_t* constrained; // bit i: component i is constrained and left alone
   const std::uint8_t* owned;       // diagnostics count owned nodes only

@@ -25,8 +25,8 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
         lo = std::min(lo, faces[f].x[a][i]);
         hi = std::max(hi, faces[f].x[a][i]);
       }
-      b[i] = lo - faces[f].depth;
-      b[3 + i] = hi + faces[f].depth;
+      b[i] = lo - 2 * faces[f].depth;
+      b[3 + i] = hi + 2 * faces[f].depth;
       cell = std::max(cell, b[3 + i] - b[i]);
     }
   }
@@ -79,14 +79,41 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
     });
 
   const double tol = 1 + opt.parametric_tolerance;
+  std::vector<const ContactFaceItem*>& own = w.own;
   for (std::size_t n = 0; n < nodes.size(); ++n) {
     const auto& nd = nodes[n];
     const Vec3 p{nd.x[0], nd.x[1], nd.x[2]};
     const std::size_t c =
         (static_cast<std::size_t>(index(2, p.z)) * dims[1] + index(1, p.y)) * dims[0] +
         index(0, p.x);
-    ContactPair best;
-    bool found = false;
+    // The node's outward normal: the sum of the area normals of its own faces (all of
+    // them are among the candidates: their capture boxes hold the node), taken in
+    // ascending face id so that every rank gets the same bits.
+    own.clear();
+    for (int k = w.cell_start[c]; k < w.cell_start[c + 1]; ++k) {
+      const auto& fc = faces[static_cast<std::size_t>(w.cell_faces[static_cast<std::size_t>(k)])];
+      if (fc.node[0] == nd.gid || fc.node[1] == nd.gid || fc.node[2] == nd.gid ||
+          fc.node[3] == nd.gid)
+        own.push_back(&fc);
+    }
+    std::sort(own.begin(), own.end(),
+              [](const ContactFaceItem* a, const ContactFaceItem* b) { return a->gid < b->gid; });
+    own.erase(std::unique(own.begin(), own.end(),
+                          [](const ContactFaceItem* a, const ContactFaceItem* b) {
+                            return a->gid == b->gid;
+                          }),
+              own.end());
+    Vec3 node_normal;
+    for (const ContactFaceItem* fc : own) {
+      const Vec3 d1{fc->x[2][0] - fc->x[0][0], fc->x[2][1] - fc->x[0][1],
+                    fc->x[2][2] - fc->x[0][2]};
+      const Vec3 d2{fc->x[3][0] - fc->x[1][0], fc->x[3][1] - fc->x[1][1],
+                    fc->x[3][2] - fc->x[1][2]};
+      node_normal += cross(d1, d2);
+    }
+
+    ContactPair best, tracked;
+    bool found = false, have_tracked = false;
     std::int64_t best_gid = 0;
     for (int k = w.cell_start[c]; k < w.cell_start[c + 1]; ++k) {
       const int f = w.cell_faces[static_cast<std::size_t>(k)];
@@ -101,8 +128,15 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
           Vec3{fc.x[0][0], fc.x[0][1], fc.x[0][2]}, Vec3{fc.x[1][0], fc.x[1][1], fc.x[1][2]},
           Vec3{fc.x[2][0], fc.x[2][1], fc.x[2][2]}, Vec3{fc.x[3][0], fc.x[3][1], fc.x[3][2]}};
       const QuadProjection q = project_on_quad(x, p);
-      if (!q.converged || std::abs(q.xi) > tol || std::abs(q.eta) > tol) continue;
-      if (!(q.gap < 0) || -q.gap > fc.depth) continue;
+      if (!q.converged || std::abs(q.xi) > tol || std::abs(q.eta) > tol || !(q.gap < 0)) continue;
+      // The surfaces must face each other: a node just outside a convex edge can be
+      // "behind" the side face there while it is in front of the top face.
+      if (!own.empty() && !(dot(node_normal, q.normal) < -0.3 * norm(node_normal))) continue;
+      if (fc.gid == nd.last_face && -q.gap <= 2 * fc.depth) {
+        tracked = {static_cast<int>(n), f, q.xi, q.eta, q.gap, q.normal};
+        have_tracked = true;
+      }
+      if (-q.gap > fc.depth) continue;
       // Least penetration wins; equal penetrations go to the lower face id.
       if (!found || q.gap > best.gap || (q.gap == best.gap && fc.gid < best_gid)) {
         best = {static_cast<int>(n), f, q.xi, q.eta, q.gap, q.normal};
@@ -110,7 +144,10 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
         found = true;
       }
     }
-    if (found) pairs.push_back(best);
+    if (have_tracked)
+      pairs.push_back(tracked);
+    else if (found)
+      pairs.push_back(best);
   }
 }
 

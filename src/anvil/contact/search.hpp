@@ -2,8 +2,13 @@
 // global search by binning (a bucket sort of face capture boxes on a uniform grid, in the
 // spirit of Benson and Hallquist 1990), then the detailed check of Heinstein et al. (1993):
 // the normal projection of each node onto each candidate face, the penetration, and the
-// best face (least penetration, ties by face global id). The result depends only on the
-// nodes and faces given, not on their order or on which rank holds them.
+// best face. A node keeps the face it was in contact with last cycle while it still
+// penetrates it (tracking: near an edge a side face can show less penetration than the
+// face the node came through); otherwise the least penetration wins, ties by face global
+// id. Tracked pairs are followed twice as deep as new ones are accepted. A pair needs the
+// node's outward normal (from its own faces) to oppose the face's. The result
+// depends only on the nodes and faces given, not on their order or on which rank holds
+// them.
 #pragma once
 
 #include <cstdint>
@@ -15,11 +20,12 @@ namespace anvil {
 
 // A contact node in the contact decomposition (trivially copyable: moved by Migration).
 struct ContactNodeItem {
-  std::int64_t gid; // global node id
-  int owner;        // FE rank that owns the node
-  double x[3];      // predicted position x* = x(n) + dt v(n+1/2)
-  double v[3];      // predicted velocity v(n+1/2)
-  double mass;      // lumped nodal mass
+  std::int64_t gid;       // global node id
+  int owner;              // FE rank that owns the node
+  double x[3];            // predicted position x* = x(n) + dt v(n+1/2)
+  double v[3];            // predicted velocity v(n+1/2)
+  double mass;            // lumped nodal mass
+  std::int64_t last_face; // face it was in contact with last cycle, or -1 (tracking)
 };
 
 // A contact face with everything the check and the forces need.
@@ -31,7 +37,7 @@ struct ContactFaceItem {
   double v[4][3];       // predicted node velocities
   double mass[4];       // nodal masses
   double stiffness;     // penalty stiffness, N/m
-  double depth;         // largest penetration treated as contact, m
+  double depth;         // largest penetration accepted for a new pair (twice for a tracked one), m
 };
 
 struct ContactPair {
@@ -49,7 +55,8 @@ struct SearchOptions {
 // Scratch space kept between cycles (no allocation in steady state).
 struct SearchWorkspace {
   std::vector<int> cell_start, cell_faces, face_cells;
-  std::vector<double> box; // 6 per face: capture box
+  std::vector<double> box;                 // 6 per face: capture box
+  std::vector<const ContactFaceItem*> own; // a node's own faces
 };
 
 // Finds, for every node, the face it penetrates (if any): pairs in ascending node index.

@@ -264,8 +264,11 @@ void Outputs::write_summary(int status, const std::string& message) {
   imb["fe"] = ratio(Phase::fe);
   imb["sph"] = 1.0;
   {
-    const double cmax = tmax[static_cast<int>(Phase::contact_search)] + tmax[static_cast<int>(Phase::contact_force)];
-    const double cmean = (tsum[static_cast<int>(Phase::contact_search)] + tsum[static_cast<int>(Phase::contact_force)]) / comm.size();
+    const double cmax = tmax[static_cast<int>(Phase::contact_search)] +
+                        tmax[static_cast<int>(Phase::contact_force)];
+    const double cmean = (tsum[static_cast<int>(Phase::contact_search)] +
+                          tsum[static_cast<int>(Phase::contact_force)]) /
+                         comm.size();
     imb["contact"] = cmean > 0 ? cmax / cmean : 1.0;
   }
   j["imbalance"] = imb;
@@ -276,7 +279,8 @@ void Outputs::write_summary(int status, const std::string& message) {
                     {"load_imbalance_last", contact_stats.imbalance},
                     {"load_imbalance_max", contact_stats.imbalance_max},
                     {"max_penetration", contact_stats.max_penetration},
-                    {"bytes_sent_per_rank_per_cycle_max", bytes_max / static_cast<double>(contact_stats.cycles)}};
+                    {"bytes_sent_per_rank_per_cycle_max",
+                     bytes_max / static_cast<double>(contact_stats.cycles)}};
   }
   j["energy"] = {{"time", s.time},
                  {"initial", sim_.initial_energy()},

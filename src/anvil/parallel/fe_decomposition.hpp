@@ -44,7 +44,7 @@ struct FeDecomposition {
     std::vector<std::int64_t> send_slots; // our corner slots it needs, in agreed order
     std::size_t recv_base = 0;            // first remote slot it fills
     std::size_t recv_count = 0;
-    std::vector<int> shared;              // local nodes both ranks hold, ascending gid
+    std::vector<int> shared; // local nodes both ranks hold, ascending gid
   };
   std::vector<Neighbor> neighbors; // ascending rank
 

@@ -32,16 +32,10 @@ std::vector<int> partition_elements(const Mesh& mesh, int parts) {
   METIS_SetDefaultOptions(options);
   options[METIS_OPTION_NUMBERING] = 0;
   options[METIS_OPTION_SEED] = 12345;
-  options[METIS_OPTION_CONTIG] = 1;
   std::vector<idx_t> epart(static_cast<std::size_t>(ne)), npart(static_cast<std::size_t>(n_nodes));
-  int rc = METIS_PartMeshDual(&n_el, &n_nodes, eptr.data(), eind.data(), nullptr, nullptr, &ncommon,
-                              &nparts, nullptr, options, &objval, epart.data(), npart.data());
-  if (rc != METIS_OK) {
-    // Contiguity cannot always be met (disconnected parts); retry without it.
-    options[METIS_OPTION_CONTIG] = 0;
-    rc = METIS_PartMeshDual(&n_el, &n_nodes, eptr.data(), eind.data(), nullptr, nullptr, &ncommon,
-                            &nparts, nullptr, options, &objval, epart.data(), npart.data());
-  }
+  const int rc =
+      METIS_PartMeshDual(&n_el, &n_nodes, eptr.data(), eind.data(), nullptr, nullptr, &ncommon,
+                         &nparts, nullptr, options, &objval, epart.data(), npart.data());
   if (rc != METIS_OK) throw std::runtime_error("METIS_PartMeshDual failed");
   for (std::size_t i = 0; i < out.size(); ++i) out[i] = static_cast<int>(epart[i]);
   return out;

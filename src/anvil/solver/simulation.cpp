@@ -35,6 +35,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     nodes_.x[i].resize(nn);
     nodes_.v[i].assign(nn, 0.0);
     nodes_.f[i].assign(nn, 0.0);
+    v_prev_[i].assign(nn, 0.0);
   }
   for (std::size_t n = 0; n < nn; ++n)
     for (int i = 0; i < 3; ++i) nodes_.x[i][n] = mesh.nodes[fe_.node_gid[n]][i];
@@ -200,16 +201,12 @@ bool Simulation::finished() const {
 // The cycle.
 
 void Simulation::step() {
-  fe_forces(); // 1. FE internal forces (static decomposition)
-  {            // 2. SPH forces: no particles in this version
-    ScopedPhase t(timers_, Phase::sph);
-  }
-  predict(); // 3. v(n+1/2) = v(n-1/2) + dt a(n)
-  {          // 4. contact detection (contact decomposition)
-    ScopedPhase t(timers_, Phase::contact_search);
-  }
-  correct(); // 5. penalty contact forces and rigid walls correct the velocities
-  update();  // 6. x(n+1), t(n+1), next stable dt
+  fe_forces();       // 1. FE internal forces (static decomposition)
+  sph_forces();      // 2. SPH forces (SPH decomposition)
+  predict();         // 3. v(n+1/2) = v(n-1/2) + dt a(n), x* = x(n) + dt v(n+1/2)
+  detect_contacts(); // 4. contact search on the predicted motion (contact decomposition)
+  correct();         // 5. penalty contact forces and rigid walls correct v(n+1/2)
+  update();          // 6. x(n+1) = x(n) + dt v(n+1/2), t(n+1)
 }
 
 void Simulation::fe_forces() {
@@ -291,6 +288,7 @@ void Simulation::predict() {
       }
     }
   double* v[3] = {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()};
+  double* v_prev[3] = {v_prev_[0].data(), v_prev_[1].data(), v_prev_[2].data()};
   const double* f[3] = {nodes_.f[0].data(), nodes_.f[1].data(), nodes_.f[2].data()};
   const double* m = nodes_.mass.data();
   const std::uint8_t* owned = fe_.node_owned.data();
@@ -300,6 +298,7 @@ void Simulation::predict() {
     double avg2 = 0;
     for (int i = 0; i < 3; ++i) {
       const double old = v[i][n];
+      v_prev[i][n] = old;
       const double nv = (fixed[n] & (1u << i)) ? v_bc_[i][n] : old + dt_avg * f[i][n] * inv_m;
       v[i][n] = nv;
       const double a = 0.5 * (old + nv);
@@ -337,16 +336,17 @@ void Simulation::correct() {
   if (contact_) {
     contact_->forces(contact_view(), clock_.dt, timers_);
     ScopedPhase t(timers_, Phase::contact_force);
-    // The penalty impulse acts over the velocity step: dv = dt_avg f / m.
+    // The penalty impulse acts over the velocity step: dv = dt_avg f / m. Its work is the
+    // impulse times the mean of the step's start and end velocities (attributing the
+    // kinetic energy change of the step exactly among the impulses that make it).
     double work = 0;
     for (std::size_t n = 0; n < nodes_.size(); ++n) {
       const double inv_m = dt_avg_ / nodes_.mass[n];
       for (int i = 0; i < 3; ++i) {
         const double f = contact_force_[i][n];
         if (f == 0.0 || (constrained_[n] & (1u << i))) continue;
-        const double old = nodes_.v[i][n];
-        nodes_.v[i][n] = old + inv_m * f;
-        if (fe_.node_owned[n]) work += f * dt_avg_ * 0.5 * (old + nodes_.v[i][n]);
+        nodes_.v[i][n] += inv_m * f;
+        if (fe_.node_owned[n]) work += f * dt_avg_ * 0.5 * (v_prev_[i][n] + nodes_.v[i][n]);
       }
     }
     contact_energy_ -= work;
@@ -356,6 +356,7 @@ void Simulation::correct() {
   std::fill(wall_impulse_.begin(), wall_impulse_.end(), 0.0);
   const WallNodes wn{{nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()},
                      {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()},
+                     {v_prev_[0].data(), v_prev_[1].data(), v_prev_[2].data()},
                      nodes_.mass.data(),
                      constrained_.data(),
                      fe_.node_owned.data(),
