@@ -48,6 +48,13 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
     const double K = blocks[b].material->elastic().bulk;
     my_face_gid_.push_back(static_cast<std::int64_t>(f));
     my_face_nodes_.push_back(ln);
+    std::array<int, 4> opp{};
+    int k = 0;
+    for (int a = 0; a < 8; ++a)
+      if (std::find(hex_faces[surf.side[f]].begin(), hex_faces[surf.side[f]].end(), a) ==
+          hex_faces[surf.side[f]].end())
+        opp[k++] = blocks[b].conn[a][e];
+    my_face_opposite_.push_back(opp);
     my_face_stiffness_.push_back(config.penalty_scale * K * area * area / vol);
     my_face_depth_.push_back(config.depth_fraction * vol / area);
     my_face_element_.emplace_back(el, surf.side[f]);
@@ -91,6 +98,8 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       }
       it.mass[a] = nd.mass[l];
     }
+    for (int a = 0; a < 4; ++a)
+      it.opposite[a] = fe_.node_gid[static_cast<std::size_t>(my_face_opposite_[f][a])];
     it.stiffness = my_face_stiffness_[f];
     it.depth = my_face_depth_[f];
   }
@@ -138,19 +147,9 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     face_dest_.clear();
     face_out_.clear();
     for (std::size_t f = 0; f < nf; ++f) {
-      Box3 box;
-      double c[3] = {0, 0, 0};
-      for (int i = 0; i < 3; ++i) {
-        double lo = faces[f].x[0][i], hi = lo;
-        for (int a = 0; a < 4; ++a) {
-          lo = std::min(lo, faces[f].x[a][i]);
-          hi = std::max(hi, faces[f].x[a][i]);
-          c[i] += 0.25 * faces[f].x[a][i];
-        }
-        box.lo[i] = lo - 2 * faces[f].depth;
-        box.hi[i] = hi + 2 * faces[f].depth;
-      }
-      my_face_rank_[f] = rcb_.owner({c[0], c[1], c[2]});
+      const Box3 box = capture_box(faces[f]);
+      const Vec3 c = face_plane(faces[f]).centre;
+      my_face_rank_[f] = rcb_.owner(c);
       rcb_.overlapping(box, ranks_);
       for (int r : ranks_) {
         face_out_.push_back(faces[f]);

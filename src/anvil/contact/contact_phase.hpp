@@ -74,7 +74,8 @@ private:
   std::vector<int> my_nodes_;           // local node indices
   std::vector<std::int64_t> last_face_; // per local node: face contacted last cycle
   std::vector<std::int64_t> my_face_gid_;
-  std::vector<std::array<int, 4>> my_face_nodes_; // local node indices
+  std::vector<std::array<int, 4>> my_face_nodes_;    // local node indices
+  std::vector<std::array<int, 4>> my_face_opposite_; // the element's other four nodes
   std::vector<double> my_face_stiffness_, my_face_depth_;
   std::vector<std::pair<std::int64_t, int>> my_face_element_; // (element gid, side)
   std::vector<int> my_face_rank_; // contact rank of the centroid, last cycle

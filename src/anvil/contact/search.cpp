@@ -7,6 +7,38 @@
 
 namespace anvil {
 
+FacePlane face_plane(const ContactFaceItem& f) {
+  const auto& x = f.x;
+  FacePlane p;
+  p.centre = {0.25 * (x[0][0] + x[1][0] + x[2][0] + x[3][0]),
+              0.25 * (x[0][1] + x[1][1] + x[2][1] + x[3][1]),
+              0.25 * (x[0][2] + x[1][2] + x[2][2] + x[3][2])};
+  const Vec3 n = cross(Vec3{x[2][0] - x[0][0], x[2][1] - x[0][1], x[2][2] - x[0][2]},
+                       Vec3{x[3][0] - x[1][0], x[3][1] - x[1][1], x[3][2] - x[1][2]});
+  const double len = norm(n);
+  p.normal = len > 0 ? n * (1 / len) : Vec3{};
+  p.size = std::sqrt(0.5 * len); // the diagonals' cross product is twice the area
+  return p;
+}
+
+Box3 capture_box(const ContactFaceItem& f) {
+  const FacePlane p = face_plane(f);
+  const Vec3 back = p.normal * (-2 * f.depth);
+  const double pad = 0.05 * p.size;
+  Box3 b{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
+  for (int a = 0; a < 4; ++a)
+    for (int i = 0; i < 3; ++i) {
+      const double v = f.x[a][i];
+      b.lo[i] = std::min({b.lo[i], v, v + back[i]});
+      b.hi[i] = std::max({b.hi[i], v, v + back[i]});
+    }
+  for (int i = 0; i < 3; ++i) {
+    b.lo[i] -= pad;
+    b.hi[i] += pad;
+  }
+  return b;
+}
+
 void find_contacts(const std::vector<ContactNodeItem>& nodes,
                    const std::vector<ContactFaceItem>& faces, const SearchOptions& opt,
                    SearchWorkspace& w, std::vector<ContactPair>& pairs) {
@@ -14,22 +46,39 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
   if (nodes.empty() || faces.empty()) return;
   const std::size_t nf = faces.size();
 
-  // Capture boxes: the face's bounding box grown by its contact depth.
   w.box.resize(6 * nf);
-  double cell = 0;
+  w.extent.resize(nf);
+  w.plane.resize(5 * nf);
   for (std::size_t f = 0; f < nf; ++f) {
+    const Box3 cb = capture_box(faces[f]);
     double* b = &w.box[6 * f];
     for (int i = 0; i < 3; ++i) {
-      double lo = faces[f].x[0][i], hi = lo;
-      for (int a = 1; a < 4; ++a) {
-        lo = std::min(lo, faces[f].x[a][i]);
-        hi = std::max(hi, faces[f].x[a][i]);
-      }
-      b[i] = lo - 2 * faces[f].depth;
-      b[3 + i] = hi + 2 * faces[f].depth;
-      cell = std::max(cell, b[3 + i] - b[i]);
+      b[i] = cb.lo[i];
+      b[3 + i] = cb.hi[i];
     }
+    w.extent[f] = std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
+    // Mean plane (unit normal from the diagonals) and how far the warped face strays from
+    // it: cheap tests that discard most candidates before the projection.
+    const auto& x = faces[f].x;
+    double* pl = &w.plane[5 * f];
+    const FacePlane fp = face_plane(faces[f]);
+    const Vec3 nrm = fp.normal;
+    const Vec3 c = fp.centre;
+    double warp = 0;
+    for (int a = 0; a < 4; ++a)
+      warp = std::max(warp, std::abs(dot(Vec3{x[a][0], x[a][1], x[a][2]} - c, nrm)));
+    pl[0] = nrm.x;
+    pl[1] = nrm.y;
+    pl[2] = nrm.z;
+    pl[3] = dot(c, nrm);
+    pl[4] = warp;
   }
+  // Cells the size of the median capture box: a typical face lands in at most 2 x 2 x 2
+  // cells, the few large ones (a crushing block's) in more, and a node's cell lists only
+  // the faces near it.
+  std::nth_element(w.extent.begin(), w.extent.begin() + static_cast<std::ptrdiff_t>(nf / 2),
+                   w.extent.end());
+  double cell = 1.0 * w.extent[nf / 2];
   // Grid over the nodes' bounding box; cells no smaller than the largest capture box, so
   // a face lands in at most 2 x 2 x 2 cells, and never more cells than 8 per item.
   double lo[3], hi[3];
@@ -71,67 +120,90 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
   };
   for (std::size_t f = 0; f < nf; ++f) for_cells(f, [&](std::size_t c) { ++w.cell_start[c + 1]; });
   for (std::size_t c = 0; c < ncell; ++c) w.cell_start[c + 1] += w.cell_start[c];
-  w.cell_faces.resize(static_cast<std::size_t>(w.cell_start[ncell]));
-  w.face_cells.assign(w.cell_start.begin(), w.cell_start.end() - 1); // fill cursors
+  w.entries.resize(static_cast<std::size_t>(w.cell_start[ncell]));
+  w.cursor.assign(w.cell_start.begin(), w.cell_start.end() - 1);
   for (std::size_t f = 0; f < nf; ++f)
     for_cells(f, [&](std::size_t c) {
-      w.cell_faces[static_cast<std::size_t>(w.face_cells[c]++)] = static_cast<int>(f);
+      // Each entry carries its face's box, so the scan of a cell is one contiguous stream.
+      auto& en = w.entries[static_cast<std::size_t>(w.cursor[c]++)];
+      const double* b = &w.box[6 * f];
+      for (int i = 0; i < 3; ++i) {
+        en.lo[i] = b[i];
+        en.hi[i] = b[3 + i];
+      }
+      en.face = static_cast<int>(f);
     });
 
   const double tol = 1 + opt.parametric_tolerance;
-  std::vector<const ContactFaceItem*>& own = w.own;
+  // Node ids of every face and its element's other nodes, packed for the hot loop.
+  w.ids.resize(8 * nf);
+  for (std::size_t f = 0; f < nf; ++f)
+    for (int a = 0; a < 4; ++a) {
+      w.ids[8 * f + a] = faces[f].node[a];
+      w.ids[8 * f + 4 + a] = faces[f].opposite[a];
+    }
+  std::vector<int>& own = w.own;
+  std::vector<int>& cand = w.cand;
+  auto by_gid = [&](int a, int b) {
+    return faces[static_cast<std::size_t>(a)].gid < faces[static_cast<std::size_t>(b)].gid;
+  };
+  auto same_gid = [&](int a, int b) {
+    return faces[static_cast<std::size_t>(a)].gid == faces[static_cast<std::size_t>(b)].gid;
+  };
   for (std::size_t n = 0; n < nodes.size(); ++n) {
     const auto& nd = nodes[n];
     const Vec3 p{nd.x[0], nd.x[1], nd.x[2]};
     const std::size_t c =
         (static_cast<std::size_t>(index(2, p.z)) * dims[1] + index(1, p.y)) * dims[0] +
         index(0, p.x);
-    // The node's outward normal: the sum of the area normals of its own faces (all of
-    // them are among the candidates: their capture boxes hold the node), taken in
-    // ascending face id so that every rank gets the same bits.
+    // Pass 1: the faces of the node's cell whose capture box holds it, split into its own
+    // faces and the others (minus those of elements the node belongs to).
     own.clear();
+    cand.clear();
     for (int k = w.cell_start[c]; k < w.cell_start[c + 1]; ++k) {
-      const auto& fc = faces[static_cast<std::size_t>(w.cell_faces[static_cast<std::size_t>(k)])];
-      if (fc.node[0] == nd.gid || fc.node[1] == nd.gid || fc.node[2] == nd.gid ||
-          fc.node[3] == nd.gid)
-        own.push_back(&fc);
+      const auto& en = w.entries[static_cast<std::size_t>(k)];
+      const bool outside = (p.x < en.lo[0]) | (p.x > en.hi[0]) | (p.y < en.lo[1]) |
+                           (p.y > en.hi[1]) | (p.z < en.lo[2]) | (p.z > en.hi[2]);
+      if (outside) continue;
+      const int f = en.face;
+      const std::int64_t* id = &w.ids[8 * static_cast<std::size_t>(f)];
+      if (id[0] == nd.gid || id[1] == nd.gid || id[2] == nd.gid || id[3] == nd.gid)
+        own.push_back(f);
+      else if (id[4] != nd.gid && id[5] != nd.gid && id[6] != nd.gid && id[7] != nd.gid)
+        cand.push_back(f);
     }
-    std::sort(own.begin(), own.end(),
-              [](const ContactFaceItem* a, const ContactFaceItem* b) { return a->gid < b->gid; });
-    own.erase(std::unique(own.begin(), own.end(),
-                          [](const ContactFaceItem* a, const ContactFaceItem* b) {
-                            return a->gid == b->gid;
-                          }),
-              own.end());
+    if (cand.empty()) continue;
+    // The node's outward normal: the sum of the unit normals of its own faces (all of
+    // them are here: their capture boxes hold the node), in ascending face id so that
+    // every rank gets the same bits.
+    std::sort(own.begin(), own.end(), by_gid);
+    own.erase(std::unique(own.begin(), own.end(), same_gid), own.end());
     Vec3 node_normal;
-    for (const ContactFaceItem* fc : own) {
-      const Vec3 d1{fc->x[2][0] - fc->x[0][0], fc->x[2][1] - fc->x[0][1],
-                    fc->x[2][2] - fc->x[0][2]};
-      const Vec3 d2{fc->x[3][0] - fc->x[1][0], fc->x[3][1] - fc->x[1][1],
-                    fc->x[3][2] - fc->x[1][2]};
-      node_normal += cross(d1, d2);
+    for (int f : own) {
+      const double* pl = &w.plane[5 * static_cast<std::size_t>(f)];
+      node_normal += Vec3{pl[0], pl[1], pl[2]};
     }
+    const double nlen = norm(node_normal);
 
+    // Pass 2: the detailed check of the candidates.
     ContactPair best, tracked;
     bool found = false, have_tracked = false;
     std::int64_t best_gid = 0;
-    for (int k = w.cell_start[c]; k < w.cell_start[c + 1]; ++k) {
-      const int f = w.cell_faces[static_cast<std::size_t>(k)];
+    for (int f : cand) {
       const auto& fc = faces[static_cast<std::size_t>(f)];
-      const double* b = &w.box[6 * static_cast<std::size_t>(f)];
-      if (p.x < b[0] || p.x > b[3] || p.y < b[1] || p.y > b[4] || p.z < b[2] || p.z > b[5])
-        continue;
-      if (fc.node[0] == nd.gid || fc.node[1] == nd.gid || fc.node[2] == nd.gid ||
-          fc.node[3] == nd.gid)
-        continue;
+      // The surfaces must face each other (a node just outside a convex edge can be
+      // "behind" the side face there while it is in front of the top face), and the node
+      // must be behind the face's mean plane, not deeper than a tracked pair may go.
+      const double* pl = &w.plane[5 * static_cast<std::size_t>(f)];
+      const Vec3 fn{pl[0], pl[1], pl[2]};
+      if (nlen > 0 && !(dot(node_normal, fn) < -0.3 * nlen)) continue;
+      const double side = dot(p, fn) - pl[3];
+      if (side > pl[4] || side < -(2 * fc.depth + pl[4])) continue;
       const std::array<Vec3, 4> x = {
           Vec3{fc.x[0][0], fc.x[0][1], fc.x[0][2]}, Vec3{fc.x[1][0], fc.x[1][1], fc.x[1][2]},
           Vec3{fc.x[2][0], fc.x[2][1], fc.x[2][2]}, Vec3{fc.x[3][0], fc.x[3][1], fc.x[3][2]}};
       const QuadProjection q = project_on_quad(x, p);
       if (!q.converged || std::abs(q.xi) > tol || std::abs(q.eta) > tol || !(q.gap < 0)) continue;
-      // The surfaces must face each other: a node just outside a convex edge can be
-      // "behind" the side face there while it is in front of the top face.
-      if (!own.empty() && !(dot(node_normal, q.normal) < -0.3 * norm(node_normal))) continue;
       if (fc.gid == nd.last_face && -q.gap <= 2 * fc.depth) {
         tracked = {static_cast<int>(n), f, q.xi, q.eta, q.gap, q.normal};
         have_tracked = true;

@@ -30,14 +30,15 @@ struct ContactNodeItem {
 
 // A contact face with everything the check and the forces need.
 struct ContactFaceItem {
-  std::int64_t gid;     // global face id (ExteriorFaces order)
-  std::int64_t node[4]; // global node ids, counter-clockwise seen from outside
-  int owner[4];         // FE owner rank of each node
-  double x[4][3];       // predicted node positions
-  double v[4][3];       // predicted node velocities
-  double mass[4];       // nodal masses
-  double stiffness;     // penalty stiffness, N/m
-  double depth;         // largest penetration accepted for a new pair (twice for a tracked one), m
+  std::int64_t gid;         // global face id (ExteriorFaces order)
+  std::int64_t node[4];     // global node ids, counter-clockwise seen from outside
+  std::int64_t opposite[4]; // the element's other four nodes (never in contact with the face)
+  int owner[4];             // FE owner rank of each node
+  double x[4][3];           // predicted node positions
+  double v[4][3];           // predicted node velocities
+  double mass[4];           // nodal masses
+  double stiffness;         // penalty stiffness, N/m
+  double depth; // largest penetration accepted for a new pair (twice for a tracked one), m
 };
 
 struct ContactPair {
@@ -48,19 +49,41 @@ struct ContactPair {
   Vec3 normal;            // unit outward normal of the face at the foot
 };
 
+// Mean plane of a face: centre, unit normal (from the diagonals), and size (square root
+// of the area).
+struct FacePlane {
+  Vec3 centre, normal;
+  double size = 0;
+};
+FacePlane face_plane(const ContactFaceItem& face);
+
+// Where a node can be in contact with the face: the face swept backwards along its normal
+// by twice its depth (the deepest a tracked pair goes), padded by 5% of its size for the
+// parametric tolerance. The contact decomposition ghosts a face to every rank this box
+// touches.
+Box3 capture_box(const ContactFaceItem& face);
+
 struct SearchOptions {
   double parametric_tolerance = 0.02; // the foot may lie this far outside [-1, 1]^2
 };
 
 // Scratch space kept between cycles (no allocation in steady state).
 struct SearchWorkspace {
-  std::vector<int> cell_start, cell_faces, face_cells;
-  std::vector<double> box;                 // 6 per face: capture box
-  std::vector<const ContactFaceItem*> own; // a node's own faces
+  struct CellEntry {
+    double lo[3], hi[3]; // the face's capture box
+    int face;
+  };
+  std::vector<int> cell_start, cursor; // per cell: first entry; fill cursors
+  std::vector<CellEntry> entries;      // faces binned by cell
+  std::vector<double> box;             // 6 per face: capture box
+  std::vector<double> extent;          // largest side of each capture box
+  std::vector<double> plane;           // 5 per face: unit normal, offset, warp
+  std::vector<int> own, cand;          // a node's own faces and its candidates
+  std::vector<std::int64_t> ids;       // 8 per face: its nodes and its element's other nodes
 };
 
 // Finds, for every node, the face it penetrates (if any): pairs in ascending node index.
-// A node never pairs with a face it belongs to.
+// A node never pairs with a face of an element it belongs to.
 void find_contacts(const std::vector<ContactNodeItem>& nodes,
                    const std::vector<ContactFaceItem>& faces, const SearchOptions& options,
                    SearchWorkspace& work, std::vector<ContactPair>& pairs);
