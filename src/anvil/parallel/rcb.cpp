@@ -73,7 +73,7 @@ struct Cand {
   std::int64_t id;
 };
 
-enum class Phase { First, Coord, GidInit, Gid, Done };
+enum class Phase { First, Coord, Gid, Done };
 
 // One tree node during the level that cuts it. Search fields are identical on all ranks
 // (they derive from reduced values only); begin/end/nu are local.
@@ -84,8 +84,9 @@ struct Node {
   std::int64_t nu = 0;             // local undetermined points (in cand[begin, begin + nu))
   double offset = 0;               // global weight of the nodes left of this one
   double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf}; // points' bounding box
-  Box3 geom;                     // node's box clipped to the domain (for empty nodes)
-  double guess = 0, spacing = 0; // previous cut and point spacing (incremental)
+  Box3 geom;                               // node's box clipped to the domain (for empty nodes)
+  double guess = 0, spacing = 0;           // previous cut and point spacing (incremental)
+  std::int64_t guess_gid = RcbCut::kNoTie; // previous tie-breaking gid (incremental)
   bool incremental = false;
 
   Phase phase = Phase::First;
@@ -101,6 +102,7 @@ struct Node {
   bool tie_lower = false;           // some points at `tie` are lower
   bool tie_upper = false;           // some points at `tie` are upper
   bool bisect = false;              // next probes divide U's extent evenly
+  bool have_gids = false;           // cand ids hold gids (caller indices before)
   int np = 0;                       // number of probes
   double pc[kMaxProbes] = {};       // coordinate probes (padded with +inf)
   std::int64_t pg[kMaxProbes] = {}; // gid probes
@@ -198,6 +200,19 @@ int gid_probes(std::int64_t* p, std::int64_t GA, std::int64_t GB, double t, doub
   for (int j = 0; j < n; ++j) p[j] = std::clamp(p[j], GA + 1, GB);
   std::sort(p, p + n);
   return static_cast<int>(std::unique(p, p + n) - p);
+}
+
+// Incremental first gid probes: the previous tie gid and geometric steps around it.
+int around_gid_probes(std::int64_t* p, std::int64_t g0) {
+  static constexpr std::int64_t s[kMaxProbes] = {-4096, -1024, -256, -64, -16, -4,   -1,  0,
+                                                 1,     4,     16,   64,  256, 1024, 4096};
+  int n = 0;
+  for (int j = 0; j < kMaxProbes; ++j) {
+    const long double v = static_cast<long double>(g0) + s[j];
+    if (v > static_cast<long double>(kMinGid) && v <= static_cast<long double>(kMaxGid))
+      p[n++] = g0 + s[j];
+  }
+  return n;
 }
 
 // Bins of U's coordinates against padded probes, with tallies. bins[i] = number of probes
@@ -405,6 +420,7 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
         s.dim = c.dim;
         s.incremental = true;
         s.guess = c.value;
+        s.guess_gid = c.gid;
         s.spacing = c.spacing;
       } else {
         // The longest extent of the points' box keeps subdomains closest to cubes (the
@@ -436,7 +452,7 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
       for (const Node& s : nodes)
         if (s.phase != Phase::Done) {
           ++active;
-          gid_round |= s.phase == Phase::GidInit || s.phase == Phase::Gid;
+          gid_round |= s.phase == Phase::Gid;
         }
       if (active == 0) break;
       ++rounds;
@@ -465,16 +481,11 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
           tally_coords(
               s.nu, s.pc, [&](std::int64_t i) { return std::pair<double, double>(u[i].c, u[i].w); },
               bins, t);
-        } else if (s.phase == Phase::GidInit) {
-          for (std::int64_t i = 0; i < s.nu; ++i) {
-            u[i].id = in.gid[static_cast<std::size_t>(u[i].id)];
-            bins[i] = 0;
-            t.w[0] += u[i].w;
-            t.n[0] += 1;
-            t.gmn[0] = std::min(t.gmn[0], u[i].id);
-            t.gmx[0] = std::max(t.gmx[0], u[i].id);
-          }
         } else {
+          if (!s.have_gids) // first round on ties: look the gids up once
+            for (std::int64_t i = 0; i < s.nu; ++i)
+              u[i].id = in.gid[static_cast<std::size_t>(u[i].id)];
+          s.have_gids = true;
           tally_gids(s.nu, s.pg, s.np, u, bins, t);
         }
       }
@@ -530,7 +541,7 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
           }
         }
         ++slot;
-        const int nbins = (s.phase == Phase::GidInit) ? 1 : s.np + 1;
+        const int nbins = s.np + 1;
         std::uint8_t* bins = wk.bins.data() + s.begin;
         Cand* u = wk.cand.data() + s.begin;
 
@@ -570,12 +581,7 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
           }
         }
 
-        if (s.phase == Phase::GidInit) {
-          s.GA = g.gmn[0];
-          s.GB = g.gmx[0];
-          s.phase = Phase::Gid;
-          s.bisect = false;
-        } else {
+        {
           const int j = crossing_bin(s, g, nbins);
           const bool gid = s.phase == Phase::Gid;
           for (int i = 0; i < j; ++i) {
@@ -640,8 +646,13 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
             s.cut = cut_between(s.lmax, s.umin);
             s.phase = Phase::Done;
           } else if (s.A == s.B) {
-            s.tie = s.A; // many points on one plane: split them by global id
-            s.phase = Phase::GidInit;
+            // Many points on one plane: split them by global id. The first gid round has
+            // no extremes to work from: one bin, or probes around the previous tie gid.
+            s.tie = s.A;
+            s.phase = Phase::Gid;
+            s.np = 0;
+            if (s.incremental && s.guess_gid != RcbCut::kNoTie)
+              s.np = around_gid_probes(s.pg, s.guess_gid);
           } else {
             s.spacing = (s.B - s.A) / s.NU;
             s.np = (s.bisect || s.NU <= kMaxBins)
