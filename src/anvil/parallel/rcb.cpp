@@ -354,6 +354,7 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
       for (int d = 0; d < 3; ++d) {
         lo[d] = std::min(lo[d], it.x[d]);
         hi[d] = std::max(hi[d], it.x[d]);
+        finite &= it.x[d] - it.x[d] == 0; // false for NaN and infinities (min/max skip NaN)
       }
     }
     for (int d = 0; d < 3; ++d) {
