@@ -73,6 +73,25 @@ struct Cand {
   std::int64_t id;
 };
 
+// Grow-only storage without value-initialisation: the work arrays are always written
+// before they are read, and zero-filling them would cost a pass over memory per call.
+template <class T>
+class Buffer {
+public:
+  void grow(std::size_t n) {
+    if (n > capacity_) {
+      data_.reset(new T[n]); // default-initialised: trivial T stays unwritten
+      capacity_ = n;
+    }
+  }
+  T* data() { return data_.get(); }
+  T& operator[](std::size_t i) { return data_[i]; }
+
+private:
+  std::unique_ptr<T[]> data_;
+  std::size_t capacity_ = 0;
+};
+
 enum class Phase { First, Coord, Gid, Done };
 
 // One tree node during the level that cuts it. Search fields are identical on all ranks
@@ -218,11 +237,17 @@ int around_gid_probes(std::int64_t* p, std::int64_t g0) {
 // Bins of U's coordinates against padded probes, with tallies. bins[i] = number of probes
 // <= key (branch-free: the inner loop vectorises).
 template <class KeyW>
-void tally_coords(std::int64_t n, const double* probes, KeyW key_w, std::uint8_t* bins, Tally& t) {
+void tally_coords(std::int64_t n, const double* node_probes, KeyW key_w, std::uint8_t* bins,
+                  Tally& t) {
+  // A local copy of the probes (padded to 16 with +inf): the compiler may then keep them
+  // in registers and compare 4 at a time, as the tallies cannot alias them.
+  alignas(32) double probes[kMaxBins];
+  for (int j = 0; j < kMaxProbes; ++j) probes[j] = node_probes[j];
+  probes[kMaxProbes] = kInf;
   for (std::int64_t i = 0; i < n; ++i) {
     const auto [k, w] = key_w(i);
     int b = 0;
-    for (int j = 0; j < kMaxProbes; ++j) b += k >= probes[j];
+    for (int j = 0; j < kMaxBins; ++j) b += k >= probes[j];
     bins[i] = static_cast<std::uint8_t>(b);
     t.w[b] += w;
     t.n[b] += 1;
@@ -277,13 +302,13 @@ bool include_u(const Node& s) {
 } // namespace
 
 struct Rcb::Work {
-  std::vector<Item<false>> unit[2]; // work arrays (ping-pong between levels), unit weights
-  std::vector<Item<true>> heavy[2]; // the same with weights
-  std::vector<Cand> cand;           // undetermined points, at each node's item range
-  std::vector<std::uint8_t> bins;   // bin of each item or candidate in the current round
-  std::vector<Node> nodes, next;    // nodes of the current and the next level
-  std::vector<Tally> tally;         // one per node of the level
-  std::vector<double> sums, maxes;  // reduction buffers
+  Buffer<Item<false>> unit[2];     // work arrays (ping-pong between levels), unit weights
+  Buffer<Item<true>> heavy[2];     // the same with weights
+  Buffer<Cand> cand;               // undetermined points, at each node's item range
+  Buffer<std::uint8_t> bins;       // bin of each item or candidate in the current round
+  std::vector<Node> nodes, next;   // nodes of the current and the next level
+  std::vector<Tally> tally;        // one per node of the level
+  std::vector<double> sums, maxes; // reduction buffers
   std::vector<std::int64_t> gmaxes;
 };
 
@@ -326,10 +351,10 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
 
   // Copy into the work array, with the root's bounding box and an input check (made
   // collective through the box reduction so that every rank throws together).
-  items[0].resize(n);
-  items[1].resize(n);
-  wk.cand.resize(n);
-  wk.bins.resize(n);
+  items[0].grow(n);
+  items[1].grow(n);
+  wk.cand.grow(n);
+  wk.bins.grow(n);
   dest_.assign(n, rank_);
   bool bad = in.y.size() != n || in.z.size() != n || in.gid.size() != n ||
              (Weighted && in.weight.size() != n && !(n == 0 && in.weight.empty()));
