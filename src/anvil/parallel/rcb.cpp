@@ -394,7 +394,8 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
   if (!inc) cuts_.assign(static_cast<std::size_t>(std::max(P, 1)), RcbCut{});
   count_.assign(static_cast<std::size_t>(P), 0);
   weight_.assign(static_cast<std::size_t>(P), 0.0);
-  stats_ = RcbStats{};
+  stats_.iterations.clear(); // keeps its capacity: a steady-state call allocates nothing
+  stats_.total_iterations = 0;
   stats_.incremental = inc;
 
   double Wtot = 0, Ntot = 0;
