@@ -313,7 +313,9 @@ struct Rcb::Work {
 };
 
 Rcb::Rcb(const Comm& comm)
-    : comm_(&comm), rank_(comm.rank()), ranks_(comm.size()), work_(std::make_unique<Work>()) {}
+    : comm_(&comm), rank_(comm.rank()), ranks_(comm.size()),
+      cuts_(static_cast<std::size_t>(comm.size())), count_(static_cast<std::size_t>(comm.size())),
+      weight_(static_cast<std::size_t>(comm.size())), work_(std::make_unique<Work>()) {}
 Rcb::~Rcb() = default;
 Rcb::Rcb(Rcb&&) noexcept = default;
 Rcb& Rcb::operator=(Rcb&&) noexcept = default;
@@ -391,6 +393,7 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
   }
 
   const bool inc = incremental && have_cuts_ && static_cast<int>(cuts_.size()) == P;
+  have_cuts_ = false; // until this partition completes (an exception leaves no stale cuts)
   if (!inc) cuts_.assign(static_cast<std::size_t>(std::max(P, 1)), RcbCut{});
   count_.assign(static_cast<std::size_t>(P), 0);
   weight_.assign(static_cast<std::size_t>(P), 0.0);

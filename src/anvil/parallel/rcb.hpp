@@ -64,6 +64,7 @@ struct RcbStats {
 class Rcb {
 public:
   // comm must outlive this object; every member function taking points is collective.
+  // Before the first partition, every cut is the plane x = 0 (queries are valid).
   explicit Rcb(const Comm& comm);
   ~Rcb();
   Rcb(Rcb&&) noexcept;
