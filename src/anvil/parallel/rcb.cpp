@@ -234,9 +234,10 @@ int around_gid_probes(std::int64_t* p, std::int64_t g0) {
   return n;
 }
 
-// Bins of U's coordinates against padded probes, with tallies. bins[i] = number of probes
-// <= key (branch-free: the inner loop vectorises).
-template <class KeyW>
+// Bins of U's coordinates against padded probes, with tallies (t cleared on entry).
+// bins[i] = number of probes <= key, branch-free. key_w(i) gives (key, weight); with
+// unit weights the weight tally is the count.
+template <bool Weighted, class KeyW>
 void tally_coords(std::int64_t n, const double* node_probes, KeyW key_w, std::uint8_t* bins,
                   Tally& t) {
   // A local copy of the probes (padded to 16 with +inf): the compiler may then keep them
@@ -244,15 +245,35 @@ void tally_coords(std::int64_t n, const double* node_probes, KeyW key_w, std::ui
   alignas(32) double probes[kMaxBins];
   for (int j = 0; j < kMaxProbes; ++j) probes[j] = node_probes[j];
   probes[kMaxProbes] = kInf;
-  for (std::int64_t i = 0; i < n; ++i) {
-    const auto [k, w] = key_w(i);
+  // Two interleaved sets of tallies: consecutive points often fall in the same bin, and
+  // with one set every update would wait for the store of the previous one.
+  double w[2][kMaxBins] = {}, c[2][kMaxBins] = {}, mn[2][kMaxBins], mx[2][kMaxBins];
+  for (int h = 0; h < 2; ++h)
+    for (int j = 0; j < kMaxBins; ++j) {
+      mn[h][j] = kInf;
+      mx[h][j] = -kInf;
+    }
+  auto one = [&](std::int64_t i, int h) {
+    const auto [k, wi] = key_w(i);
     int b = 0;
     for (int j = 0; j < kMaxBins; ++j) b += k >= probes[j];
     bins[i] = static_cast<std::uint8_t>(b);
-    t.w[b] += w;
-    t.n[b] += 1;
-    t.mn[b] = std::min(t.mn[b], k);
-    t.mx[b] = std::max(t.mx[b], k);
+    if constexpr (Weighted) w[h][b] += wi;
+    c[h][b] += 1;
+    mn[h][b] = std::min(mn[h][b], k);
+    mx[h][b] = std::max(mx[h][b], k);
+  };
+  std::int64_t i = 0;
+  for (; i + 1 < n; i += 2) {
+    one(i, 0);
+    one(i + 1, 1);
+  }
+  if (i < n) one(i, 0);
+  for (int j = 0; j < kMaxBins; ++j) {
+    t.n[j] = c[0][j] + c[1][j];
+    t.w[j] = Weighted ? w[0][j] + w[1][j] : t.n[j];
+    t.mn[j] = std::min(mn[0][j], mn[1][j]);
+    t.mx[j] = std::max(mx[0][j], mx[1][j]);
   }
 }
 
@@ -498,7 +519,7 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
         if (s.phase == Phase::First) {
           const auto* it = items[cur].data() + s.begin;
           const int d = s.dim;
-          tally_coords(
+          tally_coords<Weighted>(
               s.end - s.begin, s.pc,
               [&](std::int64_t i) {
                 if constexpr (Weighted)
@@ -508,7 +529,7 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
               },
               bins, t);
         } else if (s.phase == Phase::Coord) {
-          tally_coords(
+          tally_coords<Weighted>(
               s.nu, s.pc, [&](std::int64_t i) { return std::pair<double, double>(u[i].c, u[i].w); },
               bins, t);
         } else {
@@ -733,15 +754,22 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
       const int d = s.dim;
       const double v = s.cut;
       const std::int64_t cg = s.cut_gid;
+      // Branch-free: both slots are written, one cursor advances. The owner written here
+      // is final for a leaf child and overwritten at a deeper level otherwise (cheaper
+      // than another pass over the leaves).
       std::int64_t lo = s.begin, hi = s.end - 1;
+      int* dest = dest_.data();
       for (std::int64_t i = s.begin; i < s.end; ++i) {
         const auto& it = src[static_cast<std::size_t>(i)];
         const double x = it.x[d];
-        const bool low = x < v || (x == v && in.gid[static_cast<std::size_t>(it.idx)] < cg);
+        bool low = x < v;
+        if (x == v) [[unlikely]]
+          low = in.gid[static_cast<std::size_t>(it.idx)] < cg;
         dst[static_cast<std::size_t>(lo)] = it;
         dst[static_cast<std::size_t>(hi)] = it;
         lo += low;
         hi -= !low;
+        dest[it.idx] = low ? s.a : s.m;
       }
       for (int side = 0; side < 2; ++side) {
         Node ch;
@@ -759,8 +787,6 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
           count_[static_cast<std::size_t>(ch.a)] =
               static_cast<std::int64_t>(side == 0 ? s.NL : s.N - s.NL);
           weight_[static_cast<std::size_t>(ch.a)] = side == 0 ? s.WL : s.W - s.WL;
-          for (std::int64_t i = ch.begin; i < ch.end; ++i)
-            dest_[static_cast<std::size_t>(dst[static_cast<std::size_t>(i)].idx)] = ch.a;
           continue;
         }
         for (std::int64_t i = ch.begin; i < ch.end; ++i) {
