@@ -166,6 +166,7 @@ int finish_probes(double* p, int n, double A, double B) {
   return n;
 }
 
+// Probes dividing [A, B] evenly: 15, or count - 1 when U holds fewer points (count).
 int uniform_probes(double* p, double A, double B, double count) {
   const int n = static_cast<int>(std::min<double>(kMaxProbes, std::max(1.0, count - 1)));
   for (int j = 0; j < n; ++j) p[j] = A + (B - A) * (j + 1) / (n + 1);
@@ -277,6 +278,8 @@ void tally_coords(std::int64_t n, const double* node_probes, KeyW key_w, std::ui
   }
 }
 
+// Bins of U's gids against np sorted probes, with tallies (t cleared on entry): the tie
+// search, rare enough to stay simple.
 void tally_gids(std::int64_t n, const std::int64_t* probes, int np, const Cand* u,
                 std::uint8_t* bins, Tally& t) {
   for (std::int64_t i = 0; i < n; ++i) {
