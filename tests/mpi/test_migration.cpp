@@ -6,6 +6,9 @@
 // nothing; a destination out of range throws on every rank.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <new>
+
 #include <cstring>
 #include <limits>
 #include <vector>
@@ -13,6 +16,21 @@
 #include "anvil/core/vec3.hpp"
 #include "anvil/parallel/comm.hpp"
 #include "anvil/parallel/migration.hpp"
+
+// Counts C++ allocations of this executable (MPI's own mallocs are not counted): the
+// steady-state tests below check that moves and repartitions make none.
+std::size_t g_allocations = 0;
+void* operator new(std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
 
 namespace {
 
@@ -114,6 +132,34 @@ TEST(Migration, RebuildReusesThePlan) {
   round_trip(comm, plan, 300, 4, [](std::uint64_t, int, int) { return 0; });
   round_trip(comm, plan, 1000, 5,
              [](std::uint64_t h, int, int P) { return static_cast<int>(h % P); });
+}
+
+TEST(Migration, SteadyStateAllocatesNothing) {
+  const Comm comm = Comm::world();
+  const int P = comm.size();
+  std::vector<int> dest(2000);
+  for (std::size_t i = 0; i < dest.size(); ++i)
+    dest[i] = static_cast<int>(mix(i + 100 * comm.rank()) % P);
+  std::vector<double> a(dest.size(), 1.5), back(dest.size());
+  std::vector<Vec3> v(dest.size()), vback(dest.size());
+  Migration plan;
+  plan.build(comm, dest); // grows the plan's arrays and buffers
+  std::vector<double> b(plan.recv_count());
+  std::vector<Vec3> w(plan.recv_count());
+  plan.forward(std::span<const Vec3>(v), std::span<Vec3>(w));
+  const std::size_t before = g_allocations;
+  for (int cycle = 0; cycle < 5; ++cycle) {
+    plan.build(comm, dest);
+    plan.forward(std::span<const double>(a), std::span<double>(b));
+    plan.forward(std::span<const Vec3>(v), std::span<Vec3>(w));
+    plan.reverse(std::span<const double>(b), std::span<double>(back));
+    plan.reverse(std::span<const Vec3>(w), std::span<Vec3>(vback));
+  }
+  EXPECT_EQ(g_allocations, before);
+  auto* probe = new std::vector<int>(10); // the counter does count
+  EXPECT_GE(g_allocations, before + 2);
+  delete probe;
+  EXPECT_EQ(back, a);
 }
 
 TEST(Migration, EmptyRanks) {

@@ -8,6 +8,9 @@
 // one with fewer iterations and moves few points; the statistics JSON.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <new>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -21,6 +24,21 @@
 #include "anvil/parallel/migration.hpp"
 #include "anvil/parallel/rcb.hpp"
 #include "anvil/parallel/rcb_statistics.hpp"
+
+// Counts C++ allocations of this executable (MPI's own mallocs are not counted): the
+// steady-state tests below check that moves and repartitions make none.
+std::size_t g_allocations = 0;
+void* operator new(std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
 
 namespace {
 
@@ -488,6 +506,23 @@ TEST(Rcb, IncrementalAfterSmallMotion) {
     std::printf("incremental: %d iterations, %lld moved; scratch: %d iterations\n",
                 rcb.stats().total_iterations, static_cast<long long>(rcb.stats().points_moved),
                 fresh.stats().total_iterations);
+}
+
+TEST(Rcb, SteadyStateRepartitionAllocatesNothing) {
+  const Comm comm = world();
+  const auto all = uniform(5000);
+  Cloud c = share(all, comm, false);
+  Rcb rcb(comm);
+  rcb.partition(c.view());
+  rcb.repartition(c.view()); // the first repartition may still grow a buffer
+  for (std::size_t i = 0; i < c.size(); ++i) c.x[i] += 1e-4 * std::sin(c.y[i]);
+  const std::size_t before = g_allocations;
+  rcb.repartition(c.view());
+  rcb.repartition(c.view());
+  EXPECT_EQ(g_allocations, before);
+  auto* probe = new std::vector<int>(10); // the counter does count
+  EXPECT_GE(g_allocations, before + 2);
+  delete probe;
 }
 
 TEST(Rcb, StatisticsJson) {

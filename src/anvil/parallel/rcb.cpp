@@ -73,7 +73,26 @@ struct Cand {
   std::int64_t id;
 };
 
-enum class Phase { First, Coord, GidInit, Gid, Done };
+// Grow-only storage without value-initialisation: the work arrays are always written
+// before they are read, and zero-filling them would cost a pass over memory per call.
+template <class T>
+class Buffer {
+public:
+  void grow(std::size_t n) {
+    if (n > capacity_) {
+      data_.reset(new T[n]); // default-initialised: trivial T stays unwritten
+      capacity_ = n;
+    }
+  }
+  T* data() { return data_.get(); }
+  T& operator[](std::size_t i) { return data_[i]; }
+
+private:
+  std::unique_ptr<T[]> data_;
+  std::size_t capacity_ = 0;
+};
+
+enum class Phase { First, Coord, Gid, Done };
 
 // One tree node during the level that cuts it. Search fields are identical on all ranks
 // (they derive from reduced values only); begin/end/nu are local.
@@ -84,8 +103,9 @@ struct Node {
   std::int64_t nu = 0;             // local undetermined points (in cand[begin, begin + nu))
   double offset = 0;               // global weight of the nodes left of this one
   double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf}; // points' bounding box
-  Box3 geom;                     // node's box clipped to the domain (for empty nodes)
-  double guess = 0, spacing = 0; // previous cut and point spacing (incremental)
+  Box3 geom;                               // node's box clipped to the domain (for empty nodes)
+  double guess = 0, spacing = 0;           // previous cut and point spacing (incremental)
+  std::int64_t guess_gid = RcbCut::kNoTie; // previous tie-breaking gid (incremental)
   bool incremental = false;
 
   Phase phase = Phase::First;
@@ -101,6 +121,7 @@ struct Node {
   bool tie_lower = false;           // some points at `tie` are lower
   bool tie_upper = false;           // some points at `tie` are upper
   bool bisect = false;              // next probes divide U's extent evenly
+  bool have_gids = false;           // cand ids hold gids (caller indices before)
   int np = 0;                       // number of probes
   double pc[kMaxProbes] = {};       // coordinate probes (padded with +inf)
   std::int64_t pg[kMaxProbes] = {}; // gid probes
@@ -145,6 +166,7 @@ int finish_probes(double* p, int n, double A, double B) {
   return n;
 }
 
+// Probes dividing [A, B] evenly: 15, or count - 1 when U holds fewer points (count).
 int uniform_probes(double* p, double A, double B, double count) {
   const int n = static_cast<int>(std::min<double>(kMaxProbes, std::max(1.0, count - 1)));
   for (int j = 0; j < n; ++j) p[j] = A + (B - A) * (j + 1) / (n + 1);
@@ -200,22 +222,64 @@ int gid_probes(std::int64_t* p, std::int64_t GA, std::int64_t GB, double t, doub
   return static_cast<int>(std::unique(p, p + n) - p);
 }
 
-// Bins of U's coordinates against padded probes, with tallies. bins[i] = number of probes
-// <= key (branch-free: the inner loop vectorises).
-template <class KeyW>
-void tally_coords(std::int64_t n, const double* probes, KeyW key_w, std::uint8_t* bins, Tally& t) {
-  for (std::int64_t i = 0; i < n; ++i) {
-    const auto [k, w] = key_w(i);
+// Incremental first gid probes: the previous tie gid and geometric steps around it.
+int around_gid_probes(std::int64_t* p, std::int64_t g0) {
+  static constexpr std::int64_t s[kMaxProbes] = {-4096, -1024, -256, -64, -16, -4,   -1,  0,
+                                                 1,     4,     16,   64,  256, 1024, 4096};
+  int n = 0;
+  for (int j = 0; j < kMaxProbes; ++j) {
+    const long double v = static_cast<long double>(g0) + s[j];
+    if (v > static_cast<long double>(kMinGid) && v <= static_cast<long double>(kMaxGid))
+      p[n++] = g0 + s[j];
+  }
+  return n;
+}
+
+// Bins of U's coordinates against padded probes, with tallies (t cleared on entry).
+// bins[i] = number of probes <= key, branch-free. key_w(i) gives (key, weight); with
+// unit weights the weight tally is the count.
+template <bool Weighted, class KeyW>
+void tally_coords(std::int64_t n, const double* node_probes, KeyW key_w, std::uint8_t* bins,
+                  Tally& t) {
+  // A local copy of the probes (padded to 16 with +inf): the compiler may then keep them
+  // in registers and compare 4 at a time, as the tallies cannot alias them.
+  alignas(32) double probes[kMaxBins];
+  for (int j = 0; j < kMaxProbes; ++j) probes[j] = node_probes[j];
+  probes[kMaxProbes] = kInf;
+  // Two interleaved sets of tallies: consecutive points often fall in the same bin, and
+  // with one set every update would wait for the store of the previous one.
+  double w[2][kMaxBins] = {}, c[2][kMaxBins] = {}, mn[2][kMaxBins], mx[2][kMaxBins];
+  for (int h = 0; h < 2; ++h)
+    for (int j = 0; j < kMaxBins; ++j) {
+      mn[h][j] = kInf;
+      mx[h][j] = -kInf;
+    }
+  auto one = [&](std::int64_t i, int h) {
+    const auto [k, wi] = key_w(i);
     int b = 0;
-    for (int j = 0; j < kMaxProbes; ++j) b += k >= probes[j];
+    for (int j = 0; j < kMaxBins; ++j) b += k >= probes[j];
     bins[i] = static_cast<std::uint8_t>(b);
-    t.w[b] += w;
-    t.n[b] += 1;
-    t.mn[b] = std::min(t.mn[b], k);
-    t.mx[b] = std::max(t.mx[b], k);
+    if constexpr (Weighted) w[h][b] += wi;
+    c[h][b] += 1;
+    mn[h][b] = std::min(mn[h][b], k);
+    mx[h][b] = std::max(mx[h][b], k);
+  };
+  std::int64_t i = 0;
+  for (; i + 1 < n; i += 2) {
+    one(i, 0);
+    one(i + 1, 1);
+  }
+  if (i < n) one(i, 0);
+  for (int j = 0; j < kMaxBins; ++j) {
+    t.n[j] = c[0][j] + c[1][j];
+    t.w[j] = Weighted ? w[0][j] + w[1][j] : t.n[j];
+    t.mn[j] = std::min(mn[0][j], mn[1][j]);
+    t.mx[j] = std::max(mx[0][j], mx[1][j]);
   }
 }
 
+// Bins of U's gids against np sorted probes, with tallies (t cleared on entry): the tie
+// search, rare enough to stay simple.
 void tally_gids(std::int64_t n, const std::int64_t* probes, int np, const Cand* u,
                 std::uint8_t* bins, Tally& t) {
   for (std::int64_t i = 0; i < n; ++i) {
@@ -262,18 +326,20 @@ bool include_u(const Node& s) {
 } // namespace
 
 struct Rcb::Work {
-  std::vector<Item<false>> unit[2]; // work arrays (ping-pong between levels), unit weights
-  std::vector<Item<true>> heavy[2]; // the same with weights
-  std::vector<Cand> cand;           // undetermined points, at each node's item range
-  std::vector<std::uint8_t> bins;   // bin of each item or candidate in the current round
-  std::vector<Node> nodes, next;    // nodes of the current and the next level
-  std::vector<Tally> tally;         // one per node of the level
-  std::vector<double> sums, maxes;  // reduction buffers
+  Buffer<Item<false>> unit[2];     // work arrays (ping-pong between levels), unit weights
+  Buffer<Item<true>> heavy[2];     // the same with weights
+  Buffer<Cand> cand;               // undetermined points, at each node's item range
+  Buffer<std::uint8_t> bins;       // bin of each item or candidate in the current round
+  std::vector<Node> nodes, next;   // nodes of the current and the next level
+  std::vector<Tally> tally;        // one per node of the level
+  std::vector<double> sums, maxes; // reduction buffers
   std::vector<std::int64_t> gmaxes;
 };
 
 Rcb::Rcb(const Comm& comm)
-    : comm_(&comm), rank_(comm.rank()), ranks_(comm.size()), work_(std::make_unique<Work>()) {}
+    : comm_(&comm), rank_(comm.rank()), ranks_(comm.size()),
+      cuts_(static_cast<std::size_t>(comm.size())), count_(static_cast<std::size_t>(comm.size())),
+      weight_(static_cast<std::size_t>(comm.size())), work_(std::make_unique<Work>()) {}
 Rcb::~Rcb() = default;
 Rcb::Rcb(Rcb&&) noexcept = default;
 Rcb& Rcb::operator=(Rcb&&) noexcept = default;
@@ -311,10 +377,10 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
 
   // Copy into the work array, with the root's bounding box and an input check (made
   // collective through the box reduction so that every rank throws together).
-  items[0].resize(n);
-  items[1].resize(n);
-  wk.cand.resize(n);
-  wk.bins.resize(n);
+  items[0].grow(n);
+  items[1].grow(n);
+  wk.cand.grow(n);
+  wk.bins.grow(n);
   dest_.assign(n, rank_);
   bool bad = in.y.size() != n || in.z.size() != n || in.gid.size() != n ||
              (Weighted && in.weight.size() != n && !(n == 0 && in.weight.empty()));
@@ -339,6 +405,7 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
       for (int d = 0; d < 3; ++d) {
         lo[d] = std::min(lo[d], it.x[d]);
         hi[d] = std::max(hi[d], it.x[d]);
+        finite &= it.x[d] - it.x[d] == 0; // false for NaN and infinities (min/max skip NaN)
       }
     }
     for (int d = 0; d < 3; ++d) {
@@ -350,10 +417,12 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
   }
 
   const bool inc = incremental && have_cuts_ && static_cast<int>(cuts_.size()) == P;
+  have_cuts_ = false; // until this partition completes (an exception leaves no stale cuts)
   if (!inc) cuts_.assign(static_cast<std::size_t>(std::max(P, 1)), RcbCut{});
   count_.assign(static_cast<std::size_t>(P), 0);
   weight_.assign(static_cast<std::size_t>(P), 0.0);
-  stats_ = RcbStats{};
+  stats_.iterations.clear(); // keeps its capacity: a steady-state call allocates nothing
+  stats_.total_iterations = 0;
   stats_.incremental = inc;
 
   double Wtot = 0, Ntot = 0;
@@ -405,6 +474,7 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
         s.dim = c.dim;
         s.incremental = true;
         s.guess = c.value;
+        s.guess_gid = c.gid;
         s.spacing = c.spacing;
       } else {
         // The longest extent of the points' box keeps subdomains closest to cubes (the
@@ -436,7 +506,7 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
       for (const Node& s : nodes)
         if (s.phase != Phase::Done) {
           ++active;
-          gid_round |= s.phase == Phase::GidInit || s.phase == Phase::Gid;
+          gid_round |= s.phase == Phase::Gid;
         }
       if (active == 0) break;
       ++rounds;
@@ -452,7 +522,7 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
         if (s.phase == Phase::First) {
           const auto* it = items[cur].data() + s.begin;
           const int d = s.dim;
-          tally_coords(
+          tally_coords<Weighted>(
               s.end - s.begin, s.pc,
               [&](std::int64_t i) {
                 if constexpr (Weighted)
@@ -462,19 +532,14 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
               },
               bins, t);
         } else if (s.phase == Phase::Coord) {
-          tally_coords(
+          tally_coords<Weighted>(
               s.nu, s.pc, [&](std::int64_t i) { return std::pair<double, double>(u[i].c, u[i].w); },
               bins, t);
-        } else if (s.phase == Phase::GidInit) {
-          for (std::int64_t i = 0; i < s.nu; ++i) {
-            u[i].id = in.gid[static_cast<std::size_t>(u[i].id)];
-            bins[i] = 0;
-            t.w[0] += u[i].w;
-            t.n[0] += 1;
-            t.gmn[0] = std::min(t.gmn[0], u[i].id);
-            t.gmx[0] = std::max(t.gmx[0], u[i].id);
-          }
         } else {
+          if (!s.have_gids) // first round on ties: look the gids up once
+            for (std::int64_t i = 0; i < s.nu; ++i)
+              u[i].id = in.gid[static_cast<std::size_t>(u[i].id)];
+          s.have_gids = true;
           tally_gids(s.nu, s.pg, s.np, u, bins, t);
         }
       }
@@ -530,7 +595,7 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
           }
         }
         ++slot;
-        const int nbins = (s.phase == Phase::GidInit) ? 1 : s.np + 1;
+        const int nbins = s.np + 1;
         std::uint8_t* bins = wk.bins.data() + s.begin;
         Cand* u = wk.cand.data() + s.begin;
 
@@ -570,12 +635,7 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
           }
         }
 
-        if (s.phase == Phase::GidInit) {
-          s.GA = g.gmn[0];
-          s.GB = g.gmx[0];
-          s.phase = Phase::Gid;
-          s.bisect = false;
-        } else {
+        {
           const int j = crossing_bin(s, g, nbins);
           const bool gid = s.phase == Phase::Gid;
           for (int i = 0; i < j; ++i) {
@@ -640,8 +700,13 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
             s.cut = cut_between(s.lmax, s.umin);
             s.phase = Phase::Done;
           } else if (s.A == s.B) {
-            s.tie = s.A; // many points on one plane: split them by global id
-            s.phase = Phase::GidInit;
+            // Many points on one plane: split them by global id. The first gid round has
+            // no extremes to work from: one bin, or probes around the previous tie gid.
+            s.tie = s.A;
+            s.phase = Phase::Gid;
+            s.np = 0;
+            if (s.incremental && s.guess_gid != RcbCut::kNoTie)
+              s.np = around_gid_probes(s.pg, s.guess_gid);
           } else {
             s.spacing = (s.B - s.A) / s.NU;
             s.np = (s.bisect || s.NU <= kMaxBins)
@@ -692,15 +757,22 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
       const int d = s.dim;
       const double v = s.cut;
       const std::int64_t cg = s.cut_gid;
+      // Branch-free: both slots are written, one cursor advances. The owner written here
+      // is final for a leaf child and overwritten at a deeper level otherwise (cheaper
+      // than another pass over the leaves).
       std::int64_t lo = s.begin, hi = s.end - 1;
+      int* dest = dest_.data();
       for (std::int64_t i = s.begin; i < s.end; ++i) {
         const auto& it = src[static_cast<std::size_t>(i)];
         const double x = it.x[d];
-        const bool low = x < v || (x == v && in.gid[static_cast<std::size_t>(it.idx)] < cg);
+        bool low = x < v;
+        if (x == v) [[unlikely]]
+          low = in.gid[static_cast<std::size_t>(it.idx)] < cg;
         dst[static_cast<std::size_t>(lo)] = it;
         dst[static_cast<std::size_t>(hi)] = it;
         lo += low;
         hi -= !low;
+        dest[it.idx] = low ? s.a : s.m;
       }
       for (int side = 0; side < 2; ++side) {
         Node ch;
@@ -718,8 +790,6 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
           count_[static_cast<std::size_t>(ch.a)] =
               static_cast<std::int64_t>(side == 0 ? s.NL : s.N - s.NL);
           weight_[static_cast<std::size_t>(ch.a)] = side == 0 ? s.WL : s.W - s.WL;
-          for (std::int64_t i = ch.begin; i < ch.end; ++i)
-            dest_[static_cast<std::size_t>(dst[static_cast<std::size_t>(i)].idx)] = ch.a;
           continue;
         }
         for (std::int64_t i = ch.begin; i < ch.end; ++i) {
