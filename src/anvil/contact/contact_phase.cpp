@@ -61,6 +61,7 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
   }
   my_face_rank_.assign(my_face_gid_.size(), comm.rank());
   last_face_.assign(fe.node_gid.size(), -1);
+  allowance_.assign(fe.node_gid.size(), 0.0);
   exchange_ = std::make_unique<NodeExchange>(fe, comm);
 }
 
@@ -81,6 +82,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     }
     it.mass = nd.mass[l];
     it.last_face = last_face_[static_cast<std::size_t>(l)];
+    it.allowance = allowance_[static_cast<std::size_t>(l)];
   }
   const std::size_t nf = my_face_gid_.size();
   std::vector<ContactFaceItem>& faces = face_local_;
@@ -211,12 +213,18 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
               [](const ContactForceItem& a, const ContactForceItem& b) {
                 return a.target != b.target ? a.target < b.target : a.slave < b.slave;
               });
-    for (int l : my_nodes_) last_face_[static_cast<std::size_t>(l)] = -1;
+    for (int l : my_nodes_) {
+      last_face_[static_cast<std::size_t>(l)] = -1;
+      allowance_[static_cast<std::size_t>(l)] = 0;
+    }
     for (const auto& it : force_in_) {
       const auto pos = std::lower_bound(fe_.node_gid.begin(), fe_.node_gid.end(), it.target);
       const auto l = static_cast<std::size_t>(pos - fe_.node_gid.begin());
       for (int i = 0; i < 3; ++i) nd.force[i][l] += it.f[i];
-      if (it.target == it.slave) last_face_[l] = it.face;
+      if (it.target == it.slave) {
+        last_face_[l] = it.face;
+        allowance_[l] = it.allowance;
+      }
     }
   }
   {

@@ -73,6 +73,7 @@ private:
   // FE side (this rank): contact nodes it owns and faces of elements it owns.
   std::vector<int> my_nodes_;           // local node indices
   std::vector<std::int64_t> last_face_; // per local node: face contacted last cycle
+  std::vector<double> allowance_;       // per local node: penetration allowed without force
   std::vector<std::int64_t> my_face_gid_;
   std::vector<std::array<int, 4>> my_face_nodes_;    // local node indices
   std::vector<std::array<int, 4>> my_face_opposite_; // the element's other four nodes

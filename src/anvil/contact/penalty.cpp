@@ -14,7 +14,7 @@ void penalty_forces(const std::vector<ContactNodeItem>& nodes,
     const auto& n = nodes[static_cast<std::size_t>(p.node)];
     const auto& f = faces[static_cast<std::size_t>(p.face)];
     const auto N = quad_shape(p.xi, p.eta);
-    const double fn = f.stiffness * (-p.gap);
+    const double fn = f.stiffness * std::max(0.0, -p.gap - p.allowance);
     Vec3 F = fn * p.normal;
     if (opt.friction > 0 && opt.dt > 0) {
       Vec3 vr{n.v[0], n.v[1], n.v[2]};
@@ -31,10 +31,10 @@ void penalty_forces(const std::vector<ContactNodeItem>& nodes,
         F -= (ft / speed) * vt;
       }
     }
-    items.push_back({n.gid, n.gid, f.gid, {F.x, F.y, F.z}});
+    items.push_back({n.gid, n.gid, f.gid, p.allowance, {F.x, F.y, F.z}});
     dest.push_back(n.owner);
     for (int a = 0; a < 4; ++a) {
-      items.push_back({f.node[a], n.gid, -1, {-N[a] * F.x, -N[a] * F.y, -N[a] * F.z}});
+      items.push_back({f.node[a], n.gid, -1, 0.0, {-N[a] * F.x, -N[a] * F.y, -N[a] * F.z}});
       dest.push_back(f.owner[a]);
     }
   }

@@ -20,6 +20,7 @@ struct ContactForceItem {
   std::int64_t target; // node receiving the force (global id)
   std::int64_t slave;  // the pair's node, the key of the summation order
   std::int64_t face;   // the pair's face on the slave's own item, -1 on the face nodes'
+  double allowance;    // the pair's allowance on the slave's own item
   double f[3];         // N
 };
 

@@ -150,6 +150,18 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
   auto same_gid = [&](int a, int b) {
     return faces[static_cast<std::size_t>(a)].gid == faces[static_cast<std::size_t>(b)].gid;
   };
+  // The surfaces face each other when at least one of the node's own faces opposes the
+  // candidate (normals at more than about 107 degrees). At a convex edge a node just
+  // outside is "behind" the side face, but none of its faces opposes that face; in a
+  // closing fold the node at the crease has one face on each side, and one opposes.
+  auto faces_oppose = [&](const std::vector<int>& mine, const Vec3& fn) {
+    if (mine.empty()) return true;
+    for (int g : mine) {
+      const double* q = &w.plane[5 * static_cast<std::size_t>(g)];
+      if (q[0] * fn.x + q[1] * fn.y + q[2] * fn.z < -0.3) return true;
+    }
+    return false;
+  };
   for (std::size_t n = 0; n < nodes.size(); ++n) {
     const auto& nd = nodes[n];
     const Vec3 p{nd.x[0], nd.x[1], nd.x[2]};
@@ -173,18 +185,11 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
         cand.push_back(f);
     }
     if (cand.empty()) continue;
-    // The node's outward normal: the sum of the unit normals of its own faces (all of
-    // them are here: their capture boxes hold the node), in ascending face id so that
-    // every rank gets the same bits.
+    // The node's own faces (all of them are here: their capture boxes hold the node),
+    // deduplicated (a face can sit in several cells? no: one cell per node, but ghosts of
+    // the same face never coexist on a rank; kept for safety).
     std::sort(own.begin(), own.end(), by_gid);
     own.erase(std::unique(own.begin(), own.end(), same_gid), own.end());
-    Vec3 node_normal;
-    for (int f : own) {
-      const double* pl = &w.plane[5 * static_cast<std::size_t>(f)];
-      node_normal += Vec3{pl[0], pl[1], pl[2]};
-    }
-    const double nlen = norm(node_normal);
-
     // Pass 2: the detailed check of the candidates.
     ContactPair best, tracked;
     bool found = false, have_tracked = false;
@@ -196,7 +201,7 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
       // must be behind the face's mean plane, not deeper than a tracked pair may go.
       const double* pl = &w.plane[5 * static_cast<std::size_t>(f)];
       const Vec3 fn{pl[0], pl[1], pl[2]};
-      if (nlen > 0 && !(dot(node_normal, fn) < -0.3 * nlen)) continue;
+      if (!faces_oppose(own, fn)) continue;
       const double side = dot(p, fn) - pl[3];
       if (side > pl[4] || side < -(2 * fc.depth + pl[4])) continue;
       const std::array<Vec3, 4> x = {
@@ -205,13 +210,14 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
       const QuadProjection q = project_on_quad(x, p);
       if (!q.converged || std::abs(q.xi) > tol || std::abs(q.eta) > tol || !(q.gap < 0)) continue;
       if (fc.gid == nd.last_face && -q.gap <= 2 * fc.depth) {
-        tracked = {static_cast<int>(n), f, q.xi, q.eta, q.gap, q.normal};
+        tracked = {static_cast<int>(n),           f, q.xi, q.eta, q.gap, q.normal,
+                   std::min(nd.allowance, -q.gap)};
         have_tracked = true;
       }
       if (-q.gap > fc.depth) continue;
       // Least penetration wins; equal penetrations go to the lower face id.
       if (!found || q.gap > best.gap || (q.gap == best.gap && fc.gid < best_gid)) {
-        best = {static_cast<int>(n), f, q.xi, q.eta, q.gap, q.normal};
+        best = {static_cast<int>(n), f, q.xi, q.eta, q.gap, q.normal, -q.gap};
         best_gid = fc.gid;
         found = true;
       }

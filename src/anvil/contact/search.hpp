@@ -26,6 +26,7 @@ struct ContactNodeItem {
   double v[3];            // predicted velocity v(n+1/2)
   double mass;            // lumped nodal mass
   std::int64_t last_face; // face it was in contact with last cycle, or -1 (tracking)
+  double allowance;       // penetration that draws no force (see ContactPair), m
 };
 
 // A contact face with everything the check and the forces need.
@@ -47,6 +48,12 @@ struct ContactPair {
   double xi = 0, eta = 0; // foot of the normal on the face
   double gap = 0;         // signed distance along the normal (< 0: penetration), m
   Vec3 normal;            // unit outward normal of the face at the foot
+  // Penetration allowed without force. A pair found already penetrating (a fold closing
+  // faster than the search sees it, an initial overlap) would otherwise receive the whole
+  // penalty force at once and be kicked out with energy it never had; instead the depth at
+  // first detection is allowed and the force resists only further penetration, the
+  // allowance shrinking as the node moves out (LS-DYNA's IGNORE option).
+  double allowance = 0;
 };
 
 // Mean plane of a face: centre, unit normal (from the diagonals), and size (square root

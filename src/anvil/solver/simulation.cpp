@@ -339,16 +339,26 @@ void Simulation::correct() {
     // The penalty impulse acts over the velocity step: dv = dt_avg f / m. Its work is the
     // impulse times the mean of the step's start and end velocities (attributing the
     // kinetic energy change of the step exactly among the impulses that make it).
-    double work = 0;
+    double work = 0, reaction = 0;
     for (std::size_t n = 0; n < nodes_.size(); ++n) {
       const double inv_m = dt_avg_ / nodes_.mass[n];
       for (int i = 0; i < 3; ++i) {
         const double f = contact_force_[i][n];
-        if (f == 0.0 || (constrained_[n] & (1u << i))) continue;
+        if (f == 0.0) continue;
+        if (constrained_[n] & (1u << i)) {
+          // The constraint cancels the impulse: the contact force still works on the node
+          // (part of the pair's energy) and the constraint's reaction is external work.
+          if (fe_.node_owned[n]) {
+            work += f * dt_avg_ * nodes_.v[i][n];
+            reaction -= f * dt_avg_ * nodes_.v[i][n];
+          }
+          continue;
+        }
         nodes_.v[i][n] += inv_m * f;
         if (fe_.node_owned[n]) work += f * dt_avg_ * 0.5 * (v_prev_[i][n] + nodes_.v[i][n]);
       }
     }
+    external_work_ += reaction;
     contact_energy_ -= work;
   }
   ScopedPhase t(timers_, Phase::contact_force);
