@@ -9,6 +9,7 @@
 #include "anvil/core/error.hpp"
 #include "anvil/io/deck.hpp"
 #include "anvil/parallel/comm.hpp"
+#include "anvil/solver/can_crush.hpp"
 #include "anvil/solver/run.hpp"
 #include "anvil/solver/simulation.hpp"
 #include "anvil/version.hpp"
@@ -57,6 +58,21 @@ int main(int argc, char** argv) {
       app.add_subcommand("check", "validate a deck and its mesh; print counts, masses, stable dt");
   chk->add_option("deck", deck, "the YAML deck")->required();
 
+  auto* bench = app.add_subcommand("bench", "benchmarks");
+  bench->require_subcommand(1);
+  auto* can =
+      bench->add_subcommand("can-crush", "the paper's scaled can crush for the current rank count");
+  anvil::CanCrushOptions cc;
+  std::string bench_out = "bench_can_crush";
+  bool write_deck = false;
+  can->add_option("--elements-per-rank", cc.elements_per_rank, "one-rank model size")
+      ->capture_default_str()
+      ->check(CLI::Range(200, 10000000));
+  can->add_option("--cycles", cc.cycles, "stop after this many cycles (default: run to 3.2 ms)")
+      ->check(CLI::NonNegativeNumber);
+  can->add_option("-o,--output", bench_out, "output directory")->capture_default_str();
+  can->add_flag("--print-deck", write_deck, "print the deck for this rank count and exit");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -81,6 +97,14 @@ int main(int argc, char** argv) {
       return anvil::run(config, {outdir, !quiet}, comm);
     }
     if (*chk) return check(deck, comm);
+    if (*can) {
+      cc.ranks = comm.size();
+      if (write_deck) {
+        if (root) std::printf("%s", anvil::can_crush_deck(cc).c_str());
+        return 0;
+      }
+      return anvil::run(anvil::can_crush_config(cc), {bench_out, !quiet}, comm);
+    }
   } catch (const anvil::InputError& e) {
     if (root) std::fprintf(stderr, "anvil: error: %s\n", e.what());
     return anvil::exit_bad_input;

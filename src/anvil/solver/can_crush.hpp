@@ -1,0 +1,26 @@
+// The scaled can crush of DESIGN.md section 5, built for any rank count as the paper did:
+// the one-rank model has about 1875 elements, and each doubling of the rank count doubles
+// the elements by halving the mesh spacing in one direction, cycling through the
+// directions (around, along the axis, through the wall; the block follows in x, y, z).
+#pragma once
+
+#include <string>
+
+#include "anvil/io/config.hpp"
+
+namespace anvil {
+
+struct CanCrushOptions {
+  int ranks = 1;
+  int elements_per_rank = 1875; // one-rank size; the base mesh is scaled to it
+  double end_time = 3.2e-3;     // s
+  long long cycles = -1;        // stop after this many cycles when >= 0
+};
+
+// The deck text of the problem (YAML), for `anvil bench can-crush` and the tests.
+std::string can_crush_deck(const CanCrushOptions& options);
+
+// The same problem as configuration.
+Config can_crush_config(const CanCrushOptions& options);
+
+} // namespace anvil
