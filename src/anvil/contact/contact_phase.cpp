@@ -168,7 +168,9 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
 
   {
     ScopedPhase t(timers, Phase::contact_search);
-    find_contacts(node_in_, face_in_, SearchOptions{}, search_, pairs_);
+    SearchOptions opt;
+    opt.dt = dt;
+    find_contacts(node_in_, face_in_, opt, search_, pairs_);
   }
 }
 

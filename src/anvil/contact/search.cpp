@@ -214,7 +214,26 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
                    std::min(nd.allowance, -q.gap)};
         have_tracked = true;
       }
-      if (-q.gap > fc.depth) continue;
+      if (!(-q.gap < fc.depth)) continue;
+      // A new pair needs the node to have come through the face this step: at the start
+      // of the step (x - dt v for node and face alike) it was in front of the face's mean
+      // plane. A node found behind a face it never crossed is on the far side of the same
+      // wall, or came round an edge, and is not in contact with this face.
+      if (opt.dt > 0) {
+        Vec3 c0, n0 = cross(
+                     Vec3{(fc.x[2][0] - opt.dt * fc.v[2][0]) - (fc.x[0][0] - opt.dt * fc.v[0][0]),
+                          (fc.x[2][1] - opt.dt * fc.v[2][1]) - (fc.x[0][1] - opt.dt * fc.v[0][1]),
+                          (fc.x[2][2] - opt.dt * fc.v[2][2]) - (fc.x[0][2] - opt.dt * fc.v[0][2])},
+                     Vec3{(fc.x[3][0] - opt.dt * fc.v[3][0]) - (fc.x[1][0] - opt.dt * fc.v[1][0]),
+                          (fc.x[3][1] - opt.dt * fc.v[3][1]) - (fc.x[1][1] - opt.dt * fc.v[1][1]),
+                          (fc.x[3][2] - opt.dt * fc.v[3][2]) - (fc.x[1][2] - opt.dt * fc.v[1][2])});
+        for (int a = 0; a < 4; ++a)
+          for (int i = 0; i < 3; ++i) c0[i] += 0.25 * (fc.x[a][i] - opt.dt * fc.v[a][i]);
+        const Vec3 p0{nd.x[0] - opt.dt * nd.v[0], nd.x[1] - opt.dt * nd.v[1],
+                      nd.x[2] - opt.dt * nd.v[2]};
+        const double len0 = norm(n0);
+        if (len0 > 0 && dot(p0 - c0, n0) < -(pl[4] + 1e-3 * fc.depth) * len0) continue;
+      }
       // Least penetration wins; equal penetrations go to the lower face id.
       if (!found || q.gap > best.gap || (q.gap == best.gap && fc.gid < best_gid)) {
         best = {static_cast<int>(n), f, q.xi, q.eta, q.gap, q.normal, -q.gap};

@@ -71,6 +71,7 @@ FacePlane face_plane(const ContactFaceItem& face);
 Box3 capture_box(const ContactFaceItem& face);
 
 struct SearchOptions {
+  double dt = 0; // the step just predicted: x - dt v is the start of the step (0: no check)
   double parametric_tolerance = 0.02; // the foot may lie this far outside [-1, 1]^2
 };
 

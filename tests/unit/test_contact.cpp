@@ -1,0 +1,228 @@
+// Contact building blocks: exterior surfaces, the point-to-face projection against
+// brute force, the detailed check's rules, and momentum conservation of penalty forces.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "anvil/contact/geometry.hpp"
+#include "anvil/contact/penalty.hpp"
+#include "anvil/contact/search.hpp"
+#include "anvil/contact/surface.hpp"
+#include "anvil/mesh/generators.hpp"
+
+namespace {
+
+using namespace anvil;
+
+TEST(Contact, ExteriorFacesOfBoxesAndCans) {
+  Mesh m = generate_box({{0, 0, 0}, {1, 1, 1}, {2, 3, 4}});
+  auto f = exterior_faces(m, {true});
+  EXPECT_EQ(f.size(), 2u * (2 * 3 + 3 * 4 + 2 * 4));
+  EXPECT_EQ(static_cast<std::int64_t>(f.contact_nodes.size()),
+            m.num_nodes() - 1 * 2 * 3); // minus interior
+  // Outward normals: the face's area vector points away from its element's centre.
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    const auto& n = f.nodes[i];
+    const Vec3 c = 0.25 * (m.nodes[n[0]] + m.nodes[n[1]] + m.nodes[n[2]] + m.nodes[n[3]]);
+    const Vec3 a = cross(m.nodes[n[2]] - m.nodes[n[0]], m.nodes[n[3]] - m.nodes[n[1]]);
+    EXPECT_GT(dot(a, c - Vec3{0.5, 0.5, 0.5}), 0.0);
+  }
+  // A can has no faces between its elements, only its four surfaces.
+  Mesh can = generate_can({0.03, 0.1, 0.001, 2, {}, {12, 5, 2}});
+  EXPECT_EQ(exterior_faces(can, {true}).size(), 2u * 12 * 5 + 2u * 12 * 2);
+  // Unselected blocks give no faces.
+  Mesh two;
+  two.append(m, "a");
+  two.append(can, "b");
+  EXPECT_EQ(exterior_faces(two, {false, true}).size(), 2u * 12 * 5 + 2u * 12 * 2);
+}
+
+// The foot of the normal on a warped face is the closest point of the surface when it
+// lies inside the face: compare with a brute-force minimisation over a 401 x 401 grid
+// refined by a local search (tolerance 1e-9 of the face size on distance, 1e-6 on xi).
+TEST(Contact, ProjectionMatchesBruteForceOnWarpedFaces) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.15, 0.15);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::array<Vec3, 4> x = {Vec3{0, 0, 0}, Vec3{1, 0, 0}, Vec3{1, 1, 0}, Vec3{0, 1, 0}};
+    for (auto& p : x) p += Vec3{u(rng), u(rng), 2 * u(rng)};
+    const Vec3 p{0.5 + u(rng), 0.5 + u(rng), 0.3 * (trial % 2 ? 1 : -1) + u(rng)};
+    const QuadProjection q = project_on_quad(x, p);
+    ASSERT_TRUE(q.converged);
+    auto at = [&](double xi, double eta) {
+      const auto N = quad_shape(xi, eta);
+      return N[0] * x[0] + N[1] * x[1] + N[2] * x[2] + N[3] * x[3];
+    };
+    double best = 1e300, bx = 0, by = 0;
+    for (int i = 0; i <= 400; ++i)
+      for (int j = 0; j <= 400; ++j) {
+        const double xi = -1 + i / 200.0, eta = -1 + j / 200.0;
+        const double d = norm(at(xi, eta) - p);
+        if (d < best) {
+          best = d;
+          bx = xi;
+          by = eta;
+        }
+      }
+    if (std::abs(bx) > 0.99 || std::abs(by) > 0.99) continue; // foot outside: not comparable
+    for (double h = 1e-3; h > 1e-12; h *= 0.5)
+      for (int k = 0; k < 50; ++k)
+        for (auto [dx, dy] : {std::pair{h, 0.0}, {-h, 0.0}, {0.0, h}, {0.0, -h}}) {
+          const double d = norm(at(bx + dx, by + dy) - p);
+          if (d < best) {
+            best = d;
+            bx += dx;
+            by += dy;
+          }
+        }
+    EXPECT_NEAR(std::abs(q.gap), best, 1e-9) << trial;
+    EXPECT_NEAR(q.xi, bx, 1e-6) << trial;
+    EXPECT_NEAR(q.eta, by, 1e-6) << trial;
+    EXPECT_EQ(q.gap < 0, trial % 2 == 0) << trial; // behind when p is below the face
+  }
+}
+
+// Two faces of a block's top and a node: the rules of the detailed check.
+struct Scene {
+  std::vector<ContactNodeItem> nodes;
+  std::vector<ContactFaceItem> faces;
+  SearchWorkspace work;
+  std::vector<ContactPair> pairs;
+
+  // A unit face at height z in the x-y plane over [x0, x0 + 1] x [0, 1], normal +z.
+  void face(std::int64_t gid, double x0, double z, std::int64_t first_node) {
+    ContactFaceItem f{};
+    f.gid = gid;
+    const double xs[4][2] = {{x0, 0}, {x0 + 1, 0}, {x0 + 1, 1}, {x0, 1}};
+    for (int a = 0; a < 4; ++a) {
+      f.node[a] = first_node + a;
+      f.opposite[a] = first_node + 4 + a;
+      f.owner[a] = 0;
+      f.x[a][0] = xs[a][0];
+      f.x[a][1] = xs[a][1];
+      f.x[a][2] = z;
+      f.mass[a] = 1;
+    }
+    f.stiffness = 1e6;
+    f.depth = 0.2;
+    faces.push_back(f);
+  }
+  // A node at p whose own face (a small downward-facing face, gid 900 + index) opposes +z.
+  void node(std::int64_t gid, Vec3 p, std::int64_t last = -1) {
+    ContactNodeItem n{};
+    n.gid = gid;
+    n.x[0] = p.x;
+    n.x[1] = p.y;
+    n.x[2] = p.z;
+    n.mass = 1;
+    n.last_face = last;
+    nodes.push_back(n);
+    ContactFaceItem own{};
+    own.gid = 900 + gid;
+    const double d = 0.05;
+    const double xs[4][2] = {{0, 0}, {0, d}, {d, d}, {d, 0}}; // clockwise from above: normal -z
+    for (int a = 0; a < 4; ++a) {
+      own.node[a] = a == 0 ? gid : 10000 + 10 * gid + a;
+      own.opposite[a] = 20000 + 10 * gid + a;
+      own.x[a][0] = p.x + xs[a][0];
+      own.x[a][1] = p.y + xs[a][1];
+      own.x[a][2] = p.z;
+      own.mass[a] = 1;
+    }
+    own.stiffness = 1e6;
+    own.depth = 0.01;
+    faces.push_back(own);
+  }
+  void run() { find_contacts(nodes, faces, SearchOptions{}, work, pairs); }
+};
+
+TEST(Contact, DetailedCheckRules) {
+  { // behind the face within its depth: a pair, with the face's normal
+    Scene s;
+    s.face(1, 0, 0, 100);
+    s.node(7, {0.3, 0.4, -0.05});
+    s.run();
+    ASSERT_EQ(s.pairs.size(), 1u);
+    EXPECT_EQ(s.faces[static_cast<std::size_t>(s.pairs[0].face)].gid, 1);
+    EXPECT_NEAR(s.pairs[0].gap, -0.05, 1e-14);
+    EXPECT_NEAR(s.pairs[0].normal.z, 1.0, 1e-14);
+    EXPECT_NEAR(s.pairs[0].allowance, 0.05, 1e-14); // found already penetrating
+  }
+  { // in front, or deeper than the face's depth: nothing
+    Scene s;
+    s.face(1, 0, 0, 100);
+    s.node(7, {0.3, 0.4, 0.01});
+    s.node(8, {0.6, 0.4, -0.3});
+    s.run();
+    EXPECT_TRUE(s.pairs.empty());
+  }
+  { // a node never contacts its own element's faces
+    Scene s;
+    s.face(1, 0, 0, 100);
+    s.node(104, {0.3, 0.4, -0.05}); // node 104 is one of face 1's element's other nodes
+    s.run();
+    EXPECT_TRUE(s.pairs.empty());
+  }
+  { // two candidates: the least penetration wins; a tracked face is kept
+    Scene s;
+    s.face(1, 0, 0, 100);
+    s.face(2, 0, -0.1, 200); // a second face under the first
+    s.node(7, {0.3, 0.4, -0.12});
+    s.run();
+    ASSERT_EQ(s.pairs.size(), 1u);
+    EXPECT_EQ(s.faces[static_cast<std::size_t>(s.pairs[0].face)].gid, 2); // 0.02 behind face 2
+    Scene t;
+    t.face(1, 0, 0, 100);
+    t.face(2, 0, -0.1, 200);
+    t.node(7, {0.3, 0.4, -0.12}, /*last=*/1);
+    t.run();
+    ASSERT_EQ(t.pairs.size(), 1u);
+    EXPECT_EQ(t.faces[static_cast<std::size_t>(t.pairs[0].face)].gid, 1); // tracked
+  }
+  { // equal penetrations: the lower face id wins, whatever the order given
+    for (bool reversed : {false, true}) {
+      Scene s;
+      if (reversed) {
+        s.face(6, 1, 0, 300);
+        s.face(5, 0, 0, 100);
+      } else {
+        s.face(5, 0, 0, 100);
+        s.face(6, 1, 0, 300);
+      }
+      s.node(7, {1.0, 0.5, -0.05}); // on the shared edge of the two faces
+      s.run();
+      ASSERT_EQ(s.pairs.size(), 1u);
+      EXPECT_EQ(s.faces[static_cast<std::size_t>(s.pairs[0].face)].gid, 5);
+    }
+  }
+}
+
+// Penalty forces of a pair sum to zero (momentum conserved to round-off) with and without
+// friction; the normal force is k times the penetration beyond the allowance.
+TEST(Contact, PenaltyForcesConserveMomentum) {
+  Scene s;
+  s.face(1, 0, 0, 100);
+  s.node(7, {0.3, 0.4, -0.05});
+  s.nodes[0].v[0] = 2.0; // sliding
+  s.run();
+  ASSERT_EQ(s.pairs.size(), 1u);
+  s.pairs[0].allowance = 0.01;
+  for (double mu : {0.0, 0.3}) {
+    std::vector<ContactForceItem> items;
+    std::vector<int> dest;
+    penalty_forces(s.nodes, s.faces, s.pairs, {mu, 1e-6}, items, dest);
+    ASSERT_EQ(items.size(), 5u);
+    double sum[3] = {0, 0, 0};
+    for (const auto& it : items)
+      for (int i = 0; i < 3; ++i) sum[i] += it.f[i];
+    for (double v : sum) EXPECT_NEAR(v, 0.0, 1e-9);
+    EXPECT_NEAR(items[0].f[2], 1e6 * 0.04, 1e-6);
+    if (mu > 0)
+      EXPECT_LT(items[0].f[0], 0.0); // friction opposes the sliding
+    else
+      EXPECT_EQ(items[0].f[0], 0.0);
+  }
+}
+
+} // namespace
