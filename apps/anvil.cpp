@@ -8,6 +8,7 @@
 
 #include "anvil/core/error.hpp"
 #include "anvil/io/deck.hpp"
+#include "anvil/io/decompose.hpp"
 #include "anvil/parallel/comm.hpp"
 #include "anvil/solver/can_crush.hpp"
 #include "anvil/solver/run.hpp"
@@ -58,6 +59,10 @@ int main(int argc, char** argv) {
       app.add_subcommand("check", "validate a deck and its mesh; print counts, masses, stable dt");
   chk->add_option("deck", deck, "the YAML deck")->required();
 
+  auto* dec =
+      app.add_subcommand("decompose", "under mpirun: the decompositions at t = 0, as VTU and JSON");
+  dec->add_option("deck", deck, "the YAML deck")->required();
+  dec->add_option("-o,--output", outdir, "output directory")->required();
   auto* bench = app.add_subcommand("bench", "benchmarks");
   bench->require_subcommand(1);
   auto* can =
@@ -97,6 +102,10 @@ int main(int argc, char** argv) {
       return anvil::run(config, {outdir, !quiet}, comm);
     }
     if (*chk) return check(deck, comm);
+    if (*dec) {
+      anvil::write_decomposition(anvil::read_deck(deck), outdir, comm);
+      return 0;
+    }
     if (*can) {
       cc.ranks = comm.size();
       if (write_deck) {

@@ -60,6 +60,12 @@ public:
   void forces(const ContactNodes& nodes, double dt, PhaseTimers& timers);
 
   const ContactStats& stats() const { return stats_; }
+  // The contact RCB (valid after the first detect()).
+  const Rcb& rcb() const { return rcb_; }
+  // Items this rank held in the contact decomposition at the last detect(): its own
+  // nodes, and the faces it held (owned by centroid plus ghosts).
+  std::size_t nodes_held() const { return node_in_.size(); }
+  std::size_t faces_held() const { return face_in_.size(); }
   // RCB owner rank of each face of each owned element, -1 where the element has none
   // (first exterior face by side), per block and element (for the contact_rank field).
   std::vector<std::vector<int>> element_contact_rank(const std::vector<HexBlock>& blocks) const;

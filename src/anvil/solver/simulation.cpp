@@ -425,6 +425,10 @@ double Simulation::balance_error(const Sample& s) const {
   return std::abs(e - initial_energy_ - s.external_work) / scale;
 }
 
+void Simulation::decompose_now() {
+  if (contact_) contact_->detect(contact_view(), 0.0, timers_);
+}
+
 double Simulation::stable_time_step() {
   const NodalView view{{nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()},
                        {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()}};

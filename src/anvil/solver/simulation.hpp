@@ -73,6 +73,9 @@ public:
   // Smallest element stable time step at the current state (collective; runs the
   // element kernel without advancing anything).
   double stable_time_step();
+  // Builds the dynamic decompositions for the current state without advancing (the
+  // contact RCB of nodes and faces at rest): for `anvil decompose`. Collective.
+  void decompose_now();
 
   const Config& config() const { return config_; }
   const Comm& comm() const { return comm_; }

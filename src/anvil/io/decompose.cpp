@@ -1,0 +1,78 @@
+#include "anvil/io/decompose.hpp"
+
+#include <algorithm>
+
+#include <nlohmann/json.hpp>
+
+#include "anvil/io/files.hpp"
+#include "anvil/io/outputs.hpp"
+#include "anvil/parallel/graph_partition.hpp"
+#include "anvil/parallel/rcb_statistics.hpp"
+#include "anvil/solver/model.hpp"
+#include "anvil/solver/simulation.hpp"
+
+namespace anvil {
+
+namespace {
+
+// Per-rank values gathered on every rank, with max / mean.
+nlohmann::json per_rank(const Comm& comm, double local) {
+  const auto all = comm.allgather(local);
+  double sum = 0, mx = 0;
+  for (double v : all) {
+    sum += v;
+    mx = std::max(mx, v);
+  }
+  const double mean = sum / static_cast<double>(all.size());
+  return {{"per_rank", all}, {"total", sum}, {"imbalance", mean > 0 ? mx / mean : 1.0}};
+}
+
+} // namespace
+
+void write_decomposition(const Config& config, const std::string& outdir, const Comm& comm) {
+  Simulation sim(config, comm);
+  sim.decompose_now();
+  if (comm.rank() == 0) {
+    make_directories(outdir);
+  }
+  comm.barrier();
+
+  VtuPiece piece = fe_piece(sim);
+  const std::string stem = "decomposition";
+  write_vtu(outdir + "/" + stem + "_r" + std::to_string(comm.rank()) + ".vtu", piece);
+  comm.barrier();
+
+  nlohmann::json j;
+  j["ranks"] = comm.size();
+  j["elements"] = sim.global_elements();
+  j["nodes"] = sim.global_nodes();
+  nlohmann::json fe;
+  fe["elements"] = per_rank(comm, static_cast<double>(sim.fe().num_elements()));
+  fe["owned_nodes"] = per_rank(comm, static_cast<double>(sim.fe().num_owned_nodes()));
+  fe["held_nodes"] = per_rank(comm, static_cast<double>(sim.fe().node_gid.size()));
+  double shared = 0;
+  for (const auto& nb : sim.fe().neighbors) shared += static_cast<double>(nb.shared.size());
+  fe["shared_node_copies"] = per_rank(comm, shared);
+  fe["neighbours"] = per_rank(comm, static_cast<double>(sim.fe().neighbors.size()));
+  if (comm.rank() == 0) {
+    const Mesh mesh = build_mesh(config);
+    fe["edge_cut"] = partition_cut(mesh, partition_elements(mesh, comm.size()));
+  }
+  j["fe"] = fe;
+  if (const ContactPhase* cp = sim.contact()) {
+    nlohmann::json c = rcb_statistics(cp->rcb());
+    c["nodes_held"] = per_rank(comm, static_cast<double>(cp->nodes_held()));
+    c["faces_held"] = per_rank(comm, static_cast<double>(cp->faces_held()));
+    j["contact"] = c;
+  }
+  if (comm.rank() == 0) {
+    std::vector<std::string> pieces;
+    for (int r = 0; r < comm.size(); ++r)
+      pieces.push_back(stem + "_r" + std::to_string(r) + ".vtu");
+    write_pvtu(outdir + "/" + stem + ".pvtu", pieces, piece);
+    write_pvd(outdir + "/results.pvd", {{0.0, stem + ".pvtu"}});
+    write_file_atomic(outdir + "/decomposition.json", j.dump(2) + "\n");
+  }
+}
+
+} // namespace anvil
