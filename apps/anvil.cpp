@@ -55,6 +55,11 @@ int main(int argc, char** argv) {
   run->add_option("deck", deck, "the YAML deck")->required();
   run->add_option("-o,--output", outdir, "output directory")->capture_default_str();
   run->add_flag("-q,--quiet", quiet, "no progress line");
+  std::string restart;
+  long long stop_at = -1;
+  run->add_option("--restart", restart, "continue from a checkpoint (any number of ranks)");
+  run->add_option("--stop-at-cycle", stop_at, "stop as if by SIGTERM at this cycle (testing)")
+      ->group("");
   auto* chk =
       app.add_subcommand("check", "validate a deck and its mesh; print counts, masses, stable dt");
   chk->add_option("deck", deck, "the YAML deck")->required();
@@ -99,7 +104,7 @@ int main(int argc, char** argv) {
   try {
     if (*run) {
       const anvil::Config config = anvil::read_deck(deck);
-      return anvil::run(config, {outdir, !quiet}, comm);
+      return anvil::run(config, {outdir, !quiet, restart, stop_at}, comm);
     }
     if (*chk) return check(deck, comm);
     if (*dec) {
@@ -112,7 +117,7 @@ int main(int argc, char** argv) {
         if (root) std::printf("%s", anvil::can_crush_deck(cc).c_str());
         return 0;
       }
-      return anvil::run(anvil::can_crush_config(cc), {bench_out, !quiet}, comm);
+      return anvil::run(anvil::can_crush_config(cc), {bench_out, !quiet, "", -1}, comm);
     }
   } catch (const anvil::InputError& e) {
     if (root) std::fprintf(stderr, "anvil: error: %s\n", e.what());

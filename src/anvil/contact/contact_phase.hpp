@@ -60,6 +60,14 @@ public:
   void forces(const ContactNodes& nodes, double dt, PhaseTimers& timers);
 
   const ContactStats& stats() const { return stats_; }
+  // Contact history per local node (meaningful on the node's owner): the face it touched
+  // last cycle (-1 for none) and its allowance. For checkpoints; set_history restores it.
+  const std::vector<std::int64_t>& last_face() const { return last_face_; }
+  const std::vector<double>& allowance() const { return allowance_; }
+  void set_history(std::size_t local_node, std::int64_t face, double allowance) {
+    last_face_[local_node] = face;
+    allowance_[local_node] = allowance;
+  }
   // The contact RCB (valid after the first detect()).
   const Rcb& rcb() const { return rcb_; }
   // Items this rank held in the contact decomposition at the last detect(): its own

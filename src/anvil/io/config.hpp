@@ -102,8 +102,9 @@ struct Config {
   double end_time = std::numeric_limits<double>::infinity();
   std::int64_t end_cycles = std::numeric_limits<std::int64_t>::max();
   double time_step_scale = 0.9;
-  double fields_every = 0;  // 0: first and last only
-  double history_every = 0; // 0: every cycle
+  double fields_every = 0;     // 0: first and last only
+  double checkpoint_every = 0; // 0: checkpoints only when stopped by a signal
+  double history_every = 0;    // 0: every cycle
   std::vector<MaterialConfig> materials;
   std::vector<PartConfig> parts;
   std::map<std::string, Selection> node_sets;

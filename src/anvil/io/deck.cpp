@@ -354,9 +354,10 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
   }
   const Node top(root, "", &c.deck_file, 1);
   if (top.is_null()) throw InputError({name, 1, ""}, "the deck is empty");
-  const auto entries = top.entries(
-      {"title", "termination", "time_step", "materials", "parts", "particles", "node_sets",
-       "initial_conditions", "boundary_conditions", "contact", "rigid_walls", "probes", "output"});
+  const auto entries =
+      top.entries({"title", "termination", "time_step", "materials", "parts", "particles",
+                   "node_sets", "initial_conditions", "boundary_conditions", "contact",
+                   "rigid_walls", "probes", "output", "checkpoint"});
   for (const auto& [key, n] : entries) {
     if (key == "particles")
       n.fail(fmt::format("'{}' is part of the deck contract but not implemented in anvil {} yet",
@@ -561,6 +562,12 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
       }
       c.rigid_walls.push_back(w);
     }
+  }
+
+  if (top.has("checkpoint")) {
+    const Node cp = top.child("checkpoint");
+    cp.check_keys({"every"});
+    c.checkpoint_every = cp.required("every").positive();
   }
 
   if (top.has("output")) {

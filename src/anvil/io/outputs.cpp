@@ -2,6 +2,9 @@
 
 #include <unistd.h>
 
+#include <cstdlib>
+#include <cstring>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -107,17 +110,23 @@ double Outputs::loop_seconds() const {
   return wall_seconds() - start_wall_;
 }
 
+std::string Outputs::history_header() const {
+  const Config& c = sim_.config();
+  std::string h = "time,cycle,dt,kinetic,internal,hourglass,contact,external_work,total";
+  for (const auto& p : c.probes)
+    for (const char* f : {"ux", "uy", "uz", "vx", "vy", "vz"})
+      h += fmt::format(",{}.{}", p.name, f);
+  for (std::size_t w = 0; w < c.rigid_walls.size(); ++w) h += fmt::format(",wall{}.force", w);
+  return h;
+}
+
 void Outputs::begin() {
   start_wall_ = last_progress_wall_ = wall_seconds();
   const Config& c = sim_.config();
   if (sim_.comm().rank() == 0) {
     history_ = std::fopen((opt_.directory + "/history.csv").c_str(), "w");
     if (!history_) throw InputError("cannot write " + opt_.directory + "/history.csv");
-    std::string h = "time,cycle,dt,kinetic,internal,hourglass,contact,external_work,total";
-    for (const auto& p : c.probes)
-      for (const char* f : {"ux", "uy", "uz", "vx", "vy", "vz"})
-        h += fmt::format(",{}.{}", p.name, f);
-    std::fprintf(history_, "%s\n", h.c_str());
+    std::fprintf(history_, "%s\n", history_header().c_str());
     std::fflush(history_);
   }
   // The first row is the state the deck gave, at t = 0 (collective).
@@ -126,6 +135,46 @@ void Outputs::begin() {
   write_fields();
   next_fields_ = c.fields_every > 0 ? c.fields_every : std::numeric_limits<double>::infinity();
   next_history_ = c.history_every;
+}
+
+void Outputs::resume(const OutputState& state) {
+  start_wall_ = last_progress_wall_ = wall_seconds();
+  next_fields_ = state.next_fields;
+  next_history_ = state.next_history;
+  field_count_ = state.field_count;
+  pvd_ = state.pvd;
+  last_field_cycle_ = sim_.clock().cycle; // the fields at the checkpoint were written then
+  if (sim_.comm().rank() != 0) return;
+  // Keep the history rows before the restart time (a killed run may have written rows past
+  // its last checkpoint), then append.
+  const std::string path = opt_.directory + "/history.csv";
+  std::vector<std::string> keep;
+  if (std::FILE* in = std::fopen(path.c_str(), "r")) {
+    char* line = nullptr;
+    std::size_t cap = 0;
+    bool header = true;
+    while (getline(&line, &cap, in) > 0) {
+      std::string l(line);
+      if (!l.empty() && l.back() == '\n') l.pop_back();
+      if (header) {
+        header = false;
+        continue;
+      }
+      if (std::strtod(l.c_str(), nullptr) < sim_.clock().time) keep.push_back(l);
+    }
+    std::free(line);
+    std::fclose(in);
+  }
+  std::string text = history_header() + "\n";
+  for (const auto& l : keep) text += l + "\n";
+  write_file_atomic(path, text);
+  history_ = std::fopen(path.c_str(), "a");
+  if (!history_) throw InputError("cannot write " + path);
+  if (!pvd_.empty()) write_pvd(opt_.directory + "/results.pvd", pvd_);
+}
+
+OutputState Outputs::state() const {
+  return {next_fields_, next_history_, 0.0, field_count_, pvd_};
 }
 
 void Outputs::write_history_row(const Sample& s) {

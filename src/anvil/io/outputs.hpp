@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "anvil/io/checkpoint.hpp"
 #include "anvil/io/vtu.hpp"
 #include "anvil/solver/simulation.hpp"
 
@@ -26,6 +27,10 @@ public:
 
   // Writes the initial fields (t = 0) and opens the history.
   void begin();
+  // Continues the series of a checkpointed run instead of begin().
+  void resume(const OutputState& state);
+  // Where the series stands (for checkpoints; next_checkpoint is the run loop's).
+  OutputState state() const;
   // After each step: history row and fields when due, progress line.
   void after_step();
   // Final fields (unless just written) and summary.json. `status` is the exit status,
@@ -36,6 +41,7 @@ public:
 
 private:
   void write_fields();
+  std::string history_header() const;
   void write_history_row(const Sample& s);
   void write_summary(int status, const std::string& message);
   void progress(bool last);

@@ -1,26 +1,98 @@
 #include "anvil/solver/run.hpp"
 
+#include <csignal>
 #include <cstdio>
+#include <limits>
 
+#include "anvil/io/checkpoint.hpp"
 #include "anvil/io/outputs.hpp"
 #include "anvil/solver/simulation.hpp"
 
 namespace anvil {
 
+namespace {
+
+// The signal that asked the run to stop (0: none). A signal handler can only set a flag;
+// this is the one piece of global state in anvil, read once per cycle.
+volatile std::sig_atomic_t stop_signal = 0;
+
+extern "C" void on_stop_signal(int sig) {
+  stop_signal = sig;
+}
+
+// Installs the handlers for SIGTERM and SIGINT for its lifetime.
+class StopSignals {
+public:
+  StopSignals() {
+    stop_signal = 0;
+    struct sigaction sa {};
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGTERM, &sa, &old_term_);
+    sigaction(SIGINT, &sa, &old_int_);
+  }
+  ~StopSignals() {
+    sigaction(SIGTERM, &old_term_, nullptr);
+    sigaction(SIGINT, &old_int_, nullptr);
+  }
+
+private:
+  struct sigaction old_term_ {
+  }, old_int_{};
+};
+
+} // namespace
+
 int run(const Config& config, const RunOptions& options, const Comm& comm) {
   Simulation sim(config, comm);
   Outputs out(sim, {options.output_dir, options.progress});
-  out.begin();
+  const std::string checkpoint_path = options.output_dir + "/checkpoint.anvil";
+  double next_checkpoint = config.checkpoint_every > 0 ? config.checkpoint_every
+                                                       : std::numeric_limits<double>::infinity();
+  if (!options.restart.empty()) {
+    const Checkpoint c = read_checkpoint(options.restart); // every rank reads it
+    sim.restore(c);
+    out.resume(c.outputs);
+    if (config.checkpoint_every > 0) next_checkpoint = c.outputs.next_checkpoint;
+  } else {
+    out.begin();
+  }
+  auto checkpoint = [&] {
+    OutputState st = out.state();
+    st.next_checkpoint = next_checkpoint;
+    const Checkpoint c = capture(sim, st);
+    if (comm.rank() == 0) write_checkpoint(checkpoint_path, c);
+  };
+
+  StopSignals signals;
   try {
     while (!sim.finished()) {
+      if (stop_signal != 0 || sim.clock().cycle == options.stop_at_cycle) sim.request_stop();
       sim.step();
       out.after_step();
+      if (sim.clock().time >= next_checkpoint * (1 - 1e-12) && !sim.finished()) {
+        while (next_checkpoint <= sim.clock().time * (1 + 1e-12))
+          next_checkpoint += config.checkpoint_every;
+        checkpoint();
+      }
+      if (sim.stop_requested() && !sim.finished()) {
+        const int sig = stop_signal != 0 ? static_cast<int>(stop_signal) : SIGTERM;
+        checkpoint();
+        if (comm.rank() == 0)
+          std::fprintf(stderr,
+                       "\nanvil: stopped by signal %d at t = %.9g s (cycle %lld); checkpoint %s\n",
+                       sig, sim.clock().time, static_cast<long long>(sim.clock().cycle),
+                       checkpoint_path.c_str());
+        out.finish(128 + sig, "stopped by a signal; restart with --restart " + checkpoint_path);
+        return 128 + sig;
+      }
     }
   } catch (const PhysicsError& e) {
     if (comm.rank() == 0) std::fprintf(stderr, "\nanvil: run failed: %s\n", e.what());
     out.finish(exit_physics, e.what());
     return exit_physics;
   }
+  if (config.checkpoint_every > 0) checkpoint(); // the final state, for continuing later
   out.finish(exit_ok, "");
   return exit_ok;
 }

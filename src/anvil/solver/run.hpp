@@ -11,11 +11,16 @@ namespace anvil {
 struct RunOptions {
   std::string output_dir = "out";
   bool progress = true;
+  std::string restart;          // checkpoint to continue from (empty: start at t = 0)
+  long long stop_at_cycle = -1; // behave as if SIGTERM arrived at this cycle (testing)
 };
 
 // Runs the model to its termination time or cycle count, writing the outputs. Returns
 // the exit status: 0 when it completes, 3 when it fails physically (after writing the
-// state it failed in and the summary). Bad input throws InputError. Collective.
+// state it failed in and the summary), 128 + signal when SIGTERM or SIGINT stopped it
+// (after a checkpoint, OUTDIR/checkpoint.anvil, and the outputs). Checkpoints are also
+// written every `checkpoint.every` seconds of the deck and at the end. Bad input throws
+// InputError. Collective.
 int run(const Config& config, const RunOptions& options, const Comm& comm);
 
 } // namespace anvil

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "anvil/contact/rigid_wall.hpp"
+#include "anvil/io/checkpoint.hpp"
 #include "anvil/parallel/graph_partition.hpp"
 #include "anvil/solver/model.hpp"
 
@@ -225,8 +226,10 @@ void Simulation::fe_forces() {
     // One reduction per cycle carries the stable step and the failure flags.
     const double none = std::numeric_limits<double>::infinity();
     double red[4] = {r.dt_stable, r.inverted_gid >= 0 ? static_cast<double>(r.inverted_gid) : none,
-                     r.nonfinite_gid >= 0 ? static_cast<double>(r.nonfinite_gid) : none, 0};
-    comm_.min(std::span<double>(red, 3));
+                     r.nonfinite_gid >= 0 ? static_cast<double>(r.nonfinite_gid) : none,
+                     stop_local_ ? 0.0 : 1.0};
+    comm_.min(std::span<double>(red, 4));
+    stop_ = red[3] == 0.0; // a stop asked on any rank stops every rank after this cycle
     if (red[1] != none)
       throw PhysicsError(describe_element(static_cast<std::int64_t>(red[1])), clock_.time,
                          "inverted element (non-positive volume)");
@@ -423,6 +426,64 @@ double Simulation::balance_error(const Sample& s) const {
   const double scale =
       std::max({std::abs(e), std::abs(s.external_work), std::abs(initial_energy_), 1e-300});
   return std::abs(e - initial_energy_ - s.external_work) / scale;
+}
+
+void Simulation::restore(const Checkpoint& c) {
+  if (c.model_nodes != global_nodes_ || c.model_elements != global_elements_)
+    throw InputError(
+        fmt::format("the checkpoint of '{}' ({} nodes, {} elements) does not match this model "
+                    "({} nodes, {} elements)",
+                    c.deck, c.model_nodes, c.model_elements, global_nodes_, global_elements_));
+  clock_.time = c.time;
+  clock_.cycle = c.cycle;
+  clock_.dt = c.dt;
+  clock_.dt_prev = c.dt_prev;
+  clock_.dt_initial = c.dt_initial;
+  // Global diagnostics restart on rank 0 (they are sums over ranks).
+  external_work_ = comm_.rank() == 0 ? c.external_work : 0.0;
+  contact_energy_ = comm_.rank() == 0 ? c.contact_energy : 0.0;
+  auto find = [](const std::vector<std::int64_t>& ids, std::int64_t id) -> std::int64_t {
+    const auto it = std::lower_bound(ids.begin(), ids.end(), id);
+    return it != ids.end() && *it == id ? it - ids.begin() : -1;
+  };
+  for (std::size_t n = 0; n < nodes_.size(); ++n) {
+    const std::int64_t k = find(c.node_gid, fe_.node_gid[n]);
+    if (k < 0)
+      throw InputError("the checkpoint of '" + c.deck + "' lacks node " +
+                       std::to_string(fe_.node_gid[n] + 1));
+    const double* d = &c.node_data[static_cast<std::size_t>(k) * Checkpoint::node_values];
+    for (int i = 0; i < 3; ++i) {
+      nodes_.x[i][n] = d[i];
+      nodes_.v[i][n] = d[3 + i];
+    }
+    if (contact_) contact_->set_history(n, c.node_face[static_cast<std::size_t>(k)], d[6]);
+  }
+  for (auto& b : blocks_)
+    for (int e = 0; e < b.size(); ++e) {
+      const std::int64_t k = find(c.element_gid, b.gid[e]);
+      if (k < 0)
+        throw InputError("the checkpoint of '" + c.deck + "' lacks element " +
+                         std::to_string(b.gid[e] + 1));
+      const double* d = &c.element_data[static_cast<std::size_t>(k) * Checkpoint::element_values];
+      for (int j = 0; j < 6; ++j) b.stress[j][e] = d[j];
+      if (!b.plastic_strain.empty()) b.plastic_strain[e] = d[6];
+      if (!b.temperature.empty()) b.temperature[e] = d[7];
+      b.internal_energy[e] = d[8];
+      b.hourglass_energy[e] = d[9];
+      for (int j = 0; j < 12; ++j)
+        if (!b.hourglass_force[j].empty()) b.hourglass_force[j][e] = d[10 + j];
+    }
+  // The padding lanes of each block repeat its last element (see HexBlock::init).
+  for (auto& b : blocks_) {
+    const int n = b.size();
+    for (std::size_t e = static_cast<std::size_t>(n); n > 0 && e < b.mass.size(); ++e) {
+      for (auto& a : b.stress) a[e] = a[n - 1];
+      if (!b.plastic_strain.empty()) b.plastic_strain[e] = b.plastic_strain[n - 1];
+      if (!b.temperature.empty()) b.temperature[e] = b.temperature[n - 1];
+      for (auto& a : b.hourglass_force)
+        if (!a.empty()) a[e] = a[n - 1];
+    }
+  }
 }
 
 void Simulation::decompose_now() {

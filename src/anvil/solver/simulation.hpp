@@ -19,6 +19,8 @@
 
 namespace anvil {
 
+struct Checkpoint;
+
 // Nodal state on this rank, structure of arrays over local nodes (shared nodes appear on
 // every rank that touches them, with identical values).
 struct NodeState {
@@ -73,6 +75,18 @@ public:
   // Smallest element stable time step at the current state (collective; runs the
   // element kernel without advancing anything).
   double stable_time_step();
+  // Continues from a checkpoint of the same model (any rank count). InputError when it
+  // does not match. Collective.
+  void restore(const Checkpoint& checkpoint);
+  // Asks the run to stop after the current cycle (a signal handler's flag, or a test).
+  // The request reaches every rank through the cycle's reduction; stop_requested() then
+  // says so on all of them.
+  void request_stop() { stop_local_ = true; }
+  bool stop_requested() const { return stop_; }
+  // This rank's share of the global diagnostics (for checkpoints).
+  double external_work_local() const { return external_work_; }
+  double contact_energy_local() const { return contact_energy_; }
+
   // Builds the dynamic decompositions for the current state without advancing (the
   // contact RCB of nodes and faces at rest): for `anvil decompose`. Collective.
   void decompose_now();
@@ -150,6 +164,7 @@ private:
   std::vector<double> probe_local_;
 
   double dt_stable_ = 0; // from the last fe_forces
+  bool stop_local_ = false, stop_ = false;
   std::int64_t dt_element_ = -1;
   std::int64_t global_nodes_ = 0, global_elements_ = 0;
   std::vector<std::int64_t> block_offsets_;

@@ -1,0 +1,222 @@
+#include "anvil/io/checkpoint.hpp"
+
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "anvil/core/error.hpp"
+#include "anvil/io/files.hpp"
+#include "anvil/solver/simulation.hpp"
+
+namespace anvil {
+
+namespace {
+
+constexpr char magic[8] = {'A', 'N', 'V', 'I', 'L', 'C', 'K', '1'};
+
+// Sends this rank's records to rank 0, which keeps them in ascending global id.
+template <int Width>
+void gather_sorted(const Comm& comm, const std::vector<std::int64_t>& gid,
+                   const std::vector<double>& data, const std::vector<std::int64_t>& extra,
+                   std::vector<std::int64_t>& out_gid, std::vector<double>& out_data,
+                   std::vector<std::int64_t>& out_extra) {
+  const auto counts = comm.allgather(static_cast<std::int64_t>(gid.size()));
+  if (comm.rank() != 0) {
+    if (!gid.empty()) {
+      comm.send_bytes(gid.data(), gid.size() * sizeof(std::int64_t), 0, 21);
+      comm.send_bytes(data.data(), data.size() * sizeof(double), 0, 22);
+      comm.send_bytes(extra.data(), extra.size() * sizeof(std::int64_t), 0, 23);
+    }
+    return;
+  }
+  std::vector<std::int64_t> all_gid(gid), all_extra(extra);
+  std::vector<double> all_data(data);
+  for (int r = 1; r < comm.size(); ++r) {
+    const auto n = static_cast<std::size_t>(counts[static_cast<std::size_t>(r)]);
+    if (n == 0) continue;
+    const std::size_t g0 = all_gid.size(), d0 = all_data.size();
+    all_gid.resize(g0 + n);
+    all_extra.resize(g0 + n);
+    all_data.resize(d0 + n * Width);
+    comm.recv_bytes(all_gid.data() + g0, n * sizeof(std::int64_t), r, 21);
+    comm.recv_bytes(all_data.data() + d0, n * Width * sizeof(double), r, 22);
+    comm.recv_bytes(all_extra.data() + g0, n * sizeof(std::int64_t), r, 23);
+  }
+  std::vector<std::size_t> order(all_gid.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return all_gid[a] < all_gid[b]; });
+  out_gid.resize(order.size());
+  out_extra.resize(order.size());
+  out_data.resize(order.size() * Width);
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    out_gid[k] = all_gid[order[k]];
+    out_extra[k] = all_extra[order[k]];
+    std::memcpy(&out_data[k * Width], &all_data[order[k] * Width], Width * sizeof(double));
+  }
+}
+
+template <class T>
+void put(std::string& s, const std::vector<T>& v) {
+  const std::uint64_t n = v.size();
+  s.append(reinterpret_cast<const char*>(&n), sizeof n);
+  if (n) s.append(reinterpret_cast<const char*>(v.data()), n * sizeof(T));
+}
+
+template <class T>
+void get(const std::string& s, std::size_t& pos, std::vector<T>& v, const std::string& path) {
+  std::uint64_t n = 0;
+  if (pos + sizeof n > s.size()) throw InputError("checkpoint '" + path + "' is truncated");
+  std::memcpy(&n, s.data() + pos, sizeof n);
+  pos += sizeof n;
+  if (n > (s.size() - pos) / sizeof(T)) throw InputError("checkpoint '" + path + "' is truncated");
+  v.resize(n);
+  if (n) std::memcpy(v.data(), s.data() + pos, n * sizeof(T));
+  pos += n * sizeof(T);
+}
+
+} // namespace
+
+Checkpoint capture(const Simulation& sim, const OutputState& outputs) {
+  const Comm& comm = sim.comm();
+  Checkpoint c;
+  c.deck = sim.config().deck_file;
+  const Clock& clk = sim.clock();
+  c.time = clk.time;
+  c.cycle = clk.cycle;
+  c.dt = clk.dt;
+  c.dt_prev = clk.dt_prev;
+  c.dt_initial = clk.dt_initial;
+  c.outputs = outputs;
+  c.model_nodes = sim.global_nodes();
+  c.model_elements = sim.global_elements();
+  double diag[2] = {sim.external_work_local(), sim.contact_energy_local()};
+  comm.sum(std::span<double>(diag, 2));
+  c.external_work = diag[0];
+  c.contact_energy = diag[1];
+
+  std::vector<std::int64_t> gid, face;
+  std::vector<double> data;
+  const auto& nd = sim.nodes();
+  const ContactPhase* cp = sim.contact();
+  for (std::size_t n = 0; n < nd.size(); ++n) {
+    if (!sim.fe().node_owned[n]) continue;
+    gid.push_back(sim.fe().node_gid[n]);
+    for (int i = 0; i < 3; ++i) data.push_back(nd.x[i][n]);
+    for (int i = 0; i < 3; ++i) data.push_back(nd.v[i][n]);
+    data.push_back(cp ? cp->allowance()[n] : 0.0);
+    face.push_back(cp ? cp->last_face()[n] : -1);
+  }
+  gather_sorted<Checkpoint::node_values>(comm, gid, data, face, c.node_gid, c.node_data,
+                                         c.node_face);
+  gid.clear();
+  data.clear();
+  face.clear();
+  for (const auto& b : sim.blocks())
+    for (int e = 0; e < b.size(); ++e) {
+      gid.push_back(b.gid[e]);
+      for (int k = 0; k < 6; ++k) data.push_back(b.stress[k][e]);
+      data.push_back(b.plastic_strain.empty() ? 0.0 : b.plastic_strain[e]);
+      data.push_back(b.temperature.empty() ? 0.0 : b.temperature[e]);
+      data.push_back(b.internal_energy[e]);
+      data.push_back(b.hourglass_energy[e]);
+      for (int k = 0; k < 12; ++k)
+        data.push_back(b.hourglass_force[k].empty() ? 0.0 : b.hourglass_force[k][e]);
+      face.push_back(0);
+    }
+  std::vector<std::int64_t> unused;
+  gather_sorted<Checkpoint::element_values>(comm, gid, data, face, c.element_gid, c.element_data,
+                                            unused);
+  return c;
+}
+
+void write_checkpoint(const std::string& path, const Checkpoint& c) {
+  nlohmann::json h;
+  h["deck"] = c.deck;
+  h["time"] = c.time;
+  h["cycle"] = c.cycle;
+  h["dt"] = c.dt;
+  h["dt_prev"] = c.dt_prev;
+  h["dt_initial"] = c.dt_initial;
+  h["external_work"] = c.external_work;
+  h["contact_energy"] = c.contact_energy;
+  h["model_nodes"] = c.model_nodes;
+  h["model_elements"] = c.model_elements;
+  h["next_fields"] = c.outputs.next_fields;
+  h["next_history"] = c.outputs.next_history;
+  h["next_checkpoint"] = c.outputs.next_checkpoint;
+  h["field_count"] = c.outputs.field_count;
+  h["pvd"] = c.outputs.pvd;
+  // Doubles as raw bits in the binary part: the header's decimal text is for people.
+  const double exact[8] = {c.time,
+                           c.dt,
+                           c.dt_prev,
+                           c.dt_initial,
+                           c.external_work,
+                           c.contact_energy,
+                           c.outputs.next_fields,
+                           c.outputs.next_history};
+  std::string s(magic, sizeof magic);
+  const std::string header = h.dump();
+  put(s, std::vector<char>(header.begin(), header.end()));
+  put(s, std::vector<double>(exact, exact + 8));
+  put(s, std::vector<double>{c.outputs.next_checkpoint});
+  put(s, c.node_gid);
+  put(s, c.node_data);
+  put(s, c.node_face);
+  put(s, c.element_gid);
+  put(s, c.element_data);
+  write_file_atomic(path, s);
+}
+
+Checkpoint read_checkpoint(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError("cannot open checkpoint '" + path + "'");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string s = ss.str();
+  if (s.size() < sizeof magic || std::memcmp(s.data(), magic, sizeof magic) != 0)
+    throw InputError("'" + path + "' is not an anvil checkpoint");
+  std::size_t pos = sizeof magic;
+  Checkpoint c;
+  std::vector<char> header;
+  std::vector<double> exact, next_checkpoint;
+  get(s, pos, header, path);
+  get(s, pos, exact, path);
+  get(s, pos, next_checkpoint, path);
+  get(s, pos, c.node_gid, path);
+  get(s, pos, c.node_data, path);
+  get(s, pos, c.node_face, path);
+  get(s, pos, c.element_gid, path);
+  get(s, pos, c.element_data, path);
+  try {
+    const auto h = nlohmann::json::parse(std::string(header.begin(), header.end()));
+    c.deck = h.at("deck").get<std::string>();
+    c.cycle = h.at("cycle").get<std::int64_t>();
+    c.model_nodes = h.at("model_nodes").get<std::int64_t>();
+    c.model_elements = h.at("model_elements").get<std::int64_t>();
+    c.outputs.field_count = h.at("field_count").get<int>();
+    c.outputs.pvd = h.at("pvd").get<std::vector<std::pair<double, std::string>>>();
+  } catch (const std::exception& e) {
+    throw InputError("checkpoint '" + path + "' has a damaged header: " + e.what());
+  }
+  if (exact.size() != 8 || next_checkpoint.size() != 1 ||
+      c.node_data.size() != c.node_gid.size() * Checkpoint::node_values ||
+      c.node_face.size() != c.node_gid.size() ||
+      c.element_data.size() != c.element_gid.size() * Checkpoint::element_values)
+    throw InputError("checkpoint '" + path + "' is inconsistent");
+  c.time = exact[0];
+  c.dt = exact[1];
+  c.dt_prev = exact[2];
+  c.dt_initial = exact[3];
+  c.external_work = exact[4];
+  c.contact_energy = exact[5];
+  c.outputs.next_fields = exact[6];
+  c.outputs.next_history = exact[7];
+  c.outputs.next_checkpoint = next_checkpoint[0];
+  return c;
+}
+
+} // namespace anvil

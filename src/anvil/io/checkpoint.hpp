@@ -1,0 +1,50 @@
+// Checkpoints: the complete state of a run, independent of the number of ranks (nodes and
+// elements keyed by global id), written atomically (temporary file, fsync, rename; the
+// previous checkpoint stays until the new one is complete). `anvil run DECK --restart
+// CHECKPOINT` continues from one, on the same or another number of ranks, and reproduces
+// the uninterrupted run bit for bit.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace anvil {
+
+class Simulation;
+
+// Where the output series stood (so a restarted run continues it).
+struct OutputState {
+  double next_fields = 0, next_history = 0, next_checkpoint = 0;
+  int field_count = 0;
+  std::vector<std::pair<double, std::string>> pvd;
+};
+
+struct Checkpoint {
+  static constexpr int node_values = 7;     // x, y, z, vx, vy, vz, contact allowance
+  static constexpr int element_values = 22; // stress (6), plastic strain, temperature,
+                                            // internal and hourglass energy, Q (12)
+  std::string deck;                         // the deck the run came from (for messages)
+  double time = 0, dt = 0, dt_prev = 0, dt_initial = 0;
+  std::int64_t cycle = 0;
+  double external_work = 0, contact_energy = 0; // global diagnostics
+  OutputState outputs;
+  std::vector<std::int64_t> node_gid;               // ascending
+  std::vector<double> node_data;                    // node_values per node
+  std::vector<std::int64_t> node_face;              // contact history: last face per node
+  std::vector<std::int64_t> element_gid;            // ascending
+  std::vector<double> element_data;                 // element_values per element
+  std::int64_t model_nodes = 0, model_elements = 0; // sizes of the model, for validation
+};
+
+// Gathers the state of `sim` on rank 0 (collective); other ranks get an empty checkpoint.
+Checkpoint capture(const Simulation& sim, const OutputState& outputs);
+
+// Writes `c` to `path` atomically (rank 0's job).
+void write_checkpoint(const std::string& path, const Checkpoint& c);
+
+// Reads a checkpoint; InputError (with the file name) when it is missing or damaged.
+Checkpoint read_checkpoint(const std::string& path);
+
+} // namespace anvil
