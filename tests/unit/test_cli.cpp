@@ -149,4 +149,44 @@ output: {fields_every: 1.0e-5}
   EXPECT_TRUE(std::filesystem::exists(dir + "/results.pvd"));
 }
 
+// The same crush with erosion of inverted elements runs on: the elements are deleted
+// (counted in summary.json); and with a minimum time step fraction the collapsing step
+// stops the run naming the controlling element.
+TEST(Cli, ErosionAndTimeStepCollapse) {
+  const std::string base = R"(
+termination: {time: 1.0e-3}
+materials:
+  putty: {model: j2_plasticity, density: 1000, youngs_modulus: 1.0e8, poissons_ratio: 0.3,
+          yield_stress: 1.0e5}
+parts:
+  block:
+    mesh: {generate: box, min: [0, 0, 0], max: [0.01, 0.01, 0.01], divisions: [4, 4, 4]}
+    material: putty
+    hourglass: {model: viscous, coefficient: 0.0}
+    bulk_viscosity: {linear: 0, quadratic: 0}
+PART_EXTRA
+boundary_conditions:
+  - {set: block.zmin, fix: all}
+  - {set: block.zmax, velocity: [40.0, 0, -400.0]}
+)";
+  auto deck = [&](const std::string& extra, const std::string& top) {
+    std::string d = base;
+    d.replace(d.find("PART_EXTRA"), 10, extra);
+    return top + d;
+  };
+  const auto dir = (std::filesystem::temp_directory_path() / "anvil_cli_erosion").string();
+  std::filesystem::remove_all(dir);
+  auto r = run("run " + write_temp("erode.yaml", deck("    erosion: {inverted: true}", "")) +
+               " -o " + dir + " -q");
+  EXPECT_EQ(r.status, 0) << r.out;
+  std::stringstream summary;
+  summary << std::ifstream(dir + "/summary.json").rdbuf();
+  EXPECT_EQ(summary.str().find("\"eroded_elements\": 0"), std::string::npos) << summary.str();
+  r = run("run " + write_temp("collapse.yaml", deck("", "time_step: {minimum_fraction: 0.3}\n")) +
+          " -o " + dir + " -q");
+  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_NE(r.out.find("time step collapsed"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("part block"), std::string::npos) << r.out;
+}
+
 } // namespace

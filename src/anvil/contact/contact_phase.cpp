@@ -9,7 +9,7 @@ ContactPhase::~ContactPhase() = default;
 
 ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const FeDecomposition& fe,
                            const std::vector<HexBlock>& blocks, const Comm& comm)
-    : config_(config), fe_(fe), comm_(comm), rcb_(comm) {
+    : config_(config), fe_(fe), comm_(comm), blocks_(blocks), rcb_(comm) {
   global_nodes_ = mesh.num_nodes();
   std::vector<bool> selected(mesh.blocks.size(), config.parts.empty());
   for (const auto& name : config.parts)
@@ -58,6 +58,7 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
     my_face_stiffness_.push_back(config.penalty_scale * K * area * area / vol);
     my_face_depth_.push_back(config.depth_fraction * vol / area);
     my_face_element_.emplace_back(el, surf.side[f]);
+    my_face_slot_.emplace_back(static_cast<int>(b), static_cast<int>(e));
   }
   my_face_rank_.assign(my_face_gid_.size(), comm.rank());
   last_face_.assign(fe.node_gid.size(), -1);
@@ -149,6 +150,10 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     face_dest_.clear();
     face_out_.clear();
     for (std::size_t f = 0; f < nf; ++f) {
+      // Faces of eroded elements have left the surface.
+      const auto [fb, fe] = my_face_slot_[f];
+      if (blocks_[static_cast<std::size_t>(fb)].alive[static_cast<std::size_t>(fe)] == 0.0)
+        continue;
       const Box3 box = capture_box(faces[f]);
       const Vec3 c = face_plane(faces[f]).centre;
       my_face_rank_[f] = rcb_.owner(c);

@@ -82,7 +82,8 @@ private:
   const ContactConfig config_;
   const FeDecomposition& fe_;
   const Comm& comm_;
-  std::int64_t global_nodes_ = 0; // offset that keeps face point ids apart from node ids
+  const std::vector<HexBlock>& blocks_; // the FE blocks (their `alive` flags)
+  std::int64_t global_nodes_ = 0;       // offset that keeps face point ids apart from node ids
 
   // FE side (this rank): contact nodes it owns and faces of elements it owns.
   std::vector<int> my_nodes_;           // local node indices
@@ -93,6 +94,7 @@ private:
   std::vector<std::array<int, 4>> my_face_opposite_; // the element's other four nodes
   std::vector<double> my_face_stiffness_, my_face_depth_;
   std::vector<std::pair<std::int64_t, int>> my_face_element_; // (element gid, side)
+  std::vector<std::pair<int, int>> my_face_slot_;             // (block, element index) of each face
   std::vector<int> my_face_rank_; // contact rank of the centroid, last cycle
 
   Rcb rcb_;

@@ -84,6 +84,7 @@ int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array
       conn[a][e] = n > 0 ? corners[std::min<std::size_t>(e, n - 1)][a] : 0;
   }
   volume.assign(p, 0.0);
+  alive.assign(p, 1.0);
   hex_volumes(*this, x, volume);
   const double rho = material->elastic().density;
   mass.assign(p, 0.0);
@@ -260,8 +261,10 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       const vdouble power_new =
           s[0] * d[0] + s[1] * d[1] + s[2] * d[2] + 2.0 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
       const vdouble vmid = simd::load(scratch(s_volume_mid) + l);
-      const vdouble dE =
-          dt * vmid * (0.5 * (simd::load(scratch(s_power_old) + l) + power_new) - q * trd);
+      vdouble dE = dt * vmid * (0.5 * (simd::load(scratch(s_power_old) + l) + power_new) - q * trd);
+      const auto dead = simd::load(&b.alive[e]) == 0.0; // eroded elements store no energy
+      stdx::where(dead, dE) = 0.0;
+      stdx::where(dead, hg_power) = 0.0;
       simd::store(simd::load(&b.internal_energy[e]) + dE, &b.internal_energy[e]);
       simd::store(simd::load(&b.hourglass_energy[e]) + dt * hg_power, &b.hourglass_energy[e]);
       simd::store(vol, &b.volume[e]);
@@ -269,7 +272,20 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       // Stable time step: Flanagan-Belytschko bound on the maximum eigenvalue,
       // omega^2 <= 8 c^2 B:B / V^2, i.e. dt = V / (c sqrt(2 B:B)), reduced for the bulk
       // viscosity.
-      const vdouble dte = lc / (qv + stdx::sqrt(qv * qv + c * c));
+      vdouble dte = lc / (qv + stdx::sqrt(qv * qv + c * c));
+
+      // Eroded elements: no force, no energy, no time step (select, not multiply: their
+      // arithmetic may have produced non-finite values).
+      if (stdx::any_of(dead)) {
+        for (int a = 0; a < 8; ++a)
+          for (int i = 0; i < 3; ++i) stdx::where(dead, f[a][i]) = 0.0;
+        stdx::where(dead, dte) = 1e300;
+        for (int k = 0; k < 6; ++k) {
+          vdouble sk = simd::load(&b.stress[k][e]);
+          stdx::where(dead, sk) = 0.0;
+          simd::store(sk, &b.stress[k][e]);
+        }
+      }
 
       vdouble check = dte;
       for (int a = 0; a < 8; ++a)
@@ -283,6 +299,19 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       const int lanes = std::min(width, n - e);
       for (int k = 0; k < lanes; ++k) {
         const std::int64_t id = b.gid[e + k];
+        if (b.alive[e + k] == 0.0) continue;
+        const bool erode = (b.erosion.inverted && !(vol[k] > 0.0)) ||
+                           (b.erosion.plastic_strain > 0 && !b.plastic_strain.empty() &&
+                            b.plastic_strain[e + k] >= b.erosion.plastic_strain);
+        if (erode) { // delete it now: this cycle's forces already leave it out
+          b.alive[e + k] = 0.0;
+          for (int a = 0; a < 8; ++a)
+            for (int i = 0; i < 3; ++i)
+              corners.f[i][b.corner_base + static_cast<std::size_t>(a) * stride + e + k] = 0.0;
+          for (auto& sk : b.stress) sk[e + k] = 0.0;
+          ++result.eroded;
+          continue;
+        }
         if (!(vol[k] > 0.0)) {
           if (result.inverted_gid < 0 || id < result.inverted_gid) result.inverted_gid = id;
         } else if (!std::isfinite(check[k])) {

@@ -32,17 +32,28 @@ struct BulkViscosity {
   double linear = 0.06;
 };
 
+// Element erosion (optional, per part): an element whose plastic strain reaches a limit,
+// or whose volume turns non-positive, is deleted: it stops producing force, its faces
+// leave the contact surfaces, its mass stays on its nodes.
+struct Erosion {
+  double plastic_strain = 0; // 0: off
+  bool inverted = false;     // erode instead of stopping the run
+  bool enabled() const { return plastic_strain > 0 || inverted; }
+};
+
 struct HexBlock {
   std::string name;                   // part name
   int part = 0;                       // part index in the deck
   const Material* material = nullptr; // not owned
   HourglassControl hourglass;
   BulkViscosity bulk_viscosity;
+  Erosion erosion;
 
   std::vector<std::int64_t> gid;                       // global element ids, ascending
   std::array<std::vector<int>, 8> conn;                // local node index of each corner
   std::vector<double> mass;                            // kg
   std::vector<double> volume;                          // current volume, m^3
+  std::vector<double> alive;                           // 1, or 0 once eroded
   std::array<std::vector<double>, 6> stress;           // Cauchy stress, Pa
   std::vector<double> plastic_strain;                  // empty unless the material has it
   std::vector<double> temperature;                     // empty unless the material has it
@@ -77,6 +88,7 @@ struct HexResult {
   std::int64_t stable_gid = -1;    // element that controls it
   std::int64_t inverted_gid = -1;  // first element (by gid) with non-positive volume, or -1
   std::int64_t nonfinite_gid = -1; // first element with a non-finite force or stress, or -1
+  std::int64_t eroded = 0;         // elements eroded in this call
 };
 
 // Scratch space reused by every call (the cycle allocates nothing).

@@ -42,6 +42,7 @@ struct PartConfig {
   std::string material;
   HourglassControl hourglass;
   BulkViscosity bulk_viscosity;
+  Erosion erosion;
   SourceLocation where;
 };
 
@@ -102,9 +103,10 @@ struct Config {
   double end_time = std::numeric_limits<double>::infinity();
   std::int64_t end_cycles = std::numeric_limits<std::int64_t>::max();
   double time_step_scale = 0.9;
-  double fields_every = 0;     // 0: first and last only
-  double checkpoint_every = 0; // 0: checkpoints only when stopped by a signal
-  double history_every = 0;    // 0: every cycle
+  double time_step_minimum_fraction = 0; // stop when dt < this * initial dt (0: never)
+  double fields_every = 0;               // 0: first and last only
+  double checkpoint_every = 0;           // 0: checkpoints only when stopped by a signal
+  double history_every = 0;              // 0: every cycle
   std::vector<MaterialConfig> materials;
   std::vector<PartConfig> parts;
   std::map<std::string, Selection> node_sets;

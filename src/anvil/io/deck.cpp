@@ -279,7 +279,7 @@ PartConfig parse_part(const std::string& name, const Node& n, const std::string&
   PartConfig p;
   p.name = name;
   p.where = n.where();
-  n.check_keys({"mesh", "material", "hourglass", "bulk_viscosity"});
+  n.check_keys({"mesh", "material", "hourglass", "bulk_viscosity", "erosion"});
   p.mesh = parse_mesh(n.required("mesh"), base_dir);
   p.material = n.required("material").str();
   if (n.has("hourglass")) {
@@ -299,6 +299,16 @@ PartConfig parse_part(const std::string& name, const Node& n, const std::string&
       const double c = h.child("coefficient").number();
       if (!(c >= 0 && c <= 1)) h.child("coefficient").fail("must be between 0 and 1");
       p.hourglass.coefficient = c;
+    }
+  }
+  if (n.has("erosion")) {
+    const Node er = n.child("erosion");
+    er.check_keys({"plastic_strain", "inverted"});
+    if (er.has("plastic_strain")) p.erosion.plastic_strain = er.child("plastic_strain").positive();
+    if (er.has("inverted")) {
+      const std::string v = er.child("inverted").str();
+      if (v != "true" && v != "false") er.child("inverted").fail("expected true or false");
+      p.erosion.inverted = v == "true";
     }
   }
   if (n.has("bulk_viscosity")) {
@@ -378,7 +388,12 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 
   if (top.has("time_step")) {
     const Node ts = top.child("time_step");
-    ts.check_keys({"scale"});
+    ts.check_keys({"scale", "minimum_fraction"});
+    if (ts.has("minimum_fraction")) {
+      c.time_step_minimum_fraction = ts.child("minimum_fraction").number();
+      if (!(c.time_step_minimum_fraction >= 0 && c.time_step_minimum_fraction < 1))
+        ts.child("minimum_fraction").fail("must be in [0, 1): a fraction of the initial time step");
+    }
     if (ts.has("scale")) {
       c.time_step_scale = ts.child("scale").number();
       if (!(c.time_step_scale > 0 && c.time_step_scale <= 1))

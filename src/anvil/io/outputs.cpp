@@ -77,6 +77,15 @@ VtuPiece fe_piece(const Simulation& sim) {
   if (temp_anywhere) p.cell_data.push_back(std::move(temp));
   p.cell_data.push_back(std::move(rank));
   if (sim.contact()) p.cell_data.push_back(std::move(contact_rank));
+  // Eroded elements (1), when any part erodes: threshold them away in ParaView.
+  const auto& parts = sim.config().parts;
+  if (std::any_of(parts.begin(), parts.end(),
+                  [](const PartConfig& q) { return q.erosion.enabled(); })) {
+    VtuArray er{"eroded", 1, true};
+    for (const auto& b : sim.blocks())
+      for (int e = 0; e < b.size(); ++e) er.i64.push_back(b.alive[e] == 0.0 ? 1 : 0);
+    p.cell_data.push_back(std::move(er));
+  }
   p.cell_data.push_back(std::move(eid));
   p.cell_data.push_back(std::move(part));
   return p;
@@ -280,6 +289,7 @@ void Outputs::write_summary(int status, const std::string& message) {
   const Sample s = have_sample_ ? last_sample_ : sim_.sample();
   const ContactStats contact_stats = sim_.contact() ? sim_.contact()->stats() : ContactStats{};
   const double bytes_max = comm.max(contact_stats.bytes_sent);
+  const std::int64_t eroded = comm.sum(sim_.eroded_local());
   if (comm.rank() != 0) return;
   using nlohmann::json;
   const Clock& clk = sim_.clock();
@@ -297,6 +307,7 @@ void Outputs::write_summary(int status, const std::string& message) {
   j["elements"] = sim_.global_elements();
   j["particles"] = 0;
   j["cycles"] = clk.cycle;
+  j["eroded_elements"] = eroded;
   j["time"] = clk.time;
   j["dt_initial"] = clk.dt_initial;
   j["dt_final"] = clk.dt;

@@ -63,6 +63,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     hb.material = material_of(part.material);
     hb.hourglass = part.hourglass;
     hb.bulk_viscosity = part.bulk_viscosity;
+    hb.erosion = part.erosion;
     const int bad = hb.init(lb.gid, lb.conn, xs, lb.corner_base);
     // Every rank must throw, not only the one holding the element.
     const std::int64_t none = std::numeric_limits<std::int64_t>::max();
@@ -222,6 +223,7 @@ void Simulation::fe_forces() {
       if (b.size() > 0) hex_forces(b, view, clock_.dt_prev, corners, workspace_, r);
     dt_stable_ = r.dt_stable;
     dt_element_ = r.stable_gid;
+    eroded_ += r.eroded;
 
     // One reduction per cycle carries the stable step and the failure flags.
     const double none = std::numeric_limits<double>::infinity();
@@ -257,6 +259,12 @@ void Simulation::fe_forces() {
 void Simulation::predict() {
   ScopedPhase t(timers_, Phase::predict);
   double dt = config_.time_step_scale * dt_stable_;
+  if (clock_.cycle > 0 && dt < config_.time_step_minimum_fraction * clock_.dt_initial)
+    throw PhysicsError(
+        describe_element(dt_element_), clock_.time,
+        fmt::format("the time step collapsed to {:.3e} s, below {} of the initial {:.3e} s "
+                    "(this element controls it)",
+                    dt, config_.time_step_minimum_fraction, clock_.dt_initial));
   if (std::isfinite(config_.end_time) && clock_.time + dt > config_.end_time)
     dt = std::max(config_.end_time - clock_.time, 0.0);
   clock_.dt = dt;

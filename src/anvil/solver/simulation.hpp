@@ -86,6 +86,7 @@ public:
   // This rank's share of the global diagnostics (for checkpoints).
   double external_work_local() const { return external_work_; }
   double contact_energy_local() const { return contact_energy_; }
+  std::int64_t eroded_local() const { return eroded_; }
 
   // Builds the dynamic decompositions for the current state without advancing (the
   // contact RCB of nodes and faces at rest): for `anvil decompose`. Collective.
@@ -165,6 +166,7 @@ private:
 
   double dt_stable_ = 0; // from the last fe_forces
   bool stop_local_ = false, stop_ = false;
+  std::int64_t eroded_ = 0; // elements this rank has eroded
   std::int64_t dt_element_ = -1;
   std::int64_t global_nodes_ = 0, global_elements_ = 0;
   std::vector<std::int64_t> block_offsets_;
