@@ -154,9 +154,9 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       const auto [fb, fe] = my_face_slot_[f];
       if (blocks_[static_cast<std::size_t>(fb)].alive[static_cast<std::size_t>(fe)] == 0.0)
         continue;
-      const Box3 box = capture_box(faces[f]);
-      const Vec3 c = face_plane(faces[f]).centre;
-      my_face_rank_[f] = rcb_.owner(c);
+      const FacePlane plane = face_plane(faces[f]);
+      const Box3 box = capture_box(faces[f], plane);
+      my_face_rank_[f] = rcb_.owner(plane.centre);
       rcb_.overlapping(box, ranks_);
       for (int r : ranks_) {
         face_out_.push_back(faces[f]);

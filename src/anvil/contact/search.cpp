@@ -18,11 +18,12 @@ FacePlane face_plane(const ContactFaceItem& f) {
   const double len = norm(n);
   p.normal = len > 0 ? n * (1 / len) : Vec3{};
   p.size = std::sqrt(0.5 * len); // the diagonals' cross product is twice the area
+  for (int a = 0; a < 4; ++a)
+    p.warp = std::max(p.warp, std::abs(dot(Vec3{x[a][0], x[a][1], x[a][2]} - p.centre, p.normal)));
   return p;
 }
 
-Box3 capture_box(const ContactFaceItem& f) {
-  const FacePlane p = face_plane(f);
+Box3 capture_box(const ContactFaceItem& f, const FacePlane& p) {
   const Vec3 back = p.normal * (-2 * f.depth);
   const double pad = 0.05 * p.size;
   Box3 b{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
@@ -50,28 +51,22 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
   w.extent.resize(nf);
   w.plane.resize(5 * nf);
   for (std::size_t f = 0; f < nf; ++f) {
-    const Box3 cb = capture_box(faces[f]);
+    // Mean plane (unit normal from the diagonals) and how far the warped face strays from
+    // it: cheap tests that discard most candidates before the projection.
+    const FacePlane fp = face_plane(faces[f]);
+    const Box3 cb = capture_box(faces[f], fp);
     double* b = &w.box[6 * f];
     for (int i = 0; i < 3; ++i) {
       b[i] = cb.lo[i];
       b[3 + i] = cb.hi[i];
     }
     w.extent[f] = std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
-    // Mean plane (unit normal from the diagonals) and how far the warped face strays from
-    // it: cheap tests that discard most candidates before the projection.
-    const auto& x = faces[f].x;
     double* pl = &w.plane[5 * f];
-    const FacePlane fp = face_plane(faces[f]);
-    const Vec3 nrm = fp.normal;
-    const Vec3 c = fp.centre;
-    double warp = 0;
-    for (int a = 0; a < 4; ++a)
-      warp = std::max(warp, std::abs(dot(Vec3{x[a][0], x[a][1], x[a][2]} - c, nrm)));
-    pl[0] = nrm.x;
-    pl[1] = nrm.y;
-    pl[2] = nrm.z;
-    pl[3] = dot(c, nrm);
-    pl[4] = warp;
+    pl[0] = fp.normal.x;
+    pl[1] = fp.normal.y;
+    pl[2] = fp.normal.z;
+    pl[3] = dot(fp.centre, fp.normal);
+    pl[4] = fp.warp;
   }
   // Cells the size of the median capture box: a typical face lands in at most 2 x 2 x 2
   // cells, the few large ones (a crushing block's) in more, and a node's cell lists only

@@ -61,6 +61,7 @@ struct ContactPair {
 struct FacePlane {
   Vec3 centre, normal;
   double size = 0;
+  double warp = 0; // largest distance of a corner from the plane
 };
 FacePlane face_plane(const ContactFaceItem& face);
 
@@ -68,7 +69,7 @@ FacePlane face_plane(const ContactFaceItem& face);
 // by twice its depth (the deepest a tracked pair goes), padded by 5% of its size for the
 // parametric tolerance. The contact decomposition ghosts a face to every rank this box
 // touches.
-Box3 capture_box(const ContactFaceItem& face);
+Box3 capture_box(const ContactFaceItem& face, const FacePlane& plane);
 
 struct SearchOptions {
   double dt = 0; // the step just predicted: x - dt v is the start of the step (0: no check)
