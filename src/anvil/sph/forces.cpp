@@ -1,0 +1,286 @@
+#include "anvil/sph/forces.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "anvil/fe/hex8.hpp"
+
+namespace anvil::sph {
+
+void principal(const double s[6], double lambda[3], double Q[3][3]) {
+  double A[3][3] = {{s[0], s[3], s[5]}, {s[3], s[1], s[4]}, {s[5], s[4], s[2]}};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) Q[i][j] = i == j ? 1.0 : 0.0;
+  constexpr int pq[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+  // Jacobi converges quadratically: 6 sweeps reach round-off for any 3x3 tensor.
+  for (int sweep = 0; sweep < 6; ++sweep)
+    for (const auto& e : pq) {
+      const int p = e[0], q = e[1];
+      const double apq = A[p][q];
+      if (apq == 0.0) continue;
+      const double theta = (A[q][q] - A[p][p]) / (2 * apq);
+      const double t = (theta >= 0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1));
+      const double c = 1 / std::sqrt(t * t + 1), sn = t * c;
+      for (int k = 0; k < 3; ++k) { // A <- A J
+        const double akp = A[k][p], akq = A[k][q];
+        A[k][p] = c * akp - sn * akq;
+        A[k][q] = sn * akp + c * akq;
+      }
+      for (int k = 0; k < 3; ++k) { // A <- J^T A
+        const double apk = A[p][k], aqk = A[q][k];
+        A[p][k] = c * apk - sn * aqk;
+        A[q][k] = sn * apk + c * aqk;
+      }
+      for (int k = 0; k < 3; ++k) { // Q <- Q J
+        const double qkp = Q[k][p], qkq = Q[k][q];
+        Q[k][p] = c * qkp - sn * qkq;
+        Q[k][q] = sn * qkp + c * qkq;
+      }
+    }
+  for (int i = 0; i < 3; ++i) lambda[i] = A[i][i];
+}
+
+namespace {
+
+// Monaghan's artificial stress of one particle: in the principal frame of sigma,
+// R'_aa = -epsilon sigma'_aa / rho^2 where sigma'_aa is tensile, else 0; rotated back.
+void artificial_stress(const double s[6], double rho, double eps, double R[6]) {
+  double lam[3], Q[3][3];
+  principal(s, lam, Q);
+  double r[3];
+  for (int a = 0; a < 3; ++a) r[a] = lam[a] > 0 ? -eps * lam[a] / (rho * rho) : 0.0;
+  auto comp = [&](int i, int j) {
+    return Q[i][0] * r[0] * Q[j][0] + Q[i][1] * r[1] * Q[j][1] + Q[i][2] * r[2] * Q[j][2];
+  };
+  R[0] = comp(0, 0);
+  R[1] = comp(1, 1);
+  R[2] = comp(2, 2);
+  R[3] = comp(0, 1);
+  R[4] = comp(1, 2);
+  R[5] = comp(0, 2);
+}
+
+// Inverse of a 3x3 matrix; false when it is nearly singular (|det| below tol).
+bool invert3(const double B[3][3], double inv[3][3], double tol) {
+  const double c00 = B[1][1] * B[2][2] - B[1][2] * B[2][1];
+  const double c01 = B[1][2] * B[2][0] - B[1][0] * B[2][2];
+  const double c02 = B[1][0] * B[2][1] - B[1][1] * B[2][0];
+  const double det = B[0][0] * c00 + B[0][1] * c01 + B[0][2] * c02;
+  if (!(std::abs(det) > tol)) return false;
+  const double id = 1 / det;
+  inv[0][0] = c00 * id;
+  inv[1][0] = c01 * id;
+  inv[2][0] = c02 * id;
+  inv[0][1] = (B[0][2] * B[2][1] - B[0][1] * B[2][2]) * id;
+  inv[1][1] = (B[0][0] * B[2][2] - B[0][2] * B[2][0]) * id;
+  inv[2][1] = (B[0][1] * B[2][0] - B[0][0] * B[2][1]) * id;
+  inv[0][2] = (B[0][1] * B[1][2] - B[0][2] * B[1][1]) * id;
+  inv[1][2] = (B[0][2] * B[1][0] - B[0][0] * B[1][2]) * id;
+  inv[2][2] = (B[0][0] * B[1][1] - B[0][1] * B[1][0]) * id;
+  return true;
+}
+
+} // namespace
+
+void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelType kernel,
+                    const NeighbourList& nl, double dt, SphWorkspace& w) {
+  const std::size_t n = p.n_local;
+  w.pair.resize(4 * nl.pairs());
+  for (auto& d : w.d) d.resize(n);
+  w.power_old.resize(n);
+  w.energy_pred.resize(n);
+  const double* x = p.x[0];
+  const double* y = p.x[1];
+  const double* z = p.x[2];
+
+  for (std::size_t i = 0; i < n; ++i) {
+    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
+    const double xi = x[i], yi = y[i], zi = z[i], hi = p.h[i];
+    const double vi[3] = {p.v[0][i], p.v[1][i], p.v[2][i]};
+    double L[3][3] = {}, B[3][3] = {};
+    for (std::int64_t k = nl.start[i]; k < nl.start[i + 1]; ++k) {
+      const auto j = static_cast<std::size_t>(nl.index[static_cast<std::size_t>(k)]);
+      const SetParams& sj = sets[static_cast<std::size_t>(p.set[j])];
+      const double dx[3] = {xi - x[j], yi - y[j], zi - z[j]};
+      const double r = std::sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
+      const double hb = 0.5 * (hi + p.h[j]);
+      double wk, dwr;
+      sph::kernel(kernel, r, hb, wk, dwr);
+      const double g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
+      double fn = 0;
+      const double eps = 0.5 * (si.epsilon + sj.epsilon);
+      if (eps > 0) {
+        const double t = wk * hb * hb * hb / (0.5 * (si.w_spacing + sj.w_spacing));
+        const double ex = 0.5 * (si.exponent + sj.exponent);
+        fn = ex == 4.0 ? (t * t) * (t * t) : std::pow(t, ex);
+      }
+      double* pd = &w.pair[4 * static_cast<std::size_t>(k)];
+      pd[0] = g[0];
+      pd[1] = g[1];
+      pd[2] = g[2];
+      pd[3] = fn;
+      const double mj = p.mass[j];
+      const double dv[3] = {mj * (p.v[0][j] - vi[0]), mj * (p.v[1][j] - vi[1]),
+                            mj * (p.v[2][j] - vi[2])};
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) L[a][b] += dv[a] * g[b];
+      if (si.corrected)
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) B[a][b] -= mj * dx[a] * g[b];
+    }
+    const double inv_rho = 1 / p.rho[i];
+    for (auto& row : L)
+      for (double& c : row) c *= inv_rho;
+    if (si.corrected) {
+      // Normalised gradient L B^-1, B = (1/rho_i) sum m_j (x_j - x_i) (x) grad W: exact
+      // for a linear velocity field also near free surfaces. A particle with too few
+      // neighbours (B nearly singular) keeps the plain gradient.
+      for (auto& row : B)
+        for (double& c : row) c *= inv_rho;
+      double Bi[3][3];
+      if (invert3(B, Bi, 1e-3)) {
+        double Lc[3][3];
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b)
+            Lc[a][b] = L[a][0] * Bi[0][b] + L[a][1] * Bi[1][b] + L[a][2] * Bi[2][b];
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) L[a][b] = Lc[a][b];
+      }
+    }
+    const double d[6] = {L[0][0],
+                         L[1][1],
+                         L[2][2],
+                         0.5 * (L[0][1] + L[1][0]),
+                         0.5 * (L[1][2] + L[2][1]),
+                         0.5 * (L[0][2] + L[2][0])};
+    const double spin[3] = {0.5 * (L[2][1] - L[1][2]), 0.5 * (L[0][2] - L[2][0]),
+                            0.5 * (L[1][0] - L[0][1])};
+    // Continuity, time-centred: rho(n) = rho(n-1) (1 - tr D dt/2) / (1 + tr D dt/2).
+    const double tr = (d[0] + d[1] + d[2]) * dt;
+    p.rho[i] = p.rho[i] * (1 - 0.5 * tr) / (1 + 0.5 * tr);
+    // Objective stress rate: rotate the old stress by Hughes-Winget, as the element does.
+    double Q[3][3], s[6];
+    hex8::hughes_winget(spin, dt, Q);
+    for (int k = 0; k < 6; ++k) s[k] = p.stress[k][i];
+    hex8::rotate_symmetric(Q, s);
+    for (int k = 0; k < 6; ++k) {
+      p.stress[k][i] = s[k];
+      w.d[k][i] = d[k];
+    }
+    const double power =
+        s[0] * d[0] + s[1] * d[1] + s[2] * d[2] + 2 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
+    w.power_old[i] = power;
+    w.energy_pred[i] = p.energy[i] + power * dt / p.rho[i];
+  }
+
+  // Constitutive update through the batch interface, one run of a set's particles at a
+  // time (own particles are in ascending gid, so each set is one contiguous run).
+  constexpr std::size_t chunk = 64;
+  for (std::size_t i0 = 0; i0 < n;) {
+    const int set = p.set[i0];
+    std::size_t i1 = i0 + 1;
+    while (i1 < n && i1 - i0 < chunk && p.set[i1] == set) ++i1;
+    MaterialBatch b;
+    b.n = static_cast<int>(i1 - i0);
+    b.dt = dt;
+    for (int k = 0; k < 6; ++k) {
+      b.d[k] = w.d[k].data() + i0;
+      b.stress[k] = p.stress[k] + i0;
+    }
+    b.density = p.rho + i0;
+    b.plastic_strain = p.plastic_strain + i0;
+    b.temperature = p.temperature + i0;
+    b.wave_speed = p.wave_speed + i0;
+    b.energy = w.energy_pred.data() + i0;
+    sets[static_cast<std::size_t>(set)].material->update(b);
+    i0 = i1;
+  }
+
+  for (std::size_t i = 0; i < n; ++i) {
+    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
+    double s[6];
+    for (int k = 0; k < 6; ++k) s[k] = p.stress[k][i];
+    const double power = s[0] * w.d[0][i] + s[1] * w.d[1][i] + s[2] * w.d[2][i] +
+                         2 * (s[3] * w.d[3][i] + s[4] * w.d[4][i] + s[5] * w.d[5][i]);
+    const double rho = p.rho[i];
+    p.energy[i] += 0.5 * (w.power_old[i] + power) * dt / rho;
+    const double ir2 = 1 / (rho * rho);
+    for (int k = 0; k < 6; ++k) p.S[k][i] = s[k] * ir2;
+    double R[6] = {0, 0, 0, 0, 0, 0};
+    if (si.epsilon > 0) artificial_stress(s, rho, si.epsilon, R);
+    for (int k = 0; k < 6; ++k) p.R[k][i] = R[k];
+  }
+}
+
+void sph_forces(const SphView& p, std::span<const SetParams> sets, const NeighbourList& nl,
+                SphWorkspace& w, SphResult& res) {
+  const std::size_t n = p.n_local;
+  const double* x = p.x[0];
+  const double* y = p.x[1];
+  const double* z = p.x[2];
+  for (std::size_t i = 0; i < n; ++i) {
+    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
+    const double xi = x[i], yi = y[i], zi = z[i], hi = p.h[i];
+    const double vi[3] = {p.v[0][i], p.v[1][i], p.v[2][i]};
+    const double ci = p.wave_speed[i], rhoi = p.rho[i];
+    double Si[6], Ri[6];
+    for (int k = 0; k < 6; ++k) {
+      Si[k] = p.S[k][i];
+      Ri[k] = p.R[k][i];
+    }
+    double acc[3] = {0, 0, 0}, de = 0, mu_max = 0;
+    for (std::int64_t k = nl.start[i]; k < nl.start[i + 1]; ++k) {
+      const auto j = static_cast<std::size_t>(nl.index[static_cast<std::size_t>(k)]);
+      const double* pd = &w.pair[4 * static_cast<std::size_t>(k)];
+      const double g[3] = {pd[0], pd[1], pd[2]};
+      const double fn = pd[3];
+      const double dx[3] = {xi - x[j], yi - y[j], zi - z[j]};
+      const double dv[3] = {vi[0] - p.v[0][j], vi[1] - p.v[1][j], vi[2] - p.v[2][j]};
+      const double vr = dv[0] * dx[0] + dv[1] * dx[1] + dv[2] * dx[2];
+      double pi = 0;
+      if (vr < 0) {
+        const SetParams& sj = sets[static_cast<std::size_t>(p.set[j])];
+        const double hb = 0.5 * (hi + p.h[j]);
+        const double r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
+        const double mu = hb * vr / (r2 + 0.01 * hb * hb);
+        const double cb = 0.5 * (ci + p.wave_speed[j]), rb = 0.5 * (rhoi + p.rho[j]);
+        pi = (-0.5 * (si.alpha + sj.alpha) * cb * mu + 0.5 * (si.beta + sj.beta) * mu * mu) / rb;
+        mu_max = std::max(mu_max, -mu);
+      }
+      double T[6];
+      for (int c = 0; c < 6; ++c) T[c] = Si[c] + p.S[c][j];
+      if (fn > 0)
+        for (int c = 0; c < 6; ++c) T[c] += fn * (Ri[c] + p.R[c][j]);
+      T[0] -= pi;
+      T[1] -= pi;
+      T[2] -= pi;
+      const double mj = p.mass[j];
+      acc[0] += mj * (T[0] * g[0] + T[3] * g[1] + T[5] * g[2]);
+      acc[1] += mj * (T[3] * g[0] + T[1] * g[1] + T[4] * g[2]);
+      acc[2] += mj * (T[5] * g[0] + T[4] * g[1] + T[2] * g[2]);
+      // Work of the pair's artificial terms on particle i: half the viscous dissipation,
+      // and the artificial stress's own part (the stress's work is in the material update).
+      const double dvg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
+      double rg = 0;
+      if (fn > 0)
+        rg = dv[0] * (Ri[0] * g[0] + Ri[3] * g[1] + Ri[5] * g[2]) +
+             dv[1] * (Ri[3] * g[0] + Ri[1] * g[1] + Ri[4] * g[2]) +
+             dv[2] * (Ri[5] * g[0] + Ri[4] * g[1] + Ri[2] * g[2]);
+      de += mj * (0.5 * pi * dvg - fn * rg);
+    }
+    const double mi = p.mass[i];
+    for (int a = 0; a < 3; ++a) p.force[a][i] = mi * acc[a];
+    p.energy_rate[i] = de;
+    const double dt = courant * hi / (ci + 1.2 * (si.alpha * ci + si.beta * mu_max));
+    if (dt < res.dt_stable || (dt == res.dt_stable && p.gid[i] < res.stable_gid)) {
+      res.dt_stable = dt;
+      res.stable_gid = p.gid[i];
+    }
+    const bool finite = std::isfinite(acc[0]) && std::isfinite(acc[1]) && std::isfinite(acc[2]) &&
+                        std::isfinite(p.stress[0][i]) && std::isfinite(rhoi);
+    if (!finite && (res.nonfinite_gid < 0 || p.gid[i] < res.nonfinite_gid))
+      res.nonfinite_gid = p.gid[i];
+  }
+}
+
+} // namespace anvil::sph

@@ -1,0 +1,143 @@
+#include "anvil/sph/neighbours.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace anvil::sph {
+
+namespace {
+
+// Entries of each cell in ascending gid. The input order is made of a few ascending runs
+// (own particles, then the ghosts of each sending rank), so insertion sort is near linear.
+void sort_cells_by_gid(std::span<const std::int64_t> gid, std::span<const int> start,
+                       std::vector<int>& order) {
+  for (std::size_t c = 0; c + 1 < start.size(); ++c) {
+    for (int k = start[c] + 1; k < start[c + 1]; ++k) {
+      const int p = order[static_cast<std::size_t>(k)];
+      const std::int64_t g = gid[static_cast<std::size_t>(p)];
+      int m = k - 1;
+      while (m >= start[c] &&
+             gid[static_cast<std::size_t>(order[static_cast<std::size_t>(m)])] > g) {
+        order[static_cast<std::size_t>(m + 1)] = order[static_cast<std::size_t>(m)];
+        --m;
+      }
+      order[static_cast<std::size_t>(m + 1)] = p;
+    }
+  }
+}
+
+} // namespace
+
+void find_neighbours(std::span<const double> x, std::span<const double> y,
+                     std::span<const double> z, std::span<const double> h,
+                     std::span<const std::int64_t> gid, std::size_t n_query, double cell,
+                     NeighbourWorkspace& w, NeighbourList& out) {
+  const std::size_t n = x.size();
+  out.start.assign(n_query + 1, 0);
+  out.index.clear();
+  if (n == 0 || n_query == 0) return;
+  const double inv = 1.0 / cell;
+  // Integer cell coordinates on the global lattice and their bounding box.
+  std::int64_t lo[3] = {std::numeric_limits<std::int64_t>::max(),
+                        std::numeric_limits<std::int64_t>::max(),
+                        std::numeric_limits<std::int64_t>::max()};
+  std::int64_t hi[3] = {std::numeric_limits<std::int64_t>::min(),
+                        std::numeric_limits<std::int64_t>::min(),
+                        std::numeric_limits<std::int64_t>::min()};
+  auto coord = [&](double v) { return static_cast<std::int64_t>(std::floor(v * inv)); };
+  const std::span<const double> xyz[3] = {x, y, z};
+  for (int d = 0; d < 3; ++d)
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::int64_t c = coord(xyz[d][i]);
+      lo[d] = std::min(lo[d], c);
+      hi[d] = std::max(hi[d], c);
+    }
+  // One ring of empty cells around the box, so that the 27-cell loop needs no bounds.
+  std::int64_t dims[3];
+  double cells = 1;
+  for (int d = 0; d < 3; ++d) {
+    lo[d] -= 1;
+    dims[d] = hi[d] - lo[d] + 2;
+    cells *= static_cast<double>(dims[d]);
+  }
+  w.key.resize(n);
+  for (std::size_t i = 0; i < n; ++i)
+    w.key[i] =
+        ((coord(z[i]) - lo[2]) * dims[1] + (coord(y[i]) - lo[1])) * dims[0] + (coord(x[i]) - lo[0]);
+  w.order.resize(n);
+  const bool dense = cells <= 8.0 * static_cast<double>(n) + 4096.0;
+  if (dense) {
+    // Counting sort by cell (stable), then gid order inside each cell.
+    const auto ncell = static_cast<std::size_t>(cells);
+    w.cell_start.assign(ncell + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) ++w.cell_start[static_cast<std::size_t>(w.key[i]) + 1];
+    for (std::size_t c = 0; c < ncell; ++c) w.cell_start[c + 1] += w.cell_start[c];
+    // Fill with cell_start as running cursors, then shift it back by one cell.
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto c = static_cast<std::size_t>(w.key[i]);
+      w.order[static_cast<std::size_t>(w.cell_start[c]++)] = static_cast<int>(i);
+    }
+    for (std::size_t c = ncell; c > 0; --c) w.cell_start[c] = w.cell_start[c - 1];
+    w.cell_start[0] = 0;
+    sort_cells_by_gid(gid, w.cell_start, w.order);
+  } else {
+    // Sparse (particles spread far apart): sort by (cell, gid).
+    for (std::size_t i = 0; i < n; ++i) w.order[i] = static_cast<int>(i);
+    std::sort(w.order.begin(), w.order.end(), [&](int a, int b) {
+      const auto ka = w.key[static_cast<std::size_t>(a)], kb = w.key[static_cast<std::size_t>(b)];
+      return ka != kb ? ka < kb
+                      : gid[static_cast<std::size_t>(a)] < gid[static_cast<std::size_t>(b)];
+    });
+    w.sorted_key.resize(n);
+    for (std::size_t k = 0; k < n; ++k)
+      w.sorted_key[k] = w.key[static_cast<std::size_t>(w.order[k])];
+  }
+  // Positions and h in cell order: the candidate scans below read contiguous memory.
+  w.xs.resize(n);
+  w.ys.resize(n);
+  w.zs.resize(n);
+  w.hs.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto p = static_cast<std::size_t>(w.order[k]);
+    w.xs[k] = x[p];
+    w.ys[k] = y[p];
+    w.zs[k] = z[p];
+    w.hs[k] = h[p];
+  }
+  // Range of sorted entries in the three cells key-1 .. key+1 (a row along x).
+  auto row = [&](std::int64_t key, int& b, int& e) {
+    if (dense) {
+      b = w.cell_start[static_cast<std::size_t>(key - 1)];
+      e = w.cell_start[static_cast<std::size_t>(key + 2)];
+    } else {
+      b = static_cast<int>(std::lower_bound(w.sorted_key.begin(), w.sorted_key.end(), key - 1) -
+                           w.sorted_key.begin());
+      e = static_cast<int>(std::upper_bound(w.sorted_key.begin(), w.sorted_key.end(), key + 1) -
+                           w.sorted_key.begin());
+    }
+  };
+  const std::int64_t sy = dims[0], sz = dims[0] * dims[1];
+  out.index.reserve(n_query * 64);
+  for (std::size_t i = 0; i < n_query; ++i) {
+    const double xi = x[i], yi = y[i], zi = z[i], hi_ = h[i];
+    const std::int64_t k0 = w.key[i];
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy) {
+        int b, e;
+        row(k0 + dz * sz + dy * sy, b, e);
+        for (int k = b; k < e; ++k) {
+          const double dx_ = xi - w.xs[static_cast<std::size_t>(k)];
+          const double dy_ = yi - w.ys[static_cast<std::size_t>(k)];
+          const double dz_ = zi - w.zs[static_cast<std::size_t>(k)];
+          const double r2 = dx_ * dx_ + dy_ * dy_ + dz_ * dz_;
+          const double s = hi_ + w.hs[static_cast<std::size_t>(k)];
+          const int j = w.order[static_cast<std::size_t>(k)];
+          if (r2 < s * s && j != static_cast<int>(i)) out.index.push_back(j);
+        }
+      }
+    out.start[i + 1] = static_cast<std::int64_t>(out.index.size());
+  }
+}
+
+} // namespace anvil::sph
