@@ -52,13 +52,14 @@ struct PartConfig {
 struct LatticeSpec {
   enum class Shape { box, sphere, cylinder };
   Shape shape = Shape::box;
-  Vec3 min, max;      // box
-  Vec3 center;        // sphere
-  Vec3 origin;        // cylinder: centre of its base
-  double radius = 0;  // sphere, cylinder
-  double length = 0;  // cylinder
-  int axis = 2;       // cylinder
-  double spacing = 0; // lattice spacing, m
+  Vec3 min, max;           // box
+  Vec3 center;             // sphere
+  Vec3 origin;             // cylinder: centre of its base
+  double radius = 0;       // sphere, cylinder
+  double inner_radius = 0; // cylinder: hollow inside this radius (a ring or tube)
+  double length = 0;       // cylinder
+  int axis = 2;            // cylinder
+  double spacing = 0;      // lattice spacing, m
 };
 
 struct ParticleSetConfig {
@@ -79,6 +80,10 @@ struct ParticleSetConfig {
 // Options of the SPH decomposition (top-level `sph:`, optional).
 struct SphConfig {
   double rebalance_threshold = 1.2; // re-cut the particle RCB when max/mean count exceeds it
+  // Dimensions of the particle model: 3, or 2 (plane strain in x-y, masses per unit
+  // thickness) or 1 (uniaxial strain along x, masses per unit area) for verification
+  // problems that are planar or one-dimensional; below 3 the deck may hold no FE part.
+  int dimensions = 3;
 };
 
 // A set of nodes (and particles): a named set (deck `node_sets`, or a generated

@@ -386,12 +386,17 @@ ParticleSetConfig parse_particle_set(const std::string& name, const Node& n) {
     l.center = g.required("center").vec3();
     l.radius = g.required("radius").positive();
   } else if (shape == "cylinder") {
-    g.check_keys({"shape", "origin", "radius", "length", "axis", "spacing"});
+    g.check_keys({"shape", "origin", "radius", "inner_radius", "length", "axis", "spacing"});
     l.shape = LatticeSpec::Shape::cylinder;
     if (g.has("origin")) l.origin = g.child("origin").vec3();
     l.radius = g.required("radius").positive();
     l.length = g.required("length").positive();
     if (g.has("axis")) l.axis = g.child("axis").axis();
+    if (g.has("inner_radius")) {
+      l.inner_radius = g.child("inner_radius").number();
+      if (!(l.inner_radius >= 0 && l.inner_radius < l.radius))
+        g.child("inner_radius").fail("must be at least 0 and less than the radius");
+    }
   } else {
     g.child("shape").fail(
         fmt::format("unknown particle shape '{}' (expected box, sphere or cylinder)", shape));
@@ -556,7 +561,18 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
   }
   if (top.has("sph")) {
     const Node s = top.child("sph");
-    s.check_keys({"rebalance_threshold"});
+    s.check_keys({"rebalance_threshold", "dimensions"});
+    if (s.has("dimensions")) {
+      const auto d = s.child("dimensions").integer();
+      if (d < 1 || d > 3) s.child("dimensions").fail("must be 1, 2 or 3");
+      if (d < 3 && !c.parts.empty())
+        s.child("dimensions")
+            .fail("a particle model of fewer than 3 dimensions cannot be coupled to the mesh");
+      for (const auto& p : c.particles)
+        if (d == 1 && p.kernel == ParticleSetConfig::Kernel::wendland_c2)
+          s.child("dimensions").fail("wendland_c2 is available in 2 and 3 dimensions");
+      c.sph.dimensions = static_cast<int>(d);
+    }
     if (s.has("rebalance_threshold")) {
       c.sph.rebalance_threshold = s.child("rebalance_threshold").number();
       if (!(c.sph.rebalance_threshold >= 1))

@@ -372,7 +372,9 @@ void Simulation::sph_forces() {
   const double none = std::numeric_limits<double>::infinity();
   double red[2] = {r.dt_stable, r.nonfinite_gid >= 0 ? static_cast<double>(r.nonfinite_gid) : none};
   comm_.min(std::span<double>(red, 2));
-  if (red[1] != none || !std::isfinite(red[0]))
+  // An infinite step is no failure (particles of a gas expanded to zero pressure, at
+  // rest relative to their neighbours, constrain nothing); a NaN is.
+  if (red[1] != none || std::isnan(red[0]))
     throw PhysicsError(red[1] != none
                            ? fmt::format("particle {}", static_cast<std::int64_t>(red[1]) + 1)
                            : "the particles",

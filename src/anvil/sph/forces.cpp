@@ -42,13 +42,14 @@ void principal(const double s[6], double lambda[3], double Q[3][3]) {
 
 namespace {
 
-// Monaghan's artificial stress of one particle: in the principal frame of sigma,
-// R'_aa = -epsilon sigma'_aa / rho^2 where sigma'_aa is tensile, else 0; rotated back.
-void artificial_stress(const double s[6], double rho, double eps, double R[6]) {
+// Monaghan's artificial stress of one particle (in stress units, for the
+// (sigma_i + sigma_j) / (rho_i rho_j) form): in the principal frame of sigma,
+// R'_aa = -epsilon sigma'_aa where sigma'_aa is tensile, else 0; rotated back.
+void artificial_stress(const double s[6], double eps, double R[6]) {
   double lam[3], Q[3][3];
   principal(s, lam, Q);
   double r[3];
-  for (int a = 0; a < 3; ++a) r[a] = lam[a] > 0 ? -eps * lam[a] / (rho * rho) : 0.0;
+  for (int a = 0; a < 3; ++a) r[a] = lam[a] > 0 ? -eps * lam[a] : 0.0;
   auto comp = [&](int i, int j) {
     return Q[i][0] * r[0] * Q[j][0] + Q[i][1] * r[1] * Q[j][1] + Q[i][2] * r[2] * Q[j][2];
   };
@@ -80,63 +81,56 @@ bool invert3(const double B[3][3], double inv[3][3], double tol) {
   return true;
 }
 
-} // namespace
-
-void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelType kernel,
-                    const NeighbourList& nl, double dt, SphWorkspace& w) {
+// Pass 1's pair loop for one kernel (the kernel is a template parameter so that the
+// loop has no per-pair branch on it).
+template <KernelType K, int D>
+void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, const NeighbourList& nl,
+                      double dt, SphWorkspace& w) {
   const std::size_t n = p.n_local;
-  w.pair.resize(4 * nl.pairs());
-  for (auto& d : w.d) d.resize(n);
-  w.power_old.resize(n);
-  w.energy_pred.resize(n);
-  const double* x = p.x[0];
-  const double* y = p.x[1];
-  const double* z = p.x[2];
-
+  const NeighbourRead1* rd = w.read1.data();
   for (std::size_t i = 0; i < n; ++i) {
-    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
-    const double xi = x[i], yi = y[i], zi = z[i], hi = p.h[i];
-    const double vi[3] = {p.v[0][i], p.v[1][i], p.v[2][i]};
+    const NeighbourRead1& pi = rd[i];
+    const SetParams& si = sets[static_cast<std::size_t>(pi.set)];
     double L[3][3] = {}, B[3][3] = {};
     for (std::int64_t k = nl.start[i]; k < nl.start[i + 1]; ++k) {
-      const auto j = static_cast<std::size_t>(nl.index[static_cast<std::size_t>(k)]);
-      const SetParams& sj = sets[static_cast<std::size_t>(p.set[j])];
-      const double dx[3] = {xi - x[j], yi - y[j], zi - z[j]};
-      const double r = std::sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
-      const double hb = 0.5 * (hi + p.h[j]);
+      const NeighbourRead1& pj = rd[nl.index[static_cast<std::size_t>(k)]];
+      const double dx[3] = {pi.x[0] - pj.x[0], pi.x[1] - pj.x[1], pi.x[2] - pj.x[2]};
+      const double hb = 0.5 * (pi.h + pj.h);
+      const double r =
+          std::max(std::sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]), 1e-9 * hb);
       double wk, dwr;
-      sph::kernel(kernel, r, hb, wk, dwr);
+      kernel_fast<K, D>(r, hb, wk, dwr);
       const double g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
       double fn = 0;
-      const double eps = 0.5 * (si.epsilon + sj.epsilon);
-      if (eps > 0) {
-        const double t = wk * hb * hb * hb / (0.5 * (si.w_spacing + sj.w_spacing));
-        const double ex = 0.5 * (si.exponent + sj.exponent);
-        fn = ex == 4.0 ? (t * t) * (t * t) : std::pow(t, ex);
+      if (si.epsilon > 0 || pj.set != pi.set) {
+        const SetParams& sj = sets[static_cast<std::size_t>(pj.set)];
+        if (si.epsilon + sj.epsilon > 0) {
+          const double hd = D == 1 ? hb : (D == 2 ? hb * hb : hb * hb * hb);
+          const double t = wk * hd / (kernel_norm<K, D>() * 0.5 * (si.w_spacing + sj.w_spacing));
+          const double ex = 0.5 * (si.exponent + sj.exponent);
+          fn = ex == 4.0 ? (t * t) * (t * t) : std::pow(t, ex);
+        }
       }
       double* pd = &w.pair[4 * static_cast<std::size_t>(k)];
       pd[0] = g[0];
       pd[1] = g[1];
       pd[2] = g[2];
       pd[3] = fn;
-      const double mj = p.mass[j];
-      const double dv[3] = {mj * (p.v[0][j] - vi[0]), mj * (p.v[1][j] - vi[1]),
-                            mj * (p.v[2][j] - vi[2])};
+      // Volume weights V_j = m_j / rho_j: consistent across density jumps (a gas
+      // interface, particles of different sets).
+      const double vj = pj.volume;
+      const double dv[3] = {vj * (pj.v[0] - pi.v[0]), vj * (pj.v[1] - pi.v[1]),
+                            vj * (pj.v[2] - pi.v[2])};
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) L[a][b] += dv[a] * g[b];
       if (si.corrected)
         for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < 3; ++b) B[a][b] -= mj * dx[a] * g[b];
+          for (int b = 0; b < 3; ++b) B[a][b] -= vj * dx[a] * g[b];
     }
-    const double inv_rho = 1 / p.rho[i];
-    for (auto& row : L)
-      for (double& c : row) c *= inv_rho;
     if (si.corrected) {
-      // Normalised gradient L B^-1, B = (1/rho_i) sum m_j (x_j - x_i) (x) grad W: exact
-      // for a linear velocity field also near free surfaces. A particle with too few
+      // Normalised gradient L B^-1, B = sum V_j (x_j - x_i) (x) grad W: exact for a
+      // linear velocity field also near free surfaces. A particle with too few
       // neighbours (B nearly singular) keeps the plain gradient.
-      for (auto& row : B)
-        for (double& c : row) c *= inv_rho;
       double Bi[3][3];
       if (invert3(B, Bi, 1e-3)) {
         double Lc[3][3];
@@ -172,6 +166,42 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
     w.power_old[i] = power;
     w.energy_pred[i] = p.energy[i] + power * dt / p.rho[i];
   }
+}
+
+} // namespace
+
+void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelType kernel,
+                    const NeighbourList& nl, double dt, SphWorkspace& w) {
+  const std::size_t n = p.n_local;
+  w.pair.resize(4 * nl.pairs());
+  for (auto& d : w.d) d.resize(n);
+  w.power_old.resize(n);
+  w.energy_pred.resize(n);
+  w.read1.resize(p.n_all);
+  for (std::size_t i = 0; i < p.n_all; ++i) {
+    NeighbourRead1& r = w.read1[i];
+    for (int a = 0; a < 3; ++a) {
+      r.x[a] = p.x[a][i];
+      r.v[a] = p.v[a][i];
+    }
+    r.volume = p.mass[i] / p.rho[i];
+    r.h = p.h[i];
+    r.set = p.set[i];
+  }
+  const int dim = sets.empty() ? 3 : sets[0].dimensions;
+  if (kernel == KernelType::cubic_spline) {
+    if (dim == 1)
+      kinematics_pairs<KernelType::cubic_spline, 1>(p, sets, nl, dt, w);
+    else if (dim == 2)
+      kinematics_pairs<KernelType::cubic_spline, 2>(p, sets, nl, dt, w);
+    else
+      kinematics_pairs<KernelType::cubic_spline, 3>(p, sets, nl, dt, w);
+  } else {
+    if (dim == 2)
+      kinematics_pairs<KernelType::wendland_c2, 2>(p, sets, nl, dt, w);
+    else
+      kinematics_pairs<KernelType::wendland_c2, 3>(p, sets, nl, dt, w);
+  }
 
   // Constitutive update through the batch interface, one run of a set's particles at a
   // time (own particles are in ascending gid, so each set is one contiguous run).
@@ -204,10 +234,9 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
                          2 * (s[3] * w.d[3][i] + s[4] * w.d[4][i] + s[5] * w.d[5][i]);
     const double rho = p.rho[i];
     p.energy[i] += 0.5 * (w.power_old[i] + power) * dt / rho;
-    const double ir2 = 1 / (rho * rho);
-    for (int k = 0; k < 6; ++k) p.S[k][i] = s[k] * ir2;
+    for (int k = 0; k < 6; ++k) p.S[k][i] = s[k];
     double R[6] = {0, 0, 0, 0, 0, 0};
-    if (si.epsilon > 0) artificial_stress(s, rho, si.epsilon, R);
+    if (si.epsilon > 0) artificial_stress(s, si.epsilon, R);
     for (int k = 0; k < 6; ++k) p.R[k][i] = R[k];
   }
 }
@@ -215,69 +244,85 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
 void sph_forces(const SphView& p, std::span<const SetParams> sets, const NeighbourList& nl,
                 SphWorkspace& w, SphResult& res) {
   const std::size_t n = p.n_local;
-  const double* x = p.x[0];
-  const double* y = p.x[1];
-  const double* z = p.x[2];
-  for (std::size_t i = 0; i < n; ++i) {
+  w.read2.resize(p.n_all);
+  for (std::size_t i = 0; i < p.n_all; ++i) {
+    NeighbourRead2& r = w.read2[i];
     const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
-    const double xi = x[i], yi = y[i], zi = z[i], hi = p.h[i];
-    const double vi[3] = {p.v[0][i], p.v[1][i], p.v[2][i]};
-    const double ci = p.wave_speed[i], rhoi = p.rho[i];
-    double Si[6], Ri[6];
-    for (int k = 0; k < 6; ++k) {
-      Si[k] = p.S[k][i];
-      Ri[k] = p.R[k][i];
+    for (int a = 0; a < 3; ++a) {
+      r.x[a] = p.x[a][i];
+      r.v[a] = p.v[a][i];
     }
+    r.mass = p.mass[i];
+    r.rho = p.rho[i];
+    r.inv_rho = 1 / p.rho[i];
+    r.h = p.h[i];
+    r.c = p.wave_speed[i];
+    r.alpha = si.alpha;
+    r.beta = si.beta;
+    int any = 0;
+    for (int c = 0; c < 6; ++c) {
+      r.S[c] = p.S[c][i];
+      r.R[c] = p.R[c][i];
+      any |= p.R[c][i] != 0.0;
+    }
+    r.has_r = any;
+  }
+  const NeighbourRead2* rd = w.read2.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    const NeighbourRead2& pi = rd[i];
     double acc[3] = {0, 0, 0}, de = 0, mu_max = 0;
     for (std::int64_t k = nl.start[i]; k < nl.start[i + 1]; ++k) {
-      const auto j = static_cast<std::size_t>(nl.index[static_cast<std::size_t>(k)]);
+      const NeighbourRead2& pj = rd[nl.index[static_cast<std::size_t>(k)]];
       const double* pd = &w.pair[4 * static_cast<std::size_t>(k)];
       const double g[3] = {pd[0], pd[1], pd[2]};
       const double fn = pd[3];
-      const double dx[3] = {xi - x[j], yi - y[j], zi - z[j]};
-      const double dv[3] = {vi[0] - p.v[0][j], vi[1] - p.v[1][j], vi[2] - p.v[2][j]};
+      const double dx[3] = {pi.x[0] - pj.x[0], pi.x[1] - pj.x[1], pi.x[2] - pj.x[2]};
+      const double dv[3] = {pi.v[0] - pj.v[0], pi.v[1] - pj.v[1], pi.v[2] - pj.v[2]};
       const double vr = dv[0] * dx[0] + dv[1] * dx[1] + dv[2] * dx[2];
-      double pi = 0;
+      double visc = 0;
       if (vr < 0) {
-        const SetParams& sj = sets[static_cast<std::size_t>(p.set[j])];
-        const double hb = 0.5 * (hi + p.h[j]);
+        const double hb = 0.5 * (pi.h + pj.h);
         const double r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
         const double mu = hb * vr / (r2 + 0.01 * hb * hb);
-        const double cb = 0.5 * (ci + p.wave_speed[j]), rb = 0.5 * (rhoi + p.rho[j]);
-        pi = (-0.5 * (si.alpha + sj.alpha) * cb * mu + 0.5 * (si.beta + sj.beta) * mu * mu) / rb;
+        const double cb = 0.5 * (pi.c + pj.c);
+        // Pi_ij = (-alpha c mu + beta mu^2) / rho_ij with rho_ij = (rho_i + rho_j) / 2.
+        visc =
+            (-(pi.alpha + pj.alpha) * cb * mu + (pi.beta + pj.beta) * mu * mu) / (pi.rho + pj.rho);
         mu_max = std::max(mu_max, -mu);
       }
+      const double irr = pi.inv_rho * pj.inv_rho;
       double T[6];
-      for (int c = 0; c < 6; ++c) T[c] = Si[c] + p.S[c][j];
-      if (fn > 0)
-        for (int c = 0; c < 6; ++c) T[c] += fn * (Ri[c] + p.R[c][j]);
-      T[0] -= pi;
-      T[1] -= pi;
-      T[2] -= pi;
-      const double mj = p.mass[j];
+      for (int c = 0; c < 6; ++c) T[c] = (pi.S[c] + pj.S[c]) * irr;
+      double rg = 0;
+      if (fn > 0 && (pi.has_r | pj.has_r)) {
+        for (int c = 0; c < 6; ++c) T[c] += fn * irr * (pi.R[c] + pj.R[c]);
+        // The artificial stress's own work on particle i (the stress's is in pass 1).
+        rg = fn * irr *
+             (dv[0] * (pi.R[0] * g[0] + pi.R[3] * g[1] + pi.R[5] * g[2]) +
+              dv[1] * (pi.R[3] * g[0] + pi.R[1] * g[1] + pi.R[4] * g[2]) +
+              dv[2] * (pi.R[5] * g[0] + pi.R[4] * g[1] + pi.R[2] * g[2]));
+      }
+      T[0] -= visc;
+      T[1] -= visc;
+      T[2] -= visc;
+      const double mj = pj.mass;
       acc[0] += mj * (T[0] * g[0] + T[3] * g[1] + T[5] * g[2]);
       acc[1] += mj * (T[3] * g[0] + T[1] * g[1] + T[4] * g[2]);
       acc[2] += mj * (T[5] * g[0] + T[4] * g[1] + T[2] * g[2]);
-      // Work of the pair's artificial terms on particle i: half the viscous dissipation,
-      // and the artificial stress's own part (the stress's work is in the material update).
+      // Half the viscous dissipation of the pair heats particle i.
       const double dvg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
-      double rg = 0;
-      if (fn > 0)
-        rg = dv[0] * (Ri[0] * g[0] + Ri[3] * g[1] + Ri[5] * g[2]) +
-             dv[1] * (Ri[3] * g[0] + Ri[1] * g[1] + Ri[4] * g[2]) +
-             dv[2] * (Ri[5] * g[0] + Ri[4] * g[1] + Ri[2] * g[2]);
-      de += mj * (0.5 * pi * dvg - fn * rg);
+      de += mj * (0.5 * visc * dvg - rg);
     }
-    const double mi = p.mass[i];
-    for (int a = 0; a < 3; ++a) p.force[a][i] = mi * acc[a];
+    for (int a = 0; a < 3; ++a) p.force[a][i] = pi.mass * acc[a];
     p.energy_rate[i] = de;
-    const double dt = courant * hi / (ci + 1.2 * (si.alpha * ci + si.beta * mu_max));
+    const double ci = pi.c;
+    const double dt = courant * pi.h / (ci + 1.2 * (pi.alpha * ci + pi.beta * mu_max));
     if (dt < res.dt_stable || (dt == res.dt_stable && p.gid[i] < res.stable_gid)) {
       res.dt_stable = dt;
       res.stable_gid = p.gid[i];
     }
     const bool finite = std::isfinite(acc[0]) && std::isfinite(acc[1]) && std::isfinite(acc[2]) &&
-                        std::isfinite(p.stress[0][i]) && std::isfinite(rhoi);
+                        std::isfinite(p.stress[0][i]) && std::isfinite(pi.rho);
     if (!finite && (res.nonfinite_gid < 0 || p.gid[i] < res.nonfinite_gid))
       res.nonfinite_gid = p.gid[i];
   }

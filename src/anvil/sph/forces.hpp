@@ -3,17 +3,21 @@
 // Swegle, Attaway and Heinstein (PRONTO's SPH, 1994), in two passes over precomputed
 // neighbour lists (neighbours.hpp):
 //
-//  1. kinematics: velocity gradient L_i = (1/rho_i) sum_j m_j (v_j - v_i) (x) grad_i W_ij
-//     (optionally normalised, Randles and Libersky 1996), continuity
-//     d rho_i / dt = -rho_i tr L_i, stress rotated by Hughes-Winget with the spin and
-//     advanced by the material's batch update with D, internal energy from the stress
-//     power; then S_i = sigma_i / rho_i^2 and Monaghan's artificial stress R_i (Gray,
+//  1. kinematics: velocity gradient L_i = sum_j V_j (v_j - v_i) (x) grad_i W_ij with the
+//     volumes V_j = m_j / rho_j (optionally normalised, Randles and Libersky 1996),
+//     continuity d rho_i / dt = -rho_i tr L_i, stress rotated by Hughes-Winget with the
+//     spin and advanced by the material's batch update with D, internal energy from the
+//     stress power sigma : D / rho; then Monaghan's artificial stress R_i (Gray,
 //     Monaghan and Swift 2001) for the neighbours.
-//  2. forces: the symmetric conservative momentum equation
-//     m_i dv_i/dt = m_i sum_j m_j (S_i + S_j + f_ij^n (R_i + R_j) - Pi_ij I) grad_i W_ij
+//  2. forces: the symmetric conservative momentum equation that matches that gradient
+//     (so that the stress power and the forces' work cancel exactly, pair by pair)
+//     dv_i/dt = sum_j m_j ((sigma_i + sigma_j + f_ij^n (R_i + R_j)) / (rho_i rho_j)
+//                          - Pi_ij I) grad_i W_ij
 //     with Monaghan and Gingold's (1983) artificial viscosity Pi_ij and
 //     f_ij = W(r_ij) / W(dp); the work of Pi and R as an energy rate; the particle
-//     stable time step.
+//     stable time step. The (sigma_i + sigma_j)/(rho_i rho_j) form with volume-weighted
+//     gradients stays consistent across density jumps (Sod's tube, different materials),
+//     where the sigma/rho^2 form with (1/rho_i) sum m_j weights does not.
 //
 // W is evaluated at the mean smoothing length h_ij = (h_i + h_j)/2, so grad_i W_ij =
 // -grad_j W_ji and the pair forces cancel exactly (momentum is conserved to round-off).
@@ -42,6 +46,7 @@ struct SetParams {
   double exponent = 4;                // its exponent n
   double w_spacing = 1;               // kernel shape w(q) at q = 1 / smoothing_ratio
   bool corrected = false;             // normalised velocity gradient
+  int dimensions = 3;                 // of the particle model (1, 2 or 3)
 };
 
 // Courant number of the particle step: dt_i = courant h_i / (c_i + 1.2 (alpha c_i +
@@ -69,8 +74,8 @@ struct SphView {
   double* temperature = nullptr;
   // all: written by pass 1 for own particles, read by pass 2 for all
   double* wave_speed = nullptr;
-  double* S[6] = {}; // sigma / rho^2
-  double* R[6] = {}; // artificial stress
+  double* S[6] = {}; // stress (a copy the ghosts receive), Pa
+  double* R[6] = {}; // artificial stress, Pa
   // own, out of pass 2
   double* force[3] = {};         // N
   double* energy_rate = nullptr; // J/(kg s) from viscosity and artificial stress
@@ -82,8 +87,26 @@ struct SphResult {
   std::int64_t nonfinite_gid = -1; // smallest gid with a non-finite force or state, or -1
 };
 
+// What one pass reads of a neighbour, packed per particle (one or a few cache lines
+// instead of one per array): built for own and ghost particles at the start of a pass.
+struct NeighbourRead1 {
+  double x[3], v[3];
+  double volume; // m / rho
+  double h;
+  int set;
+};
+struct NeighbourRead2 {
+  double x[3], v[3];
+  double mass, rho, inv_rho, h, c;
+  double alpha, beta; // the particle's set's viscosity coefficients
+  double S[6], R[6];
+  int has_r; // R is not zero
+};
+
 // Scratch kept between cycles (the cycle allocates nothing in steady state).
 struct SphWorkspace {
+  std::vector<NeighbourRead1> read1;
+  std::vector<NeighbourRead2> read2;
   std::vector<double> pair;        // per neighbour entry: grad W (3), f^n
   std::vector<double> d[6];        // rate of deformation of own particles
   std::vector<double> power_old;   // rotated old stress : D
@@ -99,9 +122,10 @@ void sph_kinematics(const SphView& v, std::span<const SetParams> sets, KernelTyp
 void sph_forces(const SphView& v, std::span<const SetParams> sets, const NeighbourList& nl,
                 SphWorkspace& work, SphResult& result);
 
-// Smoothing length at density rho: h0 (rho0 / rho)^(1/3) (constant mass in the support).
+// Smoothing length at density rho: h0 (rho0 / rho)^(1/d) (constant mass in the support).
 inline double smoothing_length(const SetParams& s, double rho) {
-  return s.h0 * std::cbrt(s.rho0 / rho);
+  const double r = s.rho0 / rho;
+  return s.h0 * (s.dimensions == 3 ? std::cbrt(r) : (s.dimensions == 2 ? std::sqrt(r) : r));
 }
 
 // Principal values and axes of a symmetric tensor (xx yy zz xy yz xz) by cyclic Jacobi

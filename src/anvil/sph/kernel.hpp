@@ -4,6 +4,7 @@
 // at r = 0 for both kernels).
 #pragma once
 
+#include <algorithm>
 #include <numbers>
 
 namespace anvil::sph {
@@ -44,6 +45,36 @@ inline void wendland_c2(double r, double h, double& w, double& dwr) {
   dwr = s * ih * ih * (-5 * t3);
 }
 
+// Normalisation of a kernel in D dimensions, times h^D: cubic spline 2/3, 10/(7 pi),
+// 1/pi; Wendland C2 (this shape) 7/(4 pi) in 2-D, 21/(16 pi) in 3-D.
+template <KernelType K, int D>
+constexpr double kernel_norm() {
+  if constexpr (K == KernelType::cubic_spline)
+    return D == 1 ? 2.0 / 3.0 : (D == 2 ? 10.0 / 7.0 * std::numbers::inv_pi : std::numbers::inv_pi);
+  else
+    return D == 2 ? 7.0 / 4.0 * std::numbers::inv_pi : 21.0 / 16.0 * std::numbers::inv_pi;
+}
+
+// Branch-free forms for the pair loops in D dimensions (the 3-D values equal those
+// above up to round-off; the particle phase uses these everywhere, so every rank runs
+// the same arithmetic). r > 0.
+template <KernelType K, int D>
+inline void kernel_fast(double r, double h, double& w, double& dwr) {
+  const double ih = 1.0 / h, q = r * ih;
+  const double ihd = D == 1 ? ih : (D == 2 ? ih * ih : ih * ih * ih);
+  const double s = kernel_norm<K, D>() * ihd;
+  if constexpr (K == KernelType::cubic_spline) {
+    const double a = std::max(2 - q, 0.0), b = std::max(1 - q, 0.0);
+    w = s * (0.25 * a * a * a - b * b * b);
+    // dW/dr = s/h (-3/4 a^2 + 3 b^2); divided by r, finite as r -> 0 (b^2 - a^2/4 ~ -q).
+    dwr = s * ih * (3 * b * b - 0.75 * a * a) / r;
+  } else {
+    const double t = std::max(1 - 0.5 * q, 0.0), t3 = t * t * t;
+    w = s * t3 * t * (2 * q + 1);
+    dwr = s * ih * ih * (-5 * t3);
+  }
+}
+
 inline void kernel(KernelType k, double r, double h, double& w, double& dwr) {
   if (k == KernelType::cubic_spline)
     cubic_spline(r, h, w, dwr);
@@ -51,11 +82,13 @@ inline void kernel(KernelType k, double r, double h, double& w, double& dwr) {
     wendland_c2(r, h, w, dwr);
 }
 
-// The kernel's shape w(q) = W(q h, h) h^3 (for ratios such as Monaghan's W(r)/W(dp)).
+// The kernel's shape w(q), W = norm / h^D w(r / h) (for ratios such as Monaghan's
+// W(r) / W(dp), in which the normalisation cancels).
 inline double kernel_shape(KernelType k, double q) {
   double w, dwr;
   kernel(k, q, 1.0, w, dwr);
-  return w;
+  return w / (k == KernelType::cubic_spline ? kernel_norm<KernelType::cubic_spline, 3>()
+                                            : kernel_norm<KernelType::wendland_c2, 3>());
 }
 
 } // namespace anvil::sph

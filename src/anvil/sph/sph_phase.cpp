@@ -33,7 +33,12 @@ SphPhase::SphPhase(const Config& config, const std::function<const Material*(int
   std::vector<Lattice> lattices;
   set_offsets_.assign(1, 0);
   for (std::size_t s = 0; s < psets.size(); ++s) {
-    lattices.push_back(generate_lattice(psets[s].lattice));
+    const LatticeSpec& ls = psets[s].lattice;
+    if (config.sph.dimensions == 1 && ls.shape != LatticeSpec::Shape::box)
+      throw InputError(psets[s].where, "a one-dimensional particle model takes boxes only");
+    if (config.sph.dimensions == 2 && ls.shape == LatticeSpec::Shape::cylinder && ls.axis != 2)
+      throw InputError(psets[s].where, "in two dimensions a cylinder's axis must be z");
+    lattices.push_back(generate_lattice(ls, config.sph.dimensions));
     if (lattices.back().points.empty())
       throw InputError(psets[s].where, "the particle set's shape holds no lattice point: "
                                        "make the spacing smaller than the shape");
@@ -50,6 +55,7 @@ SphPhase::SphPhase(const Config& config, const std::function<const Material*(int
     sp.exponent = psets[s].artificial_stress_exponent;
     sp.w_spacing = kernel_shape(kernel_, 1.0 / psets[s].smoothing_ratio);
     sp.corrected = psets[s].corrected_gradient;
+    sp.dimensions = config.sph.dimensions;
     sets_.push_back(sp);
   }
   global_count_ = set_offsets_.back();
