@@ -86,6 +86,9 @@ public:
   const ContactPhase* contact() const { return contact_.get(); }
   // The SPH decomposition and its particles (null without particles).
   const sph::SphPhase* sph() const { return sph_.get(); }
+  // Mutable access for tests that set initial fields no deck key expresses (a mode
+  // shape); call before the first step.
+  sph::SphPhase* sph() { return sph_.get(); }
   std::int64_t global_nodes() const { return global_nodes_; }
   std::int64_t global_elements() const { return global_elements_; }
   const std::vector<double>& part_masses() const { return part_mass_; }

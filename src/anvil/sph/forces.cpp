@@ -12,8 +12,13 @@ void principal(const double s[6], double lambda[3], double Q[3][3]) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) Q[i][j] = i == j ? 1.0 : 0.0;
   constexpr int pq[3][2] = {{0, 1}, {0, 2}, {1, 2}};
-  // Jacobi converges quadratically: 6 sweeps reach round-off for any 3x3 tensor.
-  for (int sweep = 0; sweep < 6; ++sweep)
+  // Jacobi converges quadratically: at most 6 sweeps reach round-off for any 3x3
+  // tensor; stop once the off-diagonal part is negligible (a test on this particle's
+  // own values, so every rank does the same).
+  for (int sweep = 0; sweep < 6; ++sweep) {
+    const double off = A[0][1] * A[0][1] + A[0][2] * A[0][2] + A[1][2] * A[1][2];
+    const double diag = A[0][0] * A[0][0] + A[1][1] * A[1][1] + A[2][2] * A[2][2];
+    if (off <= 1e-30 * diag) break;
     for (const auto& e : pq) {
       const int p = e[0], q = e[1];
       const double apq = A[p][q];
@@ -37,6 +42,7 @@ void principal(const double s[6], double lambda[3], double Q[3][3]) {
         Q[k][q] = sn * qkp + c * qkq;
       }
     }
+  }
   for (int i = 0; i < 3; ++i) lambda[i] = A[i][i];
 }
 
@@ -46,6 +52,15 @@ namespace {
 // (sigma_i + sigma_j) / (rho_i rho_j) form): in the principal frame of sigma,
 // R'_aa = -epsilon sigma'_aa where sigma'_aa is tensile, else 0; rotated back.
 void artificial_stress(const double s[6], double eps, double R[6]) {
+  // Gershgorin: no eigenvalue exceeds max_i (s_ii + sum_j |s_ij|); when that is not
+  // positive no principal stress is tensile and R = 0 (compressed or fluid particles).
+  const double b0 = s[0] + std::abs(s[3]) + std::abs(s[5]);
+  const double b1 = s[1] + std::abs(s[3]) + std::abs(s[4]);
+  const double b2 = s[2] + std::abs(s[4]) + std::abs(s[5]);
+  if (std::max({b0, b1, b2}) <= 0) {
+    for (int k = 0; k < 6; ++k) R[k] = 0;
+    return;
+  }
   double lam[3], Q[3][3];
   principal(s, lam, Q);
   double r[3];
@@ -130,7 +145,10 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, const N
     if (si.corrected) {
       // Normalised gradient L B^-1, B = sum V_j (x_j - x_i) (x) grad W: exact for a
       // linear velocity field also near free surfaces. A particle with too few
-      // neighbours (B nearly singular) keeps the plain gradient.
+      // neighbours (B nearly singular) keeps the plain gradient. Below 3 dimensions B
+      // has zero rows for the directions without particles: those take the identity.
+      if constexpr (D < 3)
+        for (int a = D; a < 3; ++a) B[a][a] = 1;
       double Bi[3][3];
       if (invert3(B, Bi, 1e-3)) {
         double Lc[3][3];
