@@ -37,7 +37,10 @@ void find_neighbours(std::span<const double> x, std::span<const double> y,
   out.start.assign(n_query + 1, 0);
   out.index.clear();
   if (n == 0 || n_query == 0) return;
-  const double inv = 1.0 / cell;
+  // Cells of half the search radius: a particle's candidates lie in the 5 x 5 x 5 cells
+  // around its own (about 40% fewer than in 3 x 3 x 3 cells of the full radius).
+  constexpr int reach = 2;
+  const double inv = reach / cell;
   // Integer cell coordinates on the global lattice and their bounding box.
   std::int64_t lo[3] = {std::numeric_limits<std::int64_t>::max(),
                         std::numeric_limits<std::int64_t>::max(),
@@ -53,18 +56,19 @@ void find_neighbours(std::span<const double> x, std::span<const double> y,
       lo[d] = std::min(lo[d], c);
       hi[d] = std::max(hi[d], c);
     }
-  // One ring of empty cells around the box, so that the 27-cell loop needs no bounds.
+  // Two rings of empty cells around the box, so that the 5 x 5 x 5 cell loop needs no
+  // bounds.
   std::int64_t dims[3];
   double cells = 1;
   for (int d = 0; d < 3; ++d) {
-    lo[d] -= 1;
-    dims[d] = hi[d] - lo[d] + 2;
+    lo[d] -= reach;
+    dims[d] = hi[d] - lo[d] + reach + 1;
     cells *= static_cast<double>(dims[d]);
   }
   w.key.resize(n);
   for (std::size_t i = 0; i < n; ++i)
-    w.key[i] =
-        ((coord(z[i]) - lo[2]) * dims[1] + (coord(y[i]) - lo[1])) * dims[0] + (coord(x[i]) - lo[0]);
+    w.key[i] = ((coord(z[i]) - lo[2]) * dims[1] + (coord(y[i]) - lo[1])) * dims[0] +
+               (coord(x[i]) - lo[0]);
   w.order.resize(n);
   const bool dense = cells <= 8.0 * static_cast<double>(n) + 4096.0;
   if (dense) {
@@ -105,16 +109,18 @@ void find_neighbours(std::span<const double> x, std::span<const double> y,
     w.zs[k] = z[p];
     w.hs[k] = h[p];
   }
-  // Range of sorted entries in the three cells key-1 .. key+1 (a row along x).
+  // Range of sorted entries in the cells key-2 .. key+2 (a row along x).
   auto row = [&](std::int64_t key, int& b, int& e) {
     if (dense) {
-      b = w.cell_start[static_cast<std::size_t>(key - 1)];
-      e = w.cell_start[static_cast<std::size_t>(key + 2)];
+      b = w.cell_start[static_cast<std::size_t>(key - reach)];
+      e = w.cell_start[static_cast<std::size_t>(key + reach + 1)];
     } else {
-      b = static_cast<int>(std::lower_bound(w.sorted_key.begin(), w.sorted_key.end(), key - 1) -
-                           w.sorted_key.begin());
-      e = static_cast<int>(std::upper_bound(w.sorted_key.begin(), w.sorted_key.end(), key + 1) -
-                           w.sorted_key.begin());
+      b = static_cast<int>(
+          std::lower_bound(w.sorted_key.begin(), w.sorted_key.end(), key - reach) -
+          w.sorted_key.begin());
+      e = static_cast<int>(
+          std::upper_bound(w.sorted_key.begin(), w.sorted_key.end(), key + reach) -
+          w.sorted_key.begin());
     }
   };
   const std::int64_t sy = dims[0], sz = dims[0] * dims[1];
@@ -122,18 +128,29 @@ void find_neighbours(std::span<const double> x, std::span<const double> y,
   for (std::size_t i = 0; i < n_query; ++i) {
     const double xi = x[i], yi = y[i], zi = z[i], hi_ = h[i];
     const std::int64_t k0 = w.key[i];
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy) {
+    for (int dz = -reach; dz <= reach; ++dz)
+      for (int dy = -reach; dy <= reach; ++dy) {
         int b, e;
         row(k0 + dz * sz + dy * sy, b, e);
-        for (int k = b; k < e; ++k) {
-          const double dx_ = xi - w.xs[static_cast<std::size_t>(k)];
-          const double dy_ = yi - w.ys[static_cast<std::size_t>(k)];
-          const double dz_ = zi - w.zs[static_cast<std::size_t>(k)];
-          const double r2 = dx_ * dx_ + dy_ * dy_ + dz_ * dz_;
-          const double s = hi_ + w.hs[static_cast<std::size_t>(k)];
-          const int j = w.order[static_cast<std::size_t>(k)];
-          if (r2 < s * s && j != static_cast<int>(i)) out.index.push_back(j);
+        if (e <= b) continue;
+        // The distance test over the row's contiguous copies (a loop the compiler
+        // vectorises), then the accepted entries in order.
+        w.flags.resize(static_cast<std::size_t>(e - b));
+        unsigned char* fl = w.flags.data();
+        const double* xs = w.xs.data() + b;
+        const double* ys = w.ys.data() + b;
+        const double* zs = w.zs.data() + b;
+        const double* hs = w.hs.data() + b;
+        const int m = e - b;
+#pragma omp simd
+        for (int k = 0; k < m; ++k) {
+          const double dx_ = xi - xs[k], dy_ = yi - ys[k], dz_ = zi - zs[k];
+          const double s = hi_ + hs[k];
+          fl[k] = dx_ * dx_ + dy_ * dy_ + dz_ * dz_ < s * s;
+        }
+        for (int k = 0; k < m; ++k) {
+          const int j = w.order[static_cast<std::size_t>(b + k)];
+          if (fl[k] && j != static_cast<int>(i)) out.index.push_back(j);
         }
       }
     out.start[i + 1] = static_cast<std::int64_t>(out.index.size());

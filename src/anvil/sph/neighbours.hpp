@@ -1,11 +1,12 @@
 // Cell-list neighbour search for SPH, knowing nothing of MPI. Two particles are
 // neighbours when r < h_i + h_j (the support 2 h_ij of the kernel at the mean smoothing
-// length). Cells are cubes of edge `cell` (>= the largest h_i + h_j) on a lattice
-// anchored at the origin, cell index floor(x / cell): the same cells on every rank.
+// length). Cells are cubes of edge cell / 2 (`cell` >= the largest h_i + h_j) on a
+// lattice anchored at the origin, cell index floor(2 x / cell): the same cells on every
+// rank.
 //
 // Order (the determinism rule, DESIGN.md section 3). A particle's neighbours are listed
-// by the 27 cells around its own in a fixed order (z, then y, then x offsets, -1..1) and,
-// inside a cell, in ascending global id. The order is therefore a function of the global
+// by the 125 cells around its own in a fixed order (z, then y, then x offsets, -2..2)
+// and, inside a cell, in ascending global id. The order is therefore a function of the global
 // positions, ids and cell size only, not of which rank holds which particle or of the
 // order of the arrays: every rank that holds a particle and all of its neighbours (own
 // or ghost copies with the same bits) sums its neighbour terms in the same order.
@@ -32,6 +33,7 @@ struct NeighbourWorkspace {
   std::vector<int> order;               // particles sorted by cell, then gid
   std::vector<double> xs, ys, zs, hs;   // their positions and h in that order
   std::vector<std::int64_t> sorted_key; // sparse fallback: keys in that order
+  std::vector<unsigned char> flags;     // distance test of one row of candidates
 };
 
 // Finds the neighbours of particles [0, n_query) among all n = x.size() particles (the

@@ -121,15 +121,7 @@ void SphPhase::migrate(std::span<const int> dest) {
   const std::size_t nr = move_plan_.recv_count();
   auto move = [&](auto& field) {
     using T = typename std::decay_t<decltype(field)>::value_type;
-    std::vector<T>* tmp;
-    if constexpr (std::is_same_v<T, double>)
-      tmp = &tmp_d_;
-    else if constexpr (std::is_same_v<T, std::int64_t>)
-      tmp = &tmp_l_;
-    else if constexpr (std::is_same_v<T, int>)
-      tmp = &tmp_i_;
-    else
-      tmp = &tmp_u_;
+    std::vector<T>* tmp = scratch<T>();
     tmp->resize(nr);
     move_plan_.forward(std::span<const T>(field), std::span<T>(*tmp));
     field.swap(*tmp);
@@ -148,7 +140,8 @@ void SphPhase::sort_by_gid() {
   });
   auto apply = [&](auto& field) {
     using T = typename std::decay_t<decltype(field)>::value_type;
-    std::vector<T> out(n);
+    std::vector<T>& out = *scratch<T>();
+    out.resize(n);
     for (std::size_t k = 0; k < n; ++k) out[k] = field[static_cast<std::size_t>(perm_[k])];
     field.swap(out);
   };

@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include "anvil/core/timer.hpp"
@@ -82,6 +83,19 @@ private:
   void exchange_ghosts_in();
   void exchange_ghosts_out();
   void resize_neighbour_fields(std::size_t n);
+  // The reusable scratch vector for fields of type T (moves and reorders swap with it,
+  // so both keep their capacity: no allocation in steady state).
+  template <class T>
+  std::vector<T>* scratch() {
+    if constexpr (std::is_same_v<T, double>)
+      return &tmp_d_;
+    else if constexpr (std::is_same_v<T, std::int64_t>)
+      return &tmp_l_;
+    else if constexpr (std::is_same_v<T, int>)
+      return &tmp_i_;
+    else
+      return &tmp_u_;
+  }
 
   const Comm& comm_;
   Rcb rcb_;
