@@ -3,9 +3,42 @@
 #include <algorithm>
 #include <cmath>
 
+#include "anvil/core/simd.hpp"
 #include "anvil/fe/hex8.hpp"
 
 namespace anvil::sph {
+
+using simd::vdouble;
+using simd::width;
+namespace stdx = simd::stdx;
+
+namespace {
+
+// The lanes' sum in lane order (a fixed order: the bits do not depend on the partition).
+inline double lane_sum(const vdouble& v) {
+  double s = v[0];
+  for (int l = 1; l < width; ++l) s += v[l];
+  return s;
+}
+
+// kernel_fast for `width` pairs at once (the same operations per lane).
+template <KernelType K, int D>
+inline void kernel_simd(const vdouble& r, const vdouble& h, vdouble& w, vdouble& dwr) {
+  const vdouble ih = 1.0 / h, q = r * ih;
+  const vdouble ihd = D == 1 ? ih : (D == 2 ? ih * ih : ih * ih * ih);
+  const vdouble s = kernel_norm<K, D>() * ihd;
+  if constexpr (K == KernelType::cubic_spline) {
+    const vdouble a = stdx::max(2.0 - q, vdouble(0.0)), b = stdx::max(1.0 - q, vdouble(0.0));
+    w = s * (0.25 * a * a * a - b * b * b);
+    dwr = s * ih * (3.0 * b * b - 0.75 * a * a) / r;
+  } else {
+    const vdouble t = stdx::max(1.0 - 0.5 * q, vdouble(0.0)), t3 = t * t * t;
+    w = s * t3 * t * (2.0 * q + 1.0);
+    dwr = s * ih * ih * (-5.0 * t3);
+  }
+}
+
+} // namespace
 
 void principal(const double s[6], double lambda[3], double Q[3][3]) {
   double A[3][3] = {{s[0], s[3], s[5]}, {s[3], s[1], s[4]}, {s[5], s[4], s[2]}};
@@ -103,45 +136,81 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, const N
                       double dt, SphWorkspace& w) {
   const std::size_t n = p.n_local;
   const NeighbourRead1* rd = w.read1.data();
+  bool any_epsilon = false;
+  for (const auto& st : sets) any_epsilon = any_epsilon || st.epsilon > 0;
   for (std::size_t i = 0; i < n; ++i) {
     const NeighbourRead1& pi = rd[i];
     const SetParams& si = sets[static_cast<std::size_t>(pi.set)];
-    double L[3][3] = {}, B[3][3] = {};
-    for (std::int64_t k = nl.start[i]; k < nl.start[i + 1]; ++k) {
-      const NeighbourRead1& pj = rd[nl.index[static_cast<std::size_t>(k)]];
-      const double dx[3] = {pi.x[0] - pj.x[0], pi.x[1] - pj.x[1], pi.x[2] - pj.x[2]};
-      const double hb = 0.5 * (pi.h + pj.h);
-      const double r =
-          std::max(std::sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]), 1e-9 * hb);
-      double wk, dwr;
-      kernel_fast<K, D>(r, hb, wk, dwr);
-      const double g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
-      double fn = 0;
-      if (si.epsilon > 0 || pj.set != pi.set) {
-        const SetParams& sj = sets[static_cast<std::size_t>(pj.set)];
-        if (si.epsilon + sj.epsilon > 0) {
-          const double hd = D == 1 ? hb : (D == 2 ? hb * hb : hb * hb * hb);
-          const double t = wk * hd / (kernel_norm<K, D>() * 0.5 * (si.w_spacing + sj.w_spacing));
-          const double ex = 0.5 * (si.exponent + sj.exponent);
-          fn = ex == 4.0 ? (t * t) * (t * t) : std::pow(t, ex);
+    // The pairs, `width` at a time (lane l takes the entries k0 + l): each lane sums its
+    // entries in list order and the lanes are added in lane order at the end, so the
+    // sums depend only on the list, which is the same on every rank.
+    vdouble Lv[3][3], Bv[3][3];
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) Lv[a][b] = Bv[a][b] = 0.0;
+    const vdouble xi[3] = {pi.x[0], pi.x[1], pi.x[2]}, vi[3] = {pi.v[0], pi.v[1], pi.v[2]};
+    const std::int64_t k_end = nl.start[i + 1];
+    for (std::int64_t k0 = nl.start[i]; k0 < k_end; k0 += width) {
+      int idx[width];
+      for (int l = 0; l < width; ++l)
+        idx[l] = k0 + l < k_end ? nl.index[static_cast<std::size_t>(k0 + l)] : static_cast<int>(i);
+      auto get = [&](auto field) { return vdouble([&](auto l) { return field(rd[idx[l]]); }); };
+      const vdouble valid([&](auto l) { return k0 + static_cast<int>(l) < k_end ? 1.0 : 0.0; });
+      vdouble dx[3];
+      for (int a = 0; a < 3; ++a)
+        dx[a] = xi[a] - get([a](const NeighbourRead1& r) { return r.x[a]; });
+      const vdouble hb = 0.5 * (pi.h + get([](const NeighbourRead1& r) { return r.h; }));
+      const vdouble r =
+          stdx::max(stdx::sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]), 1e-9 * hb);
+      vdouble wk, dwr;
+      kernel_simd<K, D>(r, hb, wk, dwr);
+      const vdouble g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
+      vdouble fn = 0.0;
+      if (any_epsilon) {
+        const vdouble eps = 0.5 * (si.epsilon + get([&](const NeighbourRead1& q) {
+                                     return sets[static_cast<std::size_t>(q.set)].epsilon;
+                                   }));
+        if (stdx::any_of(eps > 0.0)) {
+          const vdouble ws = 0.5 * (si.w_spacing + get([&](const NeighbourRead1& q) {
+                                      return sets[static_cast<std::size_t>(q.set)].w_spacing;
+                                    }));
+          const vdouble ex = 0.5 * (si.exponent + get([&](const NeighbourRead1& q) {
+                                      return sets[static_cast<std::size_t>(q.set)].exponent;
+                                    }));
+          const vdouble hd = D == 1 ? hb : (D == 2 ? hb * hb : hb * hb * hb);
+          const vdouble t = wk * hd / (kernel_norm<K, D>() * ws);
+          const vdouble t2 = t * t;
+          vdouble f = t2 * t2;
+          if (stdx::any_of(ex != 4.0))
+            f = vdouble([&](auto l) { return ex[l] == 4.0 ? f[l] : std::pow(t[l], ex[l]); });
+          fn = 0.0;
+          stdx::where(eps > 0.0, fn) = f;
         }
       }
-      double* pd = &w.pair[4 * static_cast<std::size_t>(k)];
-      pd[0] = g[0];
-      pd[1] = g[1];
-      pd[2] = g[2];
-      pd[3] = fn;
+      for (int l = 0; l < width && k0 + l < k_end; ++l) {
+        double* pd = &w.pair[4 * static_cast<std::size_t>(k0 + l)];
+        pd[0] = g[0][l];
+        pd[1] = g[1][l];
+        pd[2] = g[2][l];
+        pd[3] = fn[l];
+      }
       // Volume weights V_j = m_j / rho_j: consistent across density jumps (a gas
-      // interface, particles of different sets).
-      const double vj = pj.volume;
-      const double dv[3] = {vj * (pj.v[0] - pi.v[0]), vj * (pj.v[1] - pi.v[1]),
-                            vj * (pj.v[2] - pi.v[2])};
+      // interface, particles of different sets). Padding lanes weigh nothing.
+      const vdouble vj = valid * get([](const NeighbourRead1& q) { return q.volume; });
+      vdouble dv[3];
       for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) L[a][b] += dv[a] * g[b];
+        dv[a] = vj * (get([a](const NeighbourRead1& q) { return q.v[a]; }) - vi[a]);
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) Lv[a][b] += dv[a] * g[b];
       if (si.corrected)
         for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < 3; ++b) B[a][b] -= vj * dx[a] * g[b];
+          for (int b = 0; b < 3; ++b) Bv[a][b] -= (vj * dx[a]) * g[b];
     }
+    double L[3][3], B[3][3];
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        L[a][b] = lane_sum(Lv[a][b]);
+        B[a][b] = lane_sum(Bv[a][b]);
+      }
     if (si.corrected) {
       // Normalised gradient L B^-1, B = sum V_j (x_j - x_i) (x) grad W: exact for a
       // linear velocity field also near free surfaces. A particle with too few
@@ -288,49 +357,75 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, const Neighbo
   const NeighbourRead2* rd = w.read2.data();
   for (std::size_t i = 0; i < n; ++i) {
     const NeighbourRead2& pi = rd[i];
-    double acc[3] = {0, 0, 0}, de = 0, mu_max = 0;
-    for (std::int64_t k = nl.start[i]; k < nl.start[i + 1]; ++k) {
-      const NeighbourRead2& pj = rd[nl.index[static_cast<std::size_t>(k)]];
-      const double* pd = &w.pair[4 * static_cast<std::size_t>(k)];
-      const double g[3] = {pd[0], pd[1], pd[2]};
-      const double fn = pd[3];
-      const double dx[3] = {pi.x[0] - pj.x[0], pi.x[1] - pj.x[1], pi.x[2] - pj.x[2]};
-      const double dv[3] = {pi.v[0] - pj.v[0], pi.v[1] - pj.v[1], pi.v[2] - pj.v[2]};
-      const double vr = dv[0] * dx[0] + dv[1] * dx[1] + dv[2] * dx[2];
-      double visc = 0;
-      if (vr < 0) {
-        const double hb = 0.5 * (pi.h + pj.h);
-        const double r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
-        const double mu = hb * vr / (r2 + 0.01 * hb * hb);
-        const double cb = 0.5 * (pi.c + pj.c);
-        // Pi_ij = (-alpha c mu + beta mu^2) / rho_ij with rho_ij = (rho_i + rho_j) / 2.
-        visc =
-            (-(pi.alpha + pj.alpha) * cb * mu + (pi.beta + pj.beta) * mu * mu) / (pi.rho + pj.rho);
-        mu_max = std::max(mu_max, -mu);
+    // The pairs `width` at a time, lanes summed in lane order at the end (see pass 1).
+    vdouble accv[3] = {0.0, 0.0, 0.0}, dev = 0.0, mumv = 0.0;
+    const std::int64_t k_end = nl.start[i + 1];
+    for (std::int64_t k0 = nl.start[i]; k0 < k_end; k0 += width) {
+      int idx[width];
+      for (int l = 0; l < width; ++l)
+        idx[l] = k0 + l < k_end ? nl.index[static_cast<std::size_t>(k0 + l)] : static_cast<int>(i);
+      auto get = [&](auto field) { return vdouble([&](auto l) { return field(rd[idx[l]]); }); };
+      auto pair = [&](int c) {
+        return vdouble([&](auto l) {
+          return k0 + static_cast<int>(l) < k_end ? w.pair[4 * static_cast<std::size_t>(k0 + l) + c]
+                                                  : 0.0;
+        });
+      };
+      const vdouble g[3] = {pair(0), pair(1), pair(2)};
+      const vdouble fn = pair(3);
+      vdouble dx[3], dv[3];
+      for (int a = 0; a < 3; ++a) {
+        dx[a] = pi.x[a] - get([a](const NeighbourRead2& q) { return q.x[a]; });
+        dv[a] = pi.v[a] - get([a](const NeighbourRead2& q) { return q.v[a]; });
       }
-      const double irr = pi.inv_rho * pj.inv_rho;
-      double T[6];
-      for (int c = 0; c < 6; ++c) T[c] = (pi.S[c] + pj.S[c]) * irr;
-      double rg = 0;
-      if (fn > 0 && (pi.has_r | pj.has_r)) {
-        for (int c = 0; c < 6; ++c) T[c] += fn * irr * (pi.R[c] + pj.R[c]);
+      const vdouble vr = dv[0] * dx[0] + dv[1] * dx[1] + dv[2] * dx[2];
+      vdouble visc = 0.0;
+      const auto approaching = vr < 0.0;
+      if (stdx::any_of(approaching)) {
+        const vdouble hb = 0.5 * (pi.h + get([](const NeighbourRead2& q) { return q.h; }));
+        const vdouble r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
+        const vdouble mu = hb * vr / (r2 + 0.01 * hb * hb);
+        const vdouble cb = 0.5 * (pi.c + get([](const NeighbourRead2& q) { return q.c; }));
+        // Pi_ij = (-alpha c mu + beta mu^2) / rho_ij with rho_ij = (rho_i + rho_j) / 2.
+        const vdouble pv =
+            (-(pi.alpha + get([](const NeighbourRead2& q) { return q.alpha; })) * cb * mu +
+             (pi.beta + get([](const NeighbourRead2& q) { return q.beta; })) * mu * mu) /
+            (pi.rho + get([](const NeighbourRead2& q) { return q.rho; }));
+        stdx::where(approaching, visc) = pv;
+        stdx::where(approaching, mumv) = stdx::max(mumv, -mu);
+      }
+      const vdouble irr = pi.inv_rho * get([](const NeighbourRead2& q) { return q.inv_rho; });
+      vdouble T[6];
+      for (int c = 0; c < 6; ++c)
+        T[c] = (pi.S[c] + get([c](const NeighbourRead2& q) { return q.S[c]; })) * irr;
+      vdouble rg = 0.0;
+      if (stdx::any_of(fn > 0.0) && (pi.has_r || stdx::any_of(get([](const NeighbourRead2& q) {
+                                                                return q.has_r ? 1.0 : 0.0;
+                                                              }) > 0.0))) {
+        const vdouble fi = fn * irr;
+        for (int c = 0; c < 6; ++c)
+          T[c] += fi * (pi.R[c] + get([c](const NeighbourRead2& q) { return q.R[c]; }));
         // The artificial stress's own work on particle i (the stress's is in pass 1).
-        rg = fn * irr *
-             (dv[0] * (pi.R[0] * g[0] + pi.R[3] * g[1] + pi.R[5] * g[2]) +
-              dv[1] * (pi.R[3] * g[0] + pi.R[1] * g[1] + pi.R[4] * g[2]) +
-              dv[2] * (pi.R[5] * g[0] + pi.R[4] * g[1] + pi.R[2] * g[2]));
+        rg = fi * (dv[0] * (pi.R[0] * g[0] + pi.R[3] * g[1] + pi.R[5] * g[2]) +
+                   dv[1] * (pi.R[3] * g[0] + pi.R[1] * g[1] + pi.R[4] * g[2]) +
+                   dv[2] * (pi.R[5] * g[0] + pi.R[4] * g[1] + pi.R[2] * g[2]));
       }
       T[0] -= visc;
       T[1] -= visc;
       T[2] -= visc;
-      const double mj = pj.mass;
-      acc[0] += mj * (T[0] * g[0] + T[3] * g[1] + T[5] * g[2]);
-      acc[1] += mj * (T[3] * g[0] + T[1] * g[1] + T[4] * g[2]);
-      acc[2] += mj * (T[5] * g[0] + T[4] * g[1] + T[2] * g[2]);
+      // Padding lanes have zero kernel gradients: they add nothing.
+      const vdouble mj = get([](const NeighbourRead2& q) { return q.mass; });
+      accv[0] += mj * (T[0] * g[0] + T[3] * g[1] + T[5] * g[2]);
+      accv[1] += mj * (T[3] * g[0] + T[1] * g[1] + T[4] * g[2]);
+      accv[2] += mj * (T[5] * g[0] + T[4] * g[1] + T[2] * g[2]);
       // Half the viscous dissipation of the pair heats particle i.
-      const double dvg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
-      de += mj * (0.5 * visc * dvg - rg);
+      const vdouble dvg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
+      dev += mj * (0.5 * visc * dvg - rg);
     }
+    const double acc[3] = {lane_sum(accv[0]), lane_sum(accv[1]), lane_sum(accv[2])};
+    const double de = lane_sum(dev);
+    double mu_max = 0;
+    for (int l = 0; l < width; ++l) mu_max = std::max(mu_max, static_cast<double>(mumv[l]));
     for (int a = 0; a < 3; ++a) p.force[a][i] = pi.mass * acc[a];
     p.energy_rate[i] = de;
     const double ci = pi.c;

@@ -67,8 +67,8 @@ void find_neighbours(std::span<const double> x, std::span<const double> y,
   }
   w.key.resize(n);
   for (std::size_t i = 0; i < n; ++i)
-    w.key[i] = ((coord(z[i]) - lo[2]) * dims[1] + (coord(y[i]) - lo[1])) * dims[0] +
-               (coord(x[i]) - lo[0]);
+    w.key[i] =
+        ((coord(z[i]) - lo[2]) * dims[1] + (coord(y[i]) - lo[1])) * dims[0] + (coord(x[i]) - lo[0]);
   w.order.resize(n);
   const bool dense = cells <= 8.0 * static_cast<double>(n) + 4096.0;
   if (dense) {
@@ -115,12 +115,10 @@ void find_neighbours(std::span<const double> x, std::span<const double> y,
       b = w.cell_start[static_cast<std::size_t>(key - reach)];
       e = w.cell_start[static_cast<std::size_t>(key + reach + 1)];
     } else {
-      b = static_cast<int>(
-          std::lower_bound(w.sorted_key.begin(), w.sorted_key.end(), key - reach) -
-          w.sorted_key.begin());
-      e = static_cast<int>(
-          std::upper_bound(w.sorted_key.begin(), w.sorted_key.end(), key + reach) -
-          w.sorted_key.begin());
+      b = static_cast<int>(std::lower_bound(w.sorted_key.begin(), w.sorted_key.end(), key - reach) -
+                           w.sorted_key.begin());
+      e = static_cast<int>(std::upper_bound(w.sorted_key.begin(), w.sorted_key.end(), key + reach) -
+                           w.sorted_key.begin());
     }
   };
   const std::int64_t sy = dims[0], sz = dims[0] * dims[1];
