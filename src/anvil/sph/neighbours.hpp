@@ -19,11 +19,13 @@
 namespace anvil::sph {
 
 // Neighbour lists in compressed rows: particle i's neighbours are
-// index[start[i] .. start[i+1]), indices into the arrays given to the search.
+// index[start[i] .. start[i+1]), indices into the arrays given to the search (index may
+// be longer than the list: it keeps its size between calls).
 struct NeighbourList {
   std::vector<std::int64_t> start;
-  std::vector<int> index;
-  std::size_t pairs() const { return index.size(); }
+  std::vector<int> index; // storage: only the first count() entries are the list
+  std::size_t count = 0;
+  std::size_t pairs() const { return count; }
 };
 
 // Scratch kept between calls (no allocation in steady state).
@@ -33,7 +35,6 @@ struct NeighbourWorkspace {
   std::vector<int> order;               // particles sorted by cell, then gid
   std::vector<double> xs, ys, zs, hs;   // their positions and h in that order
   std::vector<std::int64_t> sorted_key; // sparse fallback: keys in that order
-  std::vector<unsigned char> flags;     // distance test of one row of candidates
 };
 
 // Finds the neighbours of particles [0, n_query) among all n = x.size() particles (the
