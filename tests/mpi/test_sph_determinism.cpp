@@ -145,7 +145,9 @@ TEST(SphDeterminism, SameBitsOnAnyRankCount) {
   for (const auto& [id, v] : s.nodes) max_plate_v = std::max(max_plate_v, std::abs(v[5]));
   EXPECT_GT(max_ep, 0.01);
   EXPECT_GT(max_plate_v, 1.0); // the plate was pushed through contact
-  if (world.size() > 1) EXPECT_GT(stats.rebalances, 1);
+  if (world.size() > 1) {
+    EXPECT_GT(stats.rebalances, 1);
+  }
 }
 
 } // namespace
