@@ -21,7 +21,9 @@
 //
 // W is evaluated at the mean smoothing length h_ij = (h_i + h_j)/2, so grad_i W_ij =
 // -grad_j W_ji and the pair forces cancel exactly (momentum is conserved to round-off).
-// Every sum over neighbours runs in the list's order (see neighbours.hpp).
+// Every sum over neighbours is a function of the neighbour list alone (see neighbours.hpp
+// for its order): the pair loops run simd::width entries at a time, lane l summing the
+// entries l, l + width, ... in list order, and the lanes are added in lane order.
 #pragma once
 
 #include <cmath>
