@@ -4,8 +4,9 @@
 // particles with prescribed velocity and artificial stress drifts past; the particle RCB
 // is recut often (threshold 1.02) so particles migrate and ghosts change. The deck runs on
 // MPI_COMM_WORLD and, on rank 0, on MPI_COMM_SELF; every particle's position, velocity,
-// density, stress, energy and plastic strain and every node's position and velocity are
-// compared with exact equality (tolerance: zero).
+// density, stress, energy and plastic strain, every node's position and velocity, and a
+// probe on a particle are compared with exact equality (tolerance:
+// zero).
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -46,6 +47,8 @@ boundary_conditions:
   - {set: {part: slab, box: {min: [0.0066, -1, -1], max: [1, 1, 1]}}, velocity: [-150.0, 0, 0]}
 contact:
   - {type: general, parts: all, penalty_scale: 0.1}
+probes:
+  - {name: edge, at: [0.0029, 0, 0.0032]}
 )";
 
 struct Snapshot {
@@ -125,6 +128,7 @@ TEST(SphDeterminism, SameBitsOnAnyRankCount) {
   while (!parallel.finished()) parallel.step();
   const Snapshot p = gather(parallel);
   const auto stats = parallel.sph()->stats();
+  const Sample ps = parallel.sample();
   if (world.rank() != 0) return;
 
   const Comm self = Comm::self();
@@ -133,6 +137,11 @@ TEST(SphDeterminism, SameBitsOnAnyRankCount) {
   const Snapshot s = gather(serial);
 
   EXPECT_TRUE(same_bits(parallel.clock().time, serial.clock().time));
+  const Sample ss = serial.sample();
+  ASSERT_EQ(ps.probes.size(), 6u);
+  for (int k = 0; k < 6; ++k)
+    EXPECT_TRUE(same_bits(ps.probes[k], ss.probes[k])) << "probe value " << k;
+  EXPECT_NE(ss.probes[3], 0.0); // a particle probe that moves
   ASSERT_EQ(p.particles.size(), s.particles.size());
   ASSERT_EQ(p.nodes.size(), s.nodes.size());
   EXPECT_EQ(differing(s.particles, p.particles), 0)

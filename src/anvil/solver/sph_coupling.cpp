@@ -144,7 +144,11 @@ void Simulation::predict_particles(double dt_avg, double& ke, double& work) {
     pt.energy[i] += rate[i] * dt_avg;
   }
   for (std::size_t p = 0; p < probe_particle_.size(); ++p) {
-    const int q = probe_particle_[p] >= 0 ? sph_->find(probe_particle_[p]) : -1;
+    if (probe_particle_[p] < 0) continue;
+    // Only the rank holding the particle now writes; the one that held it before must
+    // not keep its old values (the history sums the slots over ranks).
+    for (int k = 0; k < 6; ++k) probe_local_[6 * p + k] = 0.0;
+    const int q = sph_->find(probe_particle_[p]);
     if (q < 0) continue;
     for (int k = 0; k < 3; ++k) {
       probe_local_[6 * p + k] = pt.x[k][q] - pt.x0[k][q];
