@@ -78,10 +78,20 @@ public:
   int find(std::int64_t gid) const;
 
 private:
+  // Moves every field of own particle i to rank dest[i] (collective), then restores
+  // ascending gid. Own arrays only (not extended by ghosts).
   void migrate(std::span<const int> dest);
+  // Reorders every field of the own particles by ascending gid (no-op when sorted).
   void sort_by_gid();
+  // Sends what pass 1 reads (gid, set, x, v, mass, rho, h) of the ghost_src_ particles to
+  // ghost_dest_ along ghost_plan_ and appends the received copies after the own
+  // particles (extends the neighbour-read arrays). Collective.
   void exchange_ghosts_in();
+  // Sends what pass 2 reads (stress, artificial stress, new rho, wave speed) along the
+  // same plan into the ghost part of S_, R_, rho and wave_speed. Collective.
   void exchange_ghosts_out();
+  // Sizes the arrays that neighbours read to n entries (own + ghosts, or own only);
+  // capacity is kept.
   void resize_neighbour_fields(std::size_t n);
   // The reusable scratch vector for fields of type T (moves and reorders swap with it,
   // so both keep their capacity: no allocation in steady state).
