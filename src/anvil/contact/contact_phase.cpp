@@ -16,6 +16,7 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
     for (std::size_t b = 0; b < mesh.blocks.size(); ++b)
       if (mesh.blocks[b].name == name) selected[b] = true;
   const ExteriorFaces surf = exterior_faces(mesh, selected);
+  extra_offset_ = global_nodes_ + static_cast<std::int64_t>(surf.size());
 
   auto local = [&](std::int64_t gid) {
     const auto it = std::lower_bound(fe.node_gid.begin(), fe.node_gid.end(), gid);
@@ -66,6 +67,10 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
   exchange_ = std::make_unique<NodeExchange>(fe, comm);
 }
 
+void ContactPhase::set_extra_nodes(std::span<const ContactNodeItem> items) {
+  extra_.assign(items.begin(), items.end());
+}
+
 void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers) {
   ++stats_.cycles;
   auto predicted = [&](int l, int i) { return nd.x[i][l] + dt * nd.v[i][l]; };
@@ -85,6 +90,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     it.last_face = last_face_[static_cast<std::size_t>(l)];
     it.allowance = allowance_[static_cast<std::size_t>(l)];
   }
+  node_out_.insert(node_out_.end(), extra_.begin(), extra_.end());
   const std::size_t nf = my_face_gid_.size();
   std::vector<ContactFaceItem>& faces = face_local_;
   faces.resize(nf);
@@ -224,7 +230,18 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
       last_face_[static_cast<std::size_t>(l)] = -1;
       allowance_[static_cast<std::size_t>(l)] = 0;
     }
+    extra_force_.assign(extra_.size(), {0.0, 0.0, 0.0});
+    extra_face_.assign(extra_.size(), -1);
     for (const auto& it : force_in_) {
+      if (it.target >= extra_offset_) {
+        const auto e = static_cast<std::size_t>(
+            std::lower_bound(extra_.begin(), extra_.end(), it.target,
+                             [](const ContactNodeItem& a, std::int64_t g) { return a.gid < g; }) -
+            extra_.begin());
+        for (int i = 0; i < 3; ++i) extra_force_[e][i] += it.f[i];
+        if (it.target == it.slave) extra_face_[e] = it.face;
+        continue;
+      }
       const auto pos = std::lower_bound(fe_.node_gid.begin(), fe_.node_gid.end(), it.target);
       const auto l = static_cast<std::size_t>(pos - fe_.node_gid.begin());
       for (int i = 0; i < 3; ++i) nd.force[i][l] += it.f[i];

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "anvil/contact/penalty.hpp"
@@ -59,6 +60,16 @@ public:
   // pair id and copied to every rank holding the node: fills `nodes.force`. Collective.
   void forces(const ContactNodes& nodes, double dt, PhaseTimers& timers);
 
+  // Contact nodes of another decomposition (SPH particles) for this cycle, given before
+  // detect(): gids >= extra_gid_offset(), ascending, owner this rank. They take part in
+  // the search as slave nodes (they have no faces); after forces(), extra_forces() holds
+  // the force on each (N, in the order given, summed like a node's) and extra_faces() the
+  // face it touched (-1: none), for its tracking next cycle.
+  void set_extra_nodes(std::span<const ContactNodeItem> items);
+  std::int64_t extra_gid_offset() const { return extra_offset_; }
+  std::span<const std::array<double, 3>> extra_forces() const { return extra_force_; }
+  std::span<const std::int64_t> extra_faces() const { return extra_face_; }
+
   const ContactStats& stats() const { return stats_; }
   // Contact history per local node (meaningful on the node's owner): the face it touched
   // last cycle (-1 for none) and its allowance. For checkpoints; set_history restores it.
@@ -84,6 +95,12 @@ private:
   const Comm& comm_;
   const std::vector<HexBlock>& blocks_; // the FE blocks (their `alive` flags)
   std::int64_t global_nodes_ = 0;       // offset that keeps face point ids apart from node ids
+  std::int64_t extra_offset_ = 0;       // first id of extra nodes (after nodes and faces)
+
+  // Extra nodes of this cycle (set_extra_nodes) and what forces() returns for them.
+  std::vector<ContactNodeItem> extra_;
+  std::vector<std::array<double, 3>> extra_force_;
+  std::vector<std::int64_t> extra_face_;
 
   // FE side (this rank): contact nodes it owns and faces of elements it owns.
   std::vector<int> my_nodes_;           // local node indices

@@ -21,8 +21,10 @@ namespace anvil {
 
 struct MaterialConfig {
   std::string name;
-  std::string model;  // registry name (material.hpp)
-  ParamValues params; // every parameter of the model, defaults filled in
+  std::string model;      // registry name (material.hpp)
+  ParamValues params;     // every parameter of the model, defaults filled in
+  std::string eos_model;  // equation of state replacing the pressure (empty: none)
+  ParamValues eos_params; // its parameters, defaults filled in
   SourceLocation where;
 };
 
@@ -46,8 +48,47 @@ struct PartConfig {
   SourceLocation where;
 };
 
-// A set of nodes: a named set (deck `node_sets`, or a generated `PART.SET`), or an
-// inline selection by part and/or box.
+// SPH particles (DESIGN.md section 4, `particles:`): a lattice filling a shape at a
+// spacing, and the options of the particle formulation (docs/sph.md).
+struct LatticeSpec {
+  enum class Shape { box, sphere, cylinder };
+  Shape shape = Shape::box;
+  Vec3 min, max;           // box
+  Vec3 center;             // sphere
+  Vec3 origin;             // cylinder: centre of its base
+  double radius = 0;       // sphere, cylinder
+  double inner_radius = 0; // cylinder: hollow inside this radius (a ring or tube)
+  double length = 0;       // cylinder
+  int axis = 2;            // cylinder
+  double spacing = 0;      // lattice spacing, m
+};
+
+struct ParticleSetConfig {
+  enum class Kernel { cubic_spline, wendland_c2 };
+  std::string name;
+  LatticeSpec lattice;
+  std::string material;
+  double smoothing_ratio = 1.3; // h = ratio * spacing
+  Kernel kernel = Kernel::cubic_spline;
+  double viscosity_linear = 1.0;    // Monaghan-Gingold alpha
+  double viscosity_quadratic = 2.0; // Monaghan-Gingold beta
+  double artificial_stress = 0.3;   // Monaghan's epsilon (Gray et al. 2001); 0 turns it off
+  double artificial_stress_exponent = 4;
+  bool corrected_gradient = false; // Randles-Libersky normalised velocity gradient
+  SourceLocation where;
+};
+
+// Options of the SPH decomposition (top-level `sph:`, optional).
+struct SphConfig {
+  double rebalance_threshold = 1.2; // re-cut the particle RCB when max/mean count exceeds it
+  // Dimensions of the particle model: 3, or 2 (plane strain in x-y, masses per unit
+  // thickness) or 1 (uniaxial strain along x, masses per unit area) for verification
+  // problems that are planar or one-dimensional; below 3 the deck may hold no FE part.
+  int dimensions = 3;
+};
+
+// A set of nodes (and particles): a named set (deck `node_sets`, or a generated
+// `PART.SET`), or an inline selection by part (a part or a particle set) and/or box.
 struct Selection {
   std::string name;                // named set, or empty for an inline selection
   std::optional<std::string> part; // restrict to the nodes of a part
@@ -109,6 +150,8 @@ struct Config {
   double history_every = 0;              // 0: every cycle
   std::vector<MaterialConfig> materials;
   std::vector<PartConfig> parts;
+  std::vector<ParticleSetConfig> particles;
+  SphConfig sph;
   std::map<std::string, Selection> node_sets;
   std::vector<InitialCondition> initial_conditions;
   std::vector<BoundaryCondition> boundary_conditions;
@@ -117,6 +160,8 @@ struct Config {
   std::vector<RigidWallConfig> rigid_walls;
 
   const MaterialConfig* material(const std::string& name) const;
+  // Index of the particle set of that name, or -1.
+  int particle_set(const std::string& name) const;
 };
 
 } // namespace anvil

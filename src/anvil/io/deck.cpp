@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <span>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -17,6 +18,12 @@ const MaterialConfig* Config::material(const std::string& name) const {
   for (const auto& m : materials)
     if (m.name == name) return &m;
   return nullptr;
+}
+
+int Config::particle_set(const std::string& name) const {
+  for (std::size_t i = 0; i < particles.size(); ++i)
+    if (particles[i].name == name) return static_cast<int>(i);
+  return -1;
 }
 
 namespace {
@@ -174,6 +181,63 @@ std::vector<std::string> generated_sets(MeshConfig::Kind kind) {
   return {};
 }
 
+// A model parameter's value, checked against its admissible range.
+double parameter_value(const ParamSpec& spec, const std::string& key, const Node& v) {
+  const double x = v.number();
+  const bool low_ok = spec.min_exclusive ? x > spec.min : x >= spec.min;
+  const bool high_ok = spec.max_exclusive ? x < spec.max : x <= spec.max;
+  if (!low_ok || !high_ok) {
+    std::string range;
+    if (spec.min > -1e299) range += fmt::format("{} {}", spec.min_exclusive ? ">" : ">=", spec.min);
+    if (spec.max < 1e299)
+      range += fmt::format("{}{} {}", range.empty() ? "" : " and ",
+                           spec.max_exclusive ? "<" : "<=", spec.max);
+    v.fail(fmt::format("{} = {} is impossible: must be {}", key, x, range));
+  }
+  return x;
+}
+
+// Fills the parameters the deck left out with their defaults; a missing required one is
+// an error at `where` (+ prefix + name).
+void fill_defaults(std::span<const ParamSpec> specs, ParamValues& values,
+                   const SourceLocation& where, const std::string& prefix,
+                   const std::string& model) {
+  for (const auto& p : specs) {
+    if (values.count(std::string(p.name))) continue;
+    if (p.required)
+      throw InputError({where.file, where.line, where.key + prefix + "." + std::string(p.name)},
+                       fmt::format("required parameter of model {} is missing", model));
+    values[std::string(p.name)] = p.default_value;
+  }
+}
+
+// `eos: {model: NAME, params...}` under a material.
+void parse_eos(MaterialConfig& m, const Node& n) {
+  const std::string model = n.required("model").str();
+  const EosModel* info = find_eos_model(model);
+  if (!info) {
+    std::string list;
+    for (const auto& e : eos_models()) list += (list.empty() ? "" : ", ") + std::string(e.name);
+    n.child("model").fail(
+        fmt::format("unknown equation of state '{}' (available: {})", model, list));
+  }
+  if (m.model == "ideal_gas") n.fail("an ideal gas has its own equation of state");
+  m.eos_model = model;
+  for (const auto& [key, v] : n.entries()) {
+    if (key == "model") continue;
+    const auto spec = std::find_if(info->params.begin(), info->params.end(),
+                                   [&](const ParamSpec& p) { return p.name == key; });
+    if (spec == info->params.end()) {
+      std::string list;
+      for (const auto& p : info->params) list += (list.empty() ? "" : ", ") + std::string(p.name);
+      v.fail(fmt::format("unknown parameter '{}' for equation of state {} (expected: {})", key,
+                         model, list));
+    }
+    m.eos_params[key] = parameter_value(*spec, key, v);
+  }
+  fill_defaults(info->params, m.eos_params, n.where(), "", model);
+}
+
 MaterialConfig parse_material(const std::string& name, const Node& n) {
   MaterialConfig m;
   m.name = name;
@@ -189,6 +253,10 @@ MaterialConfig parse_material(const std::string& name, const Node& n) {
   m.model = model;
   for (const auto& [key, v] : n.entries()) {
     if (key == "model") continue;
+    if (key == "eos") {
+      parse_eos(m, v);
+      continue;
+    }
     const auto spec = std::find_if(info->params.begin(), info->params.end(),
                                    [&](const ParamSpec& p) { return p.name == key; });
     if (spec == info->params.end()) {
@@ -196,27 +264,9 @@ MaterialConfig parse_material(const std::string& name, const Node& n) {
       for (const auto& p : info->params) list += (list.empty() ? "" : ", ") + std::string(p.name);
       v.fail(fmt::format("unknown parameter '{}' for model {} (expected: {})", key, model, list));
     }
-    const double x = v.number();
-    const bool low_ok = spec->min_exclusive ? x > spec->min : x >= spec->min;
-    const bool high_ok = spec->max_exclusive ? x < spec->max : x <= spec->max;
-    if (!low_ok || !high_ok) {
-      std::string range;
-      if (spec->min > -1e299)
-        range += fmt::format("{} {}", spec->min_exclusive ? ">" : ">=", spec->min);
-      if (spec->max < 1e299)
-        range += fmt::format("{}{} {}", range.empty() ? "" : " and ",
-                             spec->max_exclusive ? "<" : "<=", spec->max);
-      v.fail(fmt::format("{} = {} is impossible: must be {}", key, x, range));
-    }
-    m.params[key] = x;
+    m.params[key] = parameter_value(*spec, key, v);
   }
-  for (const auto& p : info->params) {
-    if (m.params.count(std::string(p.name))) continue;
-    if (p.required)
-      throw InputError({m.where.file, m.where.line, m.where.key + "." + std::string(p.name)},
-                       fmt::format("required parameter of model {} is missing", model));
-    m.params[std::string(p.name)] = p.default_value;
-  }
+  fill_defaults(info->params, m.params, m.where, "", model);
   if (model == "johnson_cook" && !(m.params["melt_temperature"] > m.params["room_temperature"]))
     throw InputError({m.where.file, m.where.line, m.where.key + ".melt_temperature"},
                      "melt_temperature must exceed room_temperature");
@@ -322,6 +372,94 @@ PartConfig parse_part(const std::string& name, const Node& n, const std::string&
   return p;
 }
 
+// One particle set: `generate: {shape: box|sphere|cylinder, ..., spacing: s}` and the
+// formulation's options (docs/sph.md).
+ParticleSetConfig parse_particle_set(const std::string& name, const Node& n) {
+  ParticleSetConfig p;
+  p.name = name;
+  p.where = n.where();
+  n.check_keys({"generate", "material", "smoothing_ratio", "kernel", "viscosity",
+                "artificial_stress", "corrected_gradient"});
+  const Node g = n.required("generate");
+  const std::string shape = g.required("shape").str();
+  LatticeSpec& l = p.lattice;
+  if (shape == "box") {
+    g.check_keys({"shape", "min", "max", "spacing"});
+    l.shape = LatticeSpec::Shape::box;
+    l.min = g.required("min").vec3();
+    l.max = g.required("max").vec3();
+    for (int i = 0; i < 3; ++i)
+      if (!(l.max[i] > l.min[i])) g.child("max").fail("max must exceed min in every direction");
+  } else if (shape == "sphere") {
+    g.check_keys({"shape", "center", "radius", "spacing"});
+    l.shape = LatticeSpec::Shape::sphere;
+    l.center = g.required("center").vec3();
+    l.radius = g.required("radius").positive();
+  } else if (shape == "cylinder") {
+    g.check_keys({"shape", "origin", "radius", "inner_radius", "length", "axis", "spacing"});
+    l.shape = LatticeSpec::Shape::cylinder;
+    if (g.has("origin")) l.origin = g.child("origin").vec3();
+    l.radius = g.required("radius").positive();
+    l.length = g.required("length").positive();
+    if (g.has("axis")) l.axis = g.child("axis").axis();
+    if (g.has("inner_radius")) {
+      l.inner_radius = g.child("inner_radius").number();
+      if (!(l.inner_radius >= 0 && l.inner_radius < l.radius))
+        g.child("inner_radius").fail("must be at least 0 and less than the radius");
+    }
+  } else {
+    g.child("shape").fail(
+        fmt::format("unknown particle shape '{}' (expected box, sphere or cylinder)", shape));
+  }
+  l.spacing = g.required("spacing").positive();
+  // A lattice of more than 2^31 particles on one deck line is a typo, not a model.
+  const double extent = shape == "box"
+                            ? (l.max.x - l.min.x) * (l.max.y - l.min.y) * (l.max.z - l.min.z)
+                            : 8 * l.radius * l.radius * std::max(l.radius, l.length);
+  if (extent / (l.spacing * l.spacing * l.spacing) > 2e9)
+    g.child("spacing").fail("the lattice would hold more than 2e9 particles");
+  p.material = n.required("material").str();
+  if (n.has("smoothing_ratio")) {
+    p.smoothing_ratio = n.child("smoothing_ratio").positive();
+    if (p.smoothing_ratio < 0.8 || p.smoothing_ratio > 3)
+      n.child("smoothing_ratio").fail("must be between 0.8 and 3 (h = ratio * spacing)");
+  }
+  if (n.has("kernel")) {
+    const std::string k = n.child("kernel").str();
+    if (k == "cubic_spline")
+      p.kernel = ParticleSetConfig::Kernel::cubic_spline;
+    else if (k == "wendland_c2")
+      p.kernel = ParticleSetConfig::Kernel::wendland_c2;
+    else
+      n.child("kernel").fail(
+          fmt::format("unknown kernel '{}' (expected cubic_spline or wendland_c2)", k));
+  }
+  if (n.has("viscosity")) {
+    const Node v = n.child("viscosity");
+    v.check_keys({"linear", "quadratic"});
+    if (v.has("linear")) p.viscosity_linear = v.child("linear").number();
+    if (v.has("quadratic")) p.viscosity_quadratic = v.child("quadratic").number();
+    if (p.viscosity_linear < 0) v.child("linear").fail("must not be negative");
+    if (p.viscosity_quadratic < 0) v.child("quadratic").fail("must not be negative");
+  }
+  if (n.has("artificial_stress")) {
+    const Node a = n.child("artificial_stress");
+    a.check_keys({"epsilon", "exponent"});
+    if (a.has("epsilon")) p.artificial_stress = a.child("epsilon").number();
+    if (a.has("exponent")) p.artificial_stress_exponent = a.child("exponent").number();
+    if (p.artificial_stress < 0 || p.artificial_stress > 1)
+      a.child("epsilon").fail("must be between 0 and 1");
+    if (p.artificial_stress_exponent < 1 || p.artificial_stress_exponent > 8)
+      a.child("exponent").fail("must be between 1 and 8");
+  }
+  if (n.has("corrected_gradient")) {
+    const std::string b = n.child("corrected_gradient").str();
+    if (b != "true" && b != "false") n.child("corrected_gradient").fail("expected true or false");
+    p.corrected_gradient = b == "true";
+  }
+  return p;
+}
+
 Box3 parse_box(const Node& n) {
   n.check_keys({"min", "max"});
   Box3 b{n.required("min").vec3(), n.required("max").vec3()};
@@ -365,14 +503,10 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
   const Node top(root, "", &c.deck_file, 1);
   if (top.is_null()) throw InputError({name, 1, ""}, "the deck is empty");
   const auto entries =
-      top.entries({"title", "termination", "time_step", "materials", "parts", "particles",
+      top.entries({"title", "termination", "time_step", "materials", "parts", "particles", "sph",
                    "node_sets", "initial_conditions", "boundary_conditions", "contact",
                    "rigid_walls", "probes", "output", "checkpoint"});
-  for (const auto& [key, n] : entries) {
-    if (key == "particles")
-      n.fail(fmt::format("'{}' is part of the deck contract but not implemented in anvil {} yet",
-                         key, "0.1"));
-  }
+  (void)entries;
 
   if (top.has("title")) c.title = top.child("title").str();
 
@@ -405,24 +539,73 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
     c.materials.push_back(parse_material(mname, mn));
   if (c.materials.empty()) top.child("materials").fail("at least one material is needed");
 
-  for (const auto& [pname, pn] : top.required("parts").entries()) {
-    if (pname.find('.') != std::string::npos) pn.fail("part names may not contain '.'");
-    PartConfig p = parse_part(pname, pn, base_dir);
-    if (!c.material(p.material))
-      pn.child("material")
-          .fail(fmt::format("material '{}' is not defined under materials", p.material));
-    c.parts.push_back(std::move(p));
+  // Finite-element parts; a deck of particles only needs none.
+  if (top.has("parts") || !top.has("particles")) {
+    for (const auto& [pname, pn] : top.required("parts").entries()) {
+      if (pname.find('.') != std::string::npos) pn.fail("part names may not contain '.'");
+      PartConfig p = parse_part(pname, pn, base_dir);
+      const MaterialConfig* mat = c.material(p.material);
+      if (!mat)
+        pn.child("material")
+            .fail(fmt::format("material '{}' is not defined under materials", p.material));
+      // The hexahedra do not track specific internal energy (docs/sph.md).
+      if (mat->model == "ideal_gas" || !mat->eos_model.empty())
+        pn.child("material")
+            .fail(fmt::format("material '{}' needs the specific internal energy ({}): it is "
+                              "available to particles only",
+                              p.material, mat->eos_model.empty() ? "ideal gas" : "eos"));
+      c.parts.push_back(std::move(p));
+    }
+    if (c.parts.empty() && !top.has("particles"))
+      top.child("parts").fail("at least one part is needed");
   }
-  if (c.parts.empty()) top.child("parts").fail("at least one part is needed");
 
+  if (top.has("particles")) {
+    for (const auto& [pname, pn] : top.child("particles").entries()) {
+      if (pname.find('.') != std::string::npos) pn.fail("particle set names may not contain '.'");
+      if (std::any_of(c.parts.begin(), c.parts.end(),
+                      [&](const PartConfig& p) { return p.name == pname; }))
+        pn.fail(fmt::format("'{}' is already the name of a part", pname));
+      ParticleSetConfig p = parse_particle_set(pname, pn);
+      if (!c.material(p.material))
+        pn.child("material")
+            .fail(fmt::format("material '{}' is not defined under materials", p.material));
+      c.particles.push_back(std::move(p));
+    }
+    if (c.particles.empty() && c.parts.empty())
+      top.child("particles").fail("at least one particle set (or a part) is needed");
+  }
+  if (top.has("sph")) {
+    const Node s = top.child("sph");
+    s.check_keys({"rebalance_threshold", "dimensions"});
+    if (s.has("dimensions")) {
+      const auto d = s.child("dimensions").integer();
+      if (d < 1 || d > 3) s.child("dimensions").fail("must be 1, 2 or 3");
+      if (d < 3 && !c.parts.empty())
+        s.child("dimensions")
+            .fail("a particle model of fewer than 3 dimensions cannot be coupled to the mesh");
+      for (const auto& p : c.particles)
+        if (d == 1 && p.kernel == ParticleSetConfig::Kernel::wendland_c2)
+          s.child("dimensions").fail("wendland_c2 is available in 2 and 3 dimensions");
+      c.sph.dimensions = static_cast<int>(d);
+    }
+    if (s.has("rebalance_threshold")) {
+      c.sph.rebalance_threshold = s.child("rebalance_threshold").number();
+      if (!(c.sph.rebalance_threshold >= 1))
+        s.child("rebalance_threshold").fail("must be at least 1");
+    }
+  }
+
+  // A part name may also name a particle set (selections, probes).
   auto part_exists = [&](const std::string& n) {
     return std::any_of(c.parts.begin(), c.parts.end(),
-                       [&](const PartConfig& p) { return p.name == n; });
+                       [&](const PartConfig& p) { return p.name == n; }) ||
+           c.particle_set(n) >= 0;
   };
   auto check_part = [&](const Selection& s) {
     if (s.part && !part_exists(*s.part))
       throw InputError({s.where.file, s.where.line, s.where.key + ".part"},
-                       fmt::format("part '{}' is not defined under parts", *s.part));
+                       fmt::format("part '{}' is not defined under parts or particles", *s.part));
   };
   // Named sets: deck sets, then PART.SET of generated meshes; file meshes are checked
   // once read.

@@ -91,6 +91,50 @@ VtuPiece fe_piece(const Simulation& sim) {
   return p;
 }
 
+VtuPiece particle_piece(const Simulation& sim) {
+  VtuPiece p;
+  const auto& pt = sim.sph()->particles();
+  const std::size_t n = pt.size();
+  p.points.resize(3 * n);
+  VtuArray disp{"displacement", 3}, vel{"velocity", 3}, rho{"density", 1}, pres{"pressure", 1},
+      stress{"stress", 6}, vm{"von_mises", 1}, ep{"plastic_strain", 1}, energy{"energy", 1},
+      h{"smoothing_length", 1}, rank{"sph_rank", 1, true}, pid{"particle_id", 1, true},
+      set{"particle_set", 1, true};
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      p.points[3 * i + k] = pt.x[k][i];
+      disp.f64.push_back(pt.x[k][i] - pt.x0[k][i]);
+      vel.f64.push_back(pt.v[k][i]);
+    }
+    double s[6];
+    for (int k = 0; k < 6; ++k) {
+      s[k] = pt.stress[k][i];
+      stress.f64.push_back(s[k]);
+    }
+    const double m = (s[0] + s[1] + s[2]) / 3;
+    const double j2 =
+        0.5 * ((s[0] - m) * (s[0] - m) + (s[1] - m) * (s[1] - m) + (s[2] - m) * (s[2] - m)) +
+        s[3] * s[3] + s[4] * s[4] + s[5] * s[5];
+    rho.f64.push_back(pt.rho[i]);
+    pres.f64.push_back(-m);
+    vm.f64.push_back(std::sqrt(3 * j2));
+    ep.f64.push_back(pt.plastic_strain[i]);
+    energy.f64.push_back(pt.energy[i]);
+    h.f64.push_back(pt.h[i]);
+    rank.i64.push_back(sim.comm().rank());
+    pid.i64.push_back(pt.gid[i] + 1);
+    set.i64.push_back(pt.set[i]);
+    // One vertex cell (VTK type 1) per particle.
+    p.connectivity.push_back(static_cast<std::int64_t>(i));
+    p.offsets.push_back(static_cast<std::int64_t>(i + 1));
+    p.types.push_back(1);
+  }
+  p.point_data = {std::move(disp),   std::move(vel),  std::move(rho), std::move(pres),
+                  std::move(stress), std::move(vm),   std::move(ep),  std::move(energy),
+                  std::move(h),      std::move(rank), std::move(pid), std::move(set)};
+  return p;
+}
+
 Outputs::Outputs(const Simulation& sim, OutputOptions options)
     : sim_(sim), opt_(std::move(options)) {
   // Rank 0 creates the directories; the others wait for it.
@@ -236,6 +280,27 @@ void Outputs::write_fields() {
     pvd_.emplace_back(clk.time, fmt::format("fields/{}.pvtu", stem));
     write_pvd(opt_.directory + "/results.pvd", pvd_);
   }
+  if (sim_.sph()) write_particles(stem);
+}
+
+// The particles of the same output as their own series (particles.pvd): one .vtu piece
+// per rank of the SPH decomposition, vertices only.
+void Outputs::write_particles(const std::string& stem) {
+  const Clock& clk = sim_.clock();
+  VtuPiece piece = particle_piece(sim_);
+  piece.time = clk.time;
+  write_vtu(
+      fmt::format("{}/fields/particles_{}_r{:04d}.vtu", opt_.directory, stem, sim_.comm().rank()),
+      piece);
+  sim_.comm().barrier();
+  if (sim_.comm().rank() == 0) {
+    std::vector<std::string> pieces;
+    for (int r = 0; r < sim_.comm().size(); ++r)
+      pieces.push_back(fmt::format("particles_{}_r{:04d}.vtu", stem, r));
+    write_pvtu(fmt::format("{}/fields/particles_{}.pvtu", opt_.directory, stem), pieces, piece);
+    particle_pvd_.emplace_back(clk.time, fmt::format("fields/particles_{}.pvtu", stem));
+    write_pvd(opt_.directory + "/particles.pvd", particle_pvd_);
+  }
 }
 
 void Outputs::progress(bool last) {
@@ -257,7 +322,8 @@ void Outputs::progress(bool last) {
   last_progress_fraction_ = frac;
   const double elapsed = now - start_wall_;
   const double eta = frac > 0 ? elapsed * (1 - frac) / frac : 0;
-  const double n = static_cast<double>(sim_.global_elements());
+  const double n =
+      static_cast<double>(sim_.global_elements() + (sim_.sph() ? sim_.sph()->global_count() : 0));
   const double grind = clk.cycle > 0 ? elapsed / static_cast<double>(clk.cycle) / n * 1e6 : 0;
   const std::string line =
       fmt::format("cycle {:>8}  t {:.4e} s  dt {:.3e} s  {:5.1f}%  left {:6.1f} s  grind {:.4f} us",
@@ -290,10 +356,15 @@ void Outputs::write_summary(int status, const std::string& message) {
   const ContactStats contact_stats = sim_.contact() ? sim_.contact()->stats() : ContactStats{};
   const double bytes_max = comm.max(contact_stats.bytes_sent);
   const std::int64_t eroded = comm.sum(sim_.eroded_local());
+  const sph::SphStats sph_stats = sim_.sph() ? sim_.sph()->stats() : sph::SphStats{};
+  double sph_seconds[4] = {sph_stats.seconds_compute, sph_stats.seconds_ghosts,
+                           sph_stats.seconds_migrate, sph_stats.seconds_rebalance};
+  comm.max(std::span<double>(sph_seconds, 4));
+  const std::int64_t particles = sim_.sph() ? sim_.sph()->global_count() : 0;
   if (comm.rank() != 0) return;
   using nlohmann::json;
   const Clock& clk = sim_.clock();
-  const double n = static_cast<double>(sim_.global_elements());
+  const double n = static_cast<double>(sim_.global_elements() + particles);
   const double cycles = static_cast<double>(std::max<std::int64_t>(clk.cycle, 1));
   json j;
   j["anvil_version"] = std::string(version);
@@ -305,7 +376,7 @@ void Outputs::write_summary(int status, const std::string& message) {
   j["ranks"] = comm.size();
   j["nodes"] = sim_.global_nodes();
   j["elements"] = sim_.global_elements();
-  j["particles"] = 0;
+  j["particles"] = particles;
   j["cycles"] = clk.cycle;
   j["eroded_elements"] = eroded;
   j["time"] = clk.time;
@@ -322,7 +393,7 @@ void Outputs::write_summary(int status, const std::string& message) {
     return mean > 0 ? tmax[static_cast<int>(p)] / mean : 1.0;
   };
   imb["fe"] = ratio(Phase::fe);
-  imb["sph"] = 1.0;
+  imb["sph"] = ratio(Phase::sph);
   {
     const double cmax = tmax[static_cast<int>(Phase::contact_search)] +
                         tmax[static_cast<int>(Phase::contact_force)];
@@ -341,6 +412,18 @@ void Outputs::write_summary(int status, const std::string& message) {
                     {"max_penetration", contact_stats.max_penetration},
                     {"bytes_sent_per_rank_per_cycle_max",
                      bytes_max / static_cast<double>(contact_stats.cycles)}};
+  }
+  if (sph_stats.cycles > 0) {
+    // Seconds are the largest over ranks; rebalances count RCB cuts, the first included.
+    j["sph"] = {{"cycles", sph_stats.cycles},
+                {"rebalances", sph_stats.rebalances},
+                {"migrations", sph_stats.migrations},
+                {"count_imbalance_last", sph_stats.imbalance},
+                {"count_imbalance_max", sph_stats.imbalance_max},
+                {"seconds_compute", sph_seconds[0]},
+                {"seconds_ghosts", sph_seconds[1]},
+                {"seconds_migrate", sph_seconds[2]},
+                {"seconds_rebalance", sph_seconds[3]}};
   }
   j["energy"] = {{"time", s.time},
                  {"initial", sim_.initial_energy()},

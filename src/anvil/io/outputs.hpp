@@ -42,6 +42,7 @@ public:
 private:
   void write_fields();
   std::string history_header() const;
+  void write_particles(const std::string& stem);
   void write_history_row(const Sample& s);
   void write_summary(int status, const std::string& message);
   void progress(bool last);
@@ -49,6 +50,7 @@ private:
   const Simulation& sim_;
   OutputOptions opt_;
   std::vector<std::pair<double, std::string>> pvd_;
+  std::vector<std::pair<double, std::string>> particle_pvd_;
   std::FILE* history_ = nullptr;
   double next_fields_ = 0, next_history_ = 0;
   std::int64_t last_field_cycle_ = -1;
@@ -62,5 +64,7 @@ private:
 
 // The field piece of this rank: points, hexahedra and their nodal and element fields.
 VtuPiece fe_piece(const Simulation& sim);
+// The particle piece of this rank (SPH decomposition): one vertex cell per particle.
+VtuPiece particle_piece(const Simulation& sim);
 
 } // namespace anvil

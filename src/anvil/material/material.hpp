@@ -22,6 +22,10 @@ struct MaterialBatch {
   double* plastic_strain = {}; // equivalent plastic strain (models with plasticity)
   double* temperature = {};    // K (models with thermal softening)
   double* wave_speed = {};     // out: longitudinal wave speed, m/s
+  // Specific internal energy at the new state, J/kg (equations of state read it; null
+  // where the caller does not track it, e.g. the hexahedra: models that need it are
+  // rejected there at setup).
+  const double* energy = {};
 };
 
 // A deck parameter of a model: name, unit, and the admissible range that the deck reader
@@ -52,6 +56,9 @@ struct ElasticConstants {
 class Material {
 public:
   explicit Material(const ParamValues& p) : elastic_(ElasticConstants::from(p)) {}
+  // For models without Young's modulus (fluids): the caller gives the constants that
+  // stand for its stiffness (density, bulk modulus; shear zero).
+  explicit Material(const ElasticConstants& c) : elastic_(c) {}
   virtual ~Material() = default;
 
   // Advances the stress of every point in the batch by one step.
@@ -59,6 +66,11 @@ public:
   virtual bool has_plastic_strain() const { return false; }
   virtual bool has_temperature() const { return false; }
   virtual double initial_temperature() const { return 0; }
+  // True when update() reads MaterialBatch::energy (equations of state, gases).
+  virtual bool needs_energy() const { return false; }
+  // Specific internal energy (J/kg) and pressure (Pa) of the undisturbed material.
+  virtual double initial_energy() const { return 0; }
+  virtual double initial_pressure() const { return 0; }
 
   const ElasticConstants& elastic() const { return elastic_; }
 
@@ -76,5 +88,31 @@ struct MaterialModel {
 };
 std::span<const MaterialModel> material_models();
 const MaterialModel* find_material_model(std::string_view name);
+
+// An equation of state p(rho, e) that replaces the pressure of a strength model (the
+// strength model keeps the deviator): `eos: {model: mie_gruneisen, ...}` under a
+// material. Same registry pattern: deck name = class = file.
+class Eos {
+public:
+  virtual ~Eos() = default;
+  // Pressure (Pa, compression positive) and the squared bulk sound speed dp/drho
+  // (m^2/s^2) at density rho (kg/m^3) and specific internal energy e (J/kg), reference
+  // density rho0; n points, arrays owned by the caller.
+  virtual void pressure(int n, double rho0, const double* rho, const double* e, double* p,
+                        double* c2) const = 0;
+};
+struct EosModel {
+  std::string_view name;
+  std::span<const ParamSpec> params;
+  std::unique_ptr<Eos> (*make)(const ParamValues&);
+  std::string_view doc;
+};
+std::span<const EosModel> eos_models();
+const EosModel* find_eos_model(std::string_view name);
+
+// A material as the deck defines it: the strength model `model` with `params`, and, when
+// eos_model is not empty, its pressure replaced by that equation of state.
+std::unique_ptr<Material> make_material(std::string_view model, const ParamValues& params,
+                                        std::string_view eos_model, const ParamValues& eos_params);
 
 } // namespace anvil

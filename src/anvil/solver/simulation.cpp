@@ -45,7 +45,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
 
   // Materials and element blocks (one per part).
   for (const auto& m : config_.materials)
-    materials_.push_back(find_material_model(m.model)->make(m.params));
+    materials_.push_back(make_material(m.model, m.params, m.eos_model, m.eos_params));
   auto material_of = [&](const std::string& name) -> const Material* {
     for (std::size_t i = 0; i < config_.materials.size(); ++i)
       if (config_.materials[i].name == name) return materials_[i].get();
@@ -94,22 +94,44 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     contact_ = std::make_unique<ContactPhase>(config_.contact[0], mesh, fe_, blocks_, comm_);
     for (auto& f : contact_force_) f.assign(nn, 0.0);
   }
+  if (!config_.particles.empty()) {
+    sph_ = std::make_unique<sph::SphPhase>(
+        config_,
+        [&](int set) {
+          return material_of(config_.particles[static_cast<std::size_t>(set)].material);
+        },
+        comm_);
+    // Particle sets in contact: all of them with `parts: all`, else those listed.
+    sph_contact_set_.assign(config_.particles.size(), 0);
+    if (contact_)
+      for (std::size_t s = 0; s < config_.particles.size(); ++s)
+        sph_contact_set_[s] =
+            config_.contact[0].parts.empty() ||
+            std::find(config_.contact[0].parts.begin(), config_.contact[0].parts.end(),
+                      config_.particles[s].name) != config_.contact[0].parts.end();
+  }
   apply_initial_conditions(mesh);
   // Constraints stop the constrained velocity components at once (a node on a fixed
   // impact face hits the wall at t = 0): the kinetic energy they remove is work done by
   // the constraint, so that the energy balance starts from the energy the deck gave.
-  const double ke_given = comm_.sum(owned_kinetic_energy());
+  const double ke_given = comm_.sum(owned_kinetic_energy() + particle_kinetic_energy());
   apply_boundary_conditions(mesh);
   locate_probes(mesh);
 
   // The initial sample (t = 0): kinetic energy of the initial velocities, probes at rest
   // position with their initial velocity.
-  kinetic_local_ = owned_kinetic_energy();
+  kinetic_local_ = owned_kinetic_energy() + particle_kinetic_energy();
   probe_local_.assign(6 * config_.probes.size(), 0.0);
-  for (std::size_t p = 0; p < probe_node_.size(); ++p)
+  for (std::size_t p = 0; p < probe_node_.size(); ++p) {
     if (probe_node_[p] >= 0)
       for (int i = 0; i < 3; ++i) probe_local_[6 * p + 3 + i] = nodes_.v[i][probe_node_[p]];
-  initial_energy_ = ke_given;
+    const int q = probe_particle_[p] >= 0 ? sph_->find(probe_particle_[p]) : -1;
+    if (q >= 0)
+      for (int i = 0; i < 3; ++i) probe_local_[6 * p + 3 + i] = sph_->particles().v[i][q];
+  }
+  // The energy the deck gave: kinetic (before constraints) plus the particles' initial
+  // internal energy (a gas's).
+  initial_energy_ = ke_given + comm_.sum(particle_internal_energy());
   const double ke_kept = comm_.sum(kinetic_local_);
   if (comm_.rank() == 0) external_work_ = ke_kept - ke_given; // counted once, on rank 0
 }
@@ -127,7 +149,7 @@ double Simulation::owned_kinetic_energy() const {
 void Simulation::apply_initial_conditions(const Mesh& mesh) {
   const std::size_t nn = fe_.node_gid.size();
   for (const auto& ic : config_.initial_conditions) {
-    const auto ids = resolve_selection(mesh, config_, ic.nodes);
+    const auto ids = selected_nodes(mesh, ic.nodes);
     for (std::size_t n = 0; n < nn; ++n) {
       if (!std::binary_search(ids.begin(), ids.end(), fe_.node_gid[n])) continue;
       const Vec3 r = Vec3{nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]} - ic.center;
@@ -135,6 +157,7 @@ void Simulation::apply_initial_conditions(const Mesh& mesh) {
       for (int i = 0; i < 3; ++i) nodes_.v[i][n] = v[i];
     }
   }
+  apply_particle_conditions(); // the particles' initial and boundary conditions
 }
 
 void Simulation::apply_boundary_conditions(const Mesh& mesh) {
@@ -142,7 +165,7 @@ void Simulation::apply_boundary_conditions(const Mesh& mesh) {
   constrained_.assign(nn, 0);
   for (int i = 0; i < 3; ++i) v_bc_[i].assign(nn, 0.0);
   for (const auto& bc : config_.boundary_conditions) {
-    const auto ids = resolve_selection(mesh, config_, bc.nodes);
+    const auto ids = selected_nodes(mesh, bc.nodes);
     for (std::size_t n = 0; n < nn; ++n) {
       if (!std::binary_search(ids.begin(), ids.end(), fe_.node_gid[n])) continue;
       for (int i = 0; i < 3; ++i) {
@@ -160,11 +183,13 @@ void Simulation::apply_boundary_conditions(const Mesh& mesh) {
       for (int i = 0; i < 3; ++i)
         if (constrained_[n] & (1u << i)) nodes_.v[i][n] = v_bc_[i][n];
     }
+  apply_particle_boundary_conditions();
 }
 
 void Simulation::locate_probes(const Mesh& mesh) {
   (void)mesh;
   probe_node_.assign(config_.probes.size(), -1);
+  probe_particle_.assign(config_.probes.size(), -1);
   for (std::size_t p = 0; p < config_.probes.size(); ++p) {
     const Vec3 at = config_.probes[p].at;
     double best = std::numeric_limits<double>::infinity();
@@ -180,7 +205,27 @@ void Simulation::locate_probes(const Mesh& mesh) {
         best_local = static_cast<int>(n);
       }
     }
+    // The nearest particle competes with the nearest node (a node wins a tie).
+    double pbest = std::numeric_limits<double>::infinity();
+    std::int64_t pbest_gid = std::numeric_limits<std::int64_t>::max();
+    if (sph_) {
+      const auto& pt = sph_->particles();
+      for (std::size_t i = 0; i < pt.size(); ++i) {
+        const Vec3 d = Vec3{pt.x[0][i], pt.x[1][i], pt.x[2][i]} - at;
+        const double r2 = dot(d, d);
+        if (r2 < pbest || (r2 == pbest && pt.gid[i] < pbest_gid)) {
+          pbest = r2;
+          pbest_gid = pt.gid[i];
+        }
+      }
+    }
     const double global_best = comm_.min(best);
+    const double global_pbest = comm_.min(pbest);
+    if (global_pbest < global_best) {
+      probe_particle_[p] =
+          comm_.min(pbest == global_pbest ? pbest_gid : std::numeric_limits<std::int64_t>::max());
+      continue;
+    }
     const std::int64_t winner =
         comm_.min(best == global_best ? best_gid : std::numeric_limits<std::int64_t>::max());
     if (best_local >= 0 && best_gid == winner) probe_node_[p] = best_local;
@@ -287,8 +332,6 @@ void Simulation::predict() {
       if (fe_.node_owned[n]) work += nodes_.mass[n] * (v_new - v_free) * 0.5 * (v_old + v_new);
     }
   }
-  external_work_ += work;
-
   double ke = 0;
   for (std::size_t p = 0; p < probe_node_.size(); ++p)
     if (probe_node_[p] >= 0) {
@@ -317,6 +360,8 @@ void Simulation::predict() {
     }
     if (owned[n]) ke += 0.5 * m[n] * avg2;
   }
+  if (sph_) predict_particles(dt_avg, ke, work);
+  external_work_ += work;
   // Probe velocity at t(n): mean of the two half-step velocities.
   for (std::size_t p = 0; p < probe_node_.size(); ++p)
     if (probe_node_[p] >= 0)
@@ -329,7 +374,28 @@ void Simulation::predict() {
 }
 
 void Simulation::sph_forces() {
-  ScopedPhase t(timers_, Phase::sph); // no particles in this version
+  clock_.dt_particle = -1;
+  if (!sph_) return;
+  sph_->forces(clock_.dt_prev, timers_);
+  ScopedPhase t(timers_, Phase::sph);
+  // One reduction: the particles' stable step and the smallest failing particle.
+  const sph::SphResult& r = sph_->result();
+  const double none = std::numeric_limits<double>::infinity();
+  double red[2] = {r.dt_stable, r.nonfinite_gid >= 0 ? static_cast<double>(r.nonfinite_gid) : none};
+  comm_.min(std::span<double>(red, 2));
+  // An infinite step is no failure (particles of a gas expanded to zero pressure, at
+  // rest relative to their neighbours, constrain nothing); a NaN is.
+  if (red[1] != none || std::isnan(red[0]))
+    throw PhysicsError(red[1] != none
+                           ? fmt::format("particle {}", static_cast<std::int64_t>(red[1]) + 1)
+                           : "the particles",
+                       clock_.time, "non-finite stress or force");
+  if (red[0] < dt_stable_) {
+    dt_stable_ = red[0];
+    dt_element_ = -1;
+    clock_.dt_particle = static_cast<std::int64_t>(
+        comm_.min(r.dt_stable == red[0] ? static_cast<double>(r.stable_gid) : none));
+  }
 }
 
 ContactNodes Simulation::contact_view() {
@@ -340,7 +406,9 @@ ContactNodes Simulation::contact_view() {
 }
 
 void Simulation::detect_contacts() {
-  if (contact_) contact_->detect(contact_view(), clock_.dt, timers_);
+  if (!contact_) return;
+  if (sph_) contact_->set_extra_nodes(particle_contact_items(clock_.dt));
+  contact_->detect(contact_view(), clock_.dt, timers_);
 }
 
 void Simulation::correct() {
@@ -370,6 +438,7 @@ void Simulation::correct() {
       }
     }
     external_work_ += reaction;
+    if (sph_) correct_particles(work);
     contact_energy_ -= work;
   }
   ScopedPhase t(timers_, Phase::contact_force);
@@ -383,6 +452,19 @@ void Simulation::correct() {
                      fe_.node_owned.data(),
                      nodes_.size()};
   external_work_ += apply_rigid_walls(config_.rigid_walls, clock_.dt, wn, wall_impulse_);
+  if (sph_) {
+    // Particles meet the walls as nodes do (every own particle is "owned").
+    auto& pt = sph_->particles();
+    particle_owned_.assign(pt.size(), 1);
+    const WallNodes wp{{pt.x[0].data(), pt.x[1].data(), pt.x[2].data()},
+                       {pt.v[0].data(), pt.v[1].data(), pt.v[2].data()},
+                       {pv_prev_[0].data(), pv_prev_[1].data(), pv_prev_[2].data()},
+                       pt.mass.data(),
+                       pt.constrained.data(),
+                       particle_owned_.data(),
+                       pt.size()};
+    external_work_ += apply_rigid_walls(config_.rigid_walls, clock_.dt, wp, wall_impulse_);
+  }
 }
 
 void Simulation::update() {
@@ -395,6 +477,7 @@ void Simulation::update() {
 #pragma omp simd
     for (std::size_t n = 0; n < nn; ++n) x[n] += dt * v[n];
   }
+  if (sph_) update_particles(dt);
   clock_.time += dt;
   clock_.cycle += 1;
   clock_.dt_prev = dt;
@@ -414,6 +497,7 @@ Sample Simulation::sample() const {
       local[1] += b.internal_energy[e];
       local[2] += b.hourglass_energy[e];
     }
+  local[1] += particle_internal_energy();
   comm_.sum(std::span<double>(local, 5));
   s.contact = local[4];
   s.kinetic = local[0];

@@ -16,6 +16,7 @@
 #include "anvil/mesh/mesh.hpp"
 #include "anvil/parallel/comm.hpp"
 #include "anvil/parallel/fe_decomposition.hpp"
+#include "anvil/sph/sph_phase.hpp"
 
 namespace anvil {
 
@@ -34,12 +35,13 @@ struct NodeState {
 
 // Time and cycle counters of the central-difference scheme.
 struct Clock {
-  double time = 0;              // t(n)
-  std::int64_t cycle = 0;       // n
-  double dt = 0;                // dt(n + 1/2) of the last step taken
-  double dt_prev = 0;           // dt(n - 1/2), the interval the stress update integrates over
-  double dt_initial = 0;        // the first step's dt
-  std::int64_t dt_element = -1; // element controlling dt
+  double time = 0;               // t(n)
+  std::int64_t cycle = 0;        // n
+  double dt = 0;                 // dt(n + 1/2) of the last step taken
+  double dt_prev = 0;            // dt(n - 1/2), the interval the stress update integrates over
+  double dt_initial = 0;         // the first step's dt
+  std::int64_t dt_element = -1;  // element controlling dt
+  std::int64_t dt_particle = -1; // particle controlling dt (then dt_element is -1)
 };
 
 // Global energies and probe values at one time (a history row).
@@ -100,6 +102,11 @@ public:
   const FeDecomposition& fe() const { return fe_; }
   const PhaseTimers& timers() const { return timers_; }
   const ContactPhase* contact() const { return contact_.get(); }
+  // The SPH decomposition and its particles (null without particles).
+  const sph::SphPhase* sph() const { return sph_.get(); }
+  // Mutable access for tests that set initial fields no deck key expresses (a mode
+  // shape); call before the first step.
+  sph::SphPhase* sph() { return sph_.get(); }
   std::int64_t global_nodes() const { return global_nodes_; }
   std::int64_t global_elements() const { return global_elements_; }
   const std::vector<double>& part_masses() const { return part_mass_; }
@@ -118,6 +125,20 @@ private:
   void apply_boundary_conditions(const Mesh& mesh);
   void locate_probes(const Mesh& mesh);
   double owned_kinetic_energy() const;
+  // Particles: selection (mask over own particles), conditions, their part of predict,
+  // contact and update (sph_coupling.cpp).
+  std::vector<std::uint8_t> select_particles(const Selection& sel) const;
+  // The mesh nodes of a selection that may also (or only) select particles: an
+  // InputError when it selects neither nodes nor particles on any rank. Collective.
+  std::vector<std::int64_t> selected_nodes(const Mesh& mesh, const Selection& sel) const;
+  void apply_particle_conditions();
+  void apply_particle_boundary_conditions();
+  double particle_kinetic_energy() const;
+  double particle_internal_energy() const;
+  void predict_particles(double dt_avg, double& ke, double& work);
+  std::vector<ContactNodeItem>& particle_contact_items(double dt);
+  void correct_particles(double& contact_work);
+  void update_particles(double dt);
 
   Config config_;
   const Comm& comm_;
@@ -153,8 +174,20 @@ private:
   double initial_energy_ = 0;
   bool have_initial_energy_ = false;
 
-  // Probes: local node index on the owning rank, -1 elsewhere.
+  // Probes: local node index on the owning rank, -1 elsewhere; or the global id of the
+  // probed particle (-1: the probe is on a node).
   std::vector<int> probe_node_;
+  std::vector<std::int64_t> probe_particle_;
+
+  // SPH (null without particles): the particle decomposition, the velocities v(n-1/2)
+  // of its own particles in the current step, the particle sets in contact and the
+  // contact items of this cycle.
+  std::unique_ptr<sph::SphPhase> sph_;
+  std::array<std::vector<double>, 3> pv_prev_;
+  std::vector<std::uint8_t> sph_contact_set_;
+  std::vector<ContactNodeItem> particle_items_;
+  std::vector<int> particle_item_index_;
+  std::vector<std::uint8_t> particle_owned_; // all ones (rigid walls' view)
 
   // What predict() records for the sample at t(n): kinetic energy of owned nodes at the
   // mid-point velocity and the probe values (zero on ranks that do not own the probe).

@@ -1,0 +1,214 @@
+// The particles' part of Simulation: selections and conditions on particles, and the
+// particles' share of the cycle's owner phases (predict, contact, update). The particle
+// forces themselves are the SPH decomposition's (sph/sph_phase.hpp). Particles are
+// coupled to the mesh only through contact: each is a contact node (slave) against the
+// exterior faces, with an id after every node and face id.
+#include <algorithm>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "anvil/solver/model.hpp"
+#include "anvil/solver/simulation.hpp"
+
+namespace anvil {
+
+std::vector<std::uint8_t> Simulation::select_particles(const Selection& sel) const {
+  std::vector<std::uint8_t> out;
+  if (!sph_) return out;
+  const auto& pt = sph_->particles();
+  const std::size_t n = pt.size();
+  out.assign(n, 0);
+  if (!sel.name.empty()) {
+    // Deck node sets are inline selections; generated PART.SET sets hold mesh nodes only.
+    const auto it = config_.node_sets.find(sel.name);
+    if (it != config_.node_sets.end()) return select_particles(it->second);
+    return out;
+  }
+  int set = -1;
+  if (sel.part) {
+    set = config_.particle_set(*sel.part);
+    if (set < 0) return out; // a finite-element part
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (set >= 0 && pt.set[i] != set) continue;
+    if (sel.box && !sel.box->contains({pt.x[0][i], pt.x[1][i], pt.x[2][i]})) continue;
+    out[i] = 1;
+  }
+  return out;
+}
+
+std::vector<std::int64_t> Simulation::selected_nodes(const Mesh& mesh, const Selection& sel) const {
+  if (!sph_) return resolve_selection(mesh, config_, sel);
+  std::vector<std::int64_t> ids;
+  std::optional<InputError> error;
+  const bool names_particles = sel.part && config_.particle_set(*sel.part) >= 0;
+  if (!names_particles) {
+    try {
+      ids = resolve_selection(mesh, config_, sel);
+    } catch (const InputError& e) {
+      error = e;
+    }
+  }
+  const auto mask = select_particles(sel);
+  const std::int64_t particles =
+      comm_.sum(static_cast<std::int64_t>(std::count(mask.begin(), mask.end(), 1)));
+  if (ids.empty() && particles == 0) {
+    // An unknown set is best told by the node resolution's own message.
+    if (error && !(sel.name.empty() && !sel.part)) throw *error;
+    throw InputError(sel.where, "the selection contains no nodes or particles");
+  }
+  return ids;
+}
+
+void Simulation::apply_particle_conditions() {
+  if (!sph_) return;
+  auto& pt = sph_->particles();
+  for (const auto& ic : config_.initial_conditions) {
+    const auto mask = select_particles(ic.nodes);
+    for (std::size_t i = 0; i < pt.size(); ++i) {
+      if (!mask[i]) continue;
+      const Vec3 r = Vec3{pt.x[0][i], pt.x[1][i], pt.x[2][i]} - ic.center;
+      const Vec3 v = ic.velocity + cross(ic.angular_velocity, r);
+      for (int k = 0; k < 3; ++k) pt.v[k][i] = v[k];
+    }
+  }
+}
+
+double Simulation::particle_kinetic_energy() const {
+  if (!sph_) return 0;
+  const auto& pt = sph_->particles();
+  double ke = 0;
+  for (std::size_t i = 0; i < pt.size(); ++i)
+    ke += 0.5 * pt.mass[i] *
+          (pt.v[0][i] * pt.v[0][i] + pt.v[1][i] * pt.v[1][i] + pt.v[2][i] * pt.v[2][i]);
+  return ke;
+}
+
+double Simulation::particle_internal_energy() const {
+  if (!sph_) return 0;
+  const auto& pt = sph_->particles();
+  double e = 0;
+  for (std::size_t i = 0; i < pt.size(); ++i) e += pt.mass[i] * pt.energy[i];
+  return e;
+}
+
+// Boundary conditions on particles: fixed or prescribed velocity components, set up
+// once; the masks travel with the particles.
+void Simulation::apply_particle_boundary_conditions() {
+  if (!sph_) return;
+  auto& pt = sph_->particles();
+  for (const auto& bc : config_.boundary_conditions) {
+    const auto mask = select_particles(bc.nodes);
+    for (std::size_t i = 0; i < pt.size(); ++i) {
+      if (!mask[i]) continue;
+      for (int k = 0; k < 3; ++k) {
+        const bool on = bc.prescribed ? bc.components[k] : bc.fix[k];
+        if (!on) continue;
+        pt.constrained[i] |= static_cast<std::uint8_t>(1u << k);
+        pt.v_bc[k][i] = bc.prescribed ? bc.velocity[k] : 0.0;
+      }
+    }
+  }
+  for (std::size_t i = 0; i < pt.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      if (pt.constrained[i] & (1u << k)) pt.v[k][i] = pt.v_bc[k][i];
+}
+
+// Cycle step 3 for the particles: v(n+1/2) = v(n-1/2) + dt_avg f / m (prescribed
+// components take their value), the specific energy gains the work of viscosity and
+// artificial stress over the same interval; adds the kinetic energy at the mid-point
+// velocity to `ke` and the constraints' work to `work` (J).
+void Simulation::predict_particles(double dt_avg, double& ke, double& work) {
+  auto& pt = sph_->particles();
+  const std::size_t n = pt.size();
+  const auto rate = sph_->energy_rate();
+  for (int k = 0; k < 3; ++k) pv_prev_[k].resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double inv_m = 1.0 / pt.mass[i];
+    double avg2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double old = pt.v[k][i];
+      pv_prev_[k][i] = old;
+      const double free = old + dt_avg * pt.f[k][i] * inv_m;
+      double nv = free;
+      if (pt.constrained[i] & (1u << k)) {
+        nv = pt.v_bc[k][i];
+        work += pt.mass[i] * (nv - free) * 0.5 * (old + nv);
+      }
+      pt.v[k][i] = nv;
+      const double a = 0.5 * (old + nv);
+      avg2 += a * a;
+    }
+    ke += 0.5 * pt.mass[i] * avg2;
+    pt.energy[i] += rate[i] * dt_avg;
+  }
+  for (std::size_t p = 0; p < probe_particle_.size(); ++p) {
+    if (probe_particle_[p] < 0) continue;
+    // Only the rank holding the particle now writes; the one that held it before must
+    // not keep its old values (the history sums the slots over ranks).
+    for (int k = 0; k < 6; ++k) probe_local_[6 * p + k] = 0.0;
+    const int q = sph_->find(probe_particle_[p]);
+    if (q < 0) continue;
+    for (int k = 0; k < 3; ++k) {
+      probe_local_[6 * p + k] = pt.x[k][q] - pt.x0[k][q];
+      probe_local_[6 * p + 3 + k] = 0.5 * (pv_prev_[k][q] + pt.v[k][q]);
+    }
+  }
+}
+
+// The contact items of the particles in contact this cycle (cycle step 4): predicted
+// position x + dt v(n+1/2), id offset past the mesh's nodes and faces, owner this rank.
+std::vector<ContactNodeItem>& Simulation::particle_contact_items(double dt) {
+  const auto& pt = sph_->particles();
+  particle_items_.clear();
+  particle_item_index_.clear();
+  const std::int64_t offset = contact_->extra_gid_offset();
+  for (std::size_t i = 0; i < pt.size(); ++i) {
+    if (!sph_contact_set_[static_cast<std::size_t>(pt.set[i])]) continue;
+    ContactNodeItem it{};
+    it.gid = offset + pt.gid[i];
+    it.owner = comm_.rank();
+    for (int k = 0; k < 3; ++k) {
+      it.x[k] = pt.x[k][i] + dt * pt.v[k][i];
+      it.v[k] = pt.v[k][i];
+    }
+    it.mass = pt.mass[i];
+    it.last_face = pt.last_face[i];
+    particle_items_.push_back(it);
+    particle_item_index_.push_back(static_cast<int>(i));
+  }
+  return particle_items_;
+}
+
+// Cycle step 5 for the particles: the penalty forces the contact phase returned change
+// v(n+1/2) by dt_avg f / m; their work is added to `contact_work` (J), as for nodes.
+void Simulation::correct_particles(double& contact_work) {
+  auto& pt = sph_->particles();
+  const auto f = contact_->extra_forces();
+  const auto faces = contact_->extra_faces();
+  for (std::size_t k = 0; k < particle_item_index_.size(); ++k) {
+    const auto i = static_cast<std::size_t>(particle_item_index_[k]);
+    pt.last_face[i] = faces[k];
+    const double inv_m = dt_avg_ / pt.mass[i];
+    for (int d = 0; d < 3; ++d) {
+      if (f[k][d] == 0.0 || (pt.constrained[i] & (1u << d))) continue;
+      pt.v[d][i] += inv_m * f[k][d];
+      contact_work += f[k][d] * dt_avg_ * 0.5 * (pv_prev_[d][i] + pt.v[d][i]);
+    }
+  }
+}
+
+// Cycle step 6 for the particles: x(n+1) = x(n) + dt v(n+1/2).
+void Simulation::update_particles(double dt) {
+  auto& pt = sph_->particles();
+  const std::size_t n = pt.size();
+  for (int k = 0; k < 3; ++k) {
+    double* x = pt.x[k].data();
+    const double* v = pt.v[k].data();
+#pragma omp simd
+    for (std::size_t i = 0; i < n; ++i) x[i] += dt * v[i];
+  }
+}
+
+} // namespace anvil

@@ -1,0 +1,444 @@
+#include "anvil/sph/forces.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "anvil/core/simd.hpp"
+#include "anvil/fe/hex8.hpp"
+
+namespace anvil::sph {
+
+using simd::vdouble;
+using simd::width;
+namespace stdx = simd::stdx;
+
+namespace {
+
+// The lanes' sum in lane order (a fixed order: the bits do not depend on the partition).
+inline double lane_sum(const vdouble& v) {
+  double s = v[0];
+  for (int l = 1; l < width; ++l) s += v[l];
+  return s;
+}
+
+// kernel_fast for `width` pairs at once (the same operations per lane).
+template <KernelType K, int D>
+inline void kernel_simd(const vdouble& r, const vdouble& h, vdouble& w, vdouble& dwr) {
+  const vdouble ih = 1.0 / h, q = r * ih;
+  const vdouble ihd = D == 1 ? ih : (D == 2 ? ih * ih : ih * ih * ih);
+  const vdouble s = kernel_norm<K, D>() * ihd;
+  if constexpr (K == KernelType::cubic_spline) {
+    const vdouble a = stdx::max(2.0 - q, vdouble(0.0)), b = stdx::max(1.0 - q, vdouble(0.0));
+    w = s * (0.25 * a * a * a - b * b * b);
+    dwr = s * ih * (3.0 * b * b - 0.75 * a * a) / r;
+  } else {
+    const vdouble t = stdx::max(1.0 - 0.5 * q, vdouble(0.0)), t3 = t * t * t;
+    w = s * t3 * t * (2.0 * q + 1.0);
+    dwr = s * ih * ih * (-5.0 * t3);
+  }
+}
+
+} // namespace
+
+void principal(const double s[6], double lambda[3], double Q[3][3]) {
+  double A[3][3] = {{s[0], s[3], s[5]}, {s[3], s[1], s[4]}, {s[5], s[4], s[2]}};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) Q[i][j] = i == j ? 1.0 : 0.0;
+  constexpr int pq[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+  // Jacobi converges quadratically: at most 6 sweeps reach round-off for any 3x3
+  // tensor; stop once the off-diagonal part is negligible (a test on this particle's
+  // own values, so every rank does the same).
+  for (int sweep = 0; sweep < 6; ++sweep) {
+    const double off = A[0][1] * A[0][1] + A[0][2] * A[0][2] + A[1][2] * A[1][2];
+    const double diag = A[0][0] * A[0][0] + A[1][1] * A[1][1] + A[2][2] * A[2][2];
+    if (off <= 1e-30 * diag) break;
+    for (const auto& e : pq) {
+      const int p = e[0], q = e[1];
+      const double apq = A[p][q];
+      if (apq == 0.0) continue;
+      const double theta = (A[q][q] - A[p][p]) / (2 * apq);
+      const double t = (theta >= 0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1));
+      const double c = 1 / std::sqrt(t * t + 1), sn = t * c;
+      for (int k = 0; k < 3; ++k) { // A <- A J
+        const double akp = A[k][p], akq = A[k][q];
+        A[k][p] = c * akp - sn * akq;
+        A[k][q] = sn * akp + c * akq;
+      }
+      for (int k = 0; k < 3; ++k) { // A <- J^T A
+        const double apk = A[p][k], aqk = A[q][k];
+        A[p][k] = c * apk - sn * aqk;
+        A[q][k] = sn * apk + c * aqk;
+      }
+      for (int k = 0; k < 3; ++k) { // Q <- Q J
+        const double qkp = Q[k][p], qkq = Q[k][q];
+        Q[k][p] = c * qkp - sn * qkq;
+        Q[k][q] = sn * qkp + c * qkq;
+      }
+    }
+  }
+  for (int i = 0; i < 3; ++i) lambda[i] = A[i][i];
+}
+
+namespace {
+
+// Monaghan's artificial stress of one particle (in stress units, for the
+// (sigma_i + sigma_j) / (rho_i rho_j) form): in the principal frame of sigma,
+// R'_aa = -epsilon sigma'_aa where sigma'_aa is tensile, else 0; rotated back.
+void artificial_stress(const double s[6], double eps, double R[6]) {
+  // Gershgorin: no eigenvalue exceeds max_i (s_ii + sum_j |s_ij|); when that is not
+  // positive no principal stress is tensile and R = 0 (compressed or fluid particles).
+  const double b0 = s[0] + std::abs(s[3]) + std::abs(s[5]);
+  const double b1 = s[1] + std::abs(s[3]) + std::abs(s[4]);
+  const double b2 = s[2] + std::abs(s[4]) + std::abs(s[5]);
+  if (std::max({b0, b1, b2}) <= 0) {
+    for (int k = 0; k < 6; ++k) R[k] = 0;
+    return;
+  }
+  double lam[3], Q[3][3];
+  principal(s, lam, Q);
+  double r[3];
+  for (int a = 0; a < 3; ++a) r[a] = lam[a] > 0 ? -eps * lam[a] : 0.0;
+  auto comp = [&](int i, int j) {
+    return Q[i][0] * r[0] * Q[j][0] + Q[i][1] * r[1] * Q[j][1] + Q[i][2] * r[2] * Q[j][2];
+  };
+  R[0] = comp(0, 0);
+  R[1] = comp(1, 1);
+  R[2] = comp(2, 2);
+  R[3] = comp(0, 1);
+  R[4] = comp(1, 2);
+  R[5] = comp(0, 2);
+}
+
+// Inverse of a 3x3 matrix; false when it is nearly singular (|det| below tol).
+bool invert3(const double B[3][3], double inv[3][3], double tol) {
+  const double c00 = B[1][1] * B[2][2] - B[1][2] * B[2][1];
+  const double c01 = B[1][2] * B[2][0] - B[1][0] * B[2][2];
+  const double c02 = B[1][0] * B[2][1] - B[1][1] * B[2][0];
+  const double det = B[0][0] * c00 + B[0][1] * c01 + B[0][2] * c02;
+  if (!(std::abs(det) > tol)) return false;
+  const double id = 1 / det;
+  inv[0][0] = c00 * id;
+  inv[1][0] = c01 * id;
+  inv[2][0] = c02 * id;
+  inv[0][1] = (B[0][2] * B[2][1] - B[0][1] * B[2][2]) * id;
+  inv[1][1] = (B[0][0] * B[2][2] - B[0][2] * B[2][0]) * id;
+  inv[2][1] = (B[0][1] * B[2][0] - B[0][0] * B[2][1]) * id;
+  inv[0][2] = (B[0][1] * B[1][2] - B[0][2] * B[1][1]) * id;
+  inv[1][2] = (B[0][2] * B[1][0] - B[0][0] * B[1][2]) * id;
+  inv[2][2] = (B[0][0] * B[1][1] - B[0][1] * B[1][0]) * id;
+  return true;
+}
+
+// Pass 1's pair loop for one kernel (the kernel is a template parameter so that the
+// loop has no per-pair branch on it).
+template <KernelType K, int D>
+void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, const NeighbourList& nl,
+                      double dt, SphWorkspace& w) {
+  const std::size_t n = p.n_local;
+  const NeighbourRead1* rd = w.read1.data();
+  bool any_epsilon = false;
+  for (const auto& st : sets) any_epsilon = any_epsilon || st.epsilon > 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const NeighbourRead1& pi = rd[i];
+    const SetParams& si = sets[static_cast<std::size_t>(pi.set)];
+    // The pairs, `width` at a time (lane l takes the entries k0 + l): each lane sums its
+    // entries in list order and the lanes are added in lane order at the end, so the
+    // sums depend only on the list, which is the same on every rank.
+    vdouble Lv[3][3], Bv[3][3];
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) Lv[a][b] = Bv[a][b] = 0.0;
+    const vdouble xi[3] = {pi.x[0], pi.x[1], pi.x[2]}, vi[3] = {pi.v[0], pi.v[1], pi.v[2]};
+    const std::int64_t k_end = nl.start[i + 1];
+    for (std::int64_t k0 = nl.start[i]; k0 < k_end; k0 += width) {
+      int idx[width];
+      for (int l = 0; l < width; ++l)
+        idx[l] = k0 + l < k_end ? nl.index[static_cast<std::size_t>(k0 + l)] : static_cast<int>(i);
+      auto get = [&](auto field) { return vdouble([&](auto l) { return field(rd[idx[l]]); }); };
+      const vdouble valid([&](auto l) { return k0 + static_cast<int>(l) < k_end ? 1.0 : 0.0; });
+      vdouble dx[3];
+      for (int a = 0; a < 3; ++a)
+        dx[a] = xi[a] - get([a](const NeighbourRead1& r) { return r.x[a]; });
+      const vdouble hb = 0.5 * (pi.h + get([](const NeighbourRead1& r) { return r.h; }));
+      const vdouble r =
+          stdx::max(stdx::sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]), 1e-9 * hb);
+      vdouble wk, dwr;
+      kernel_simd<K, D>(r, hb, wk, dwr);
+      const vdouble g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
+      vdouble fn = 0.0;
+      if (any_epsilon) {
+        const vdouble eps = 0.5 * (si.epsilon + get([&](const NeighbourRead1& q) {
+                                     return sets[static_cast<std::size_t>(q.set)].epsilon;
+                                   }));
+        if (stdx::any_of(eps > 0.0)) {
+          const vdouble ws = 0.5 * (si.w_spacing + get([&](const NeighbourRead1& q) {
+                                      return sets[static_cast<std::size_t>(q.set)].w_spacing;
+                                    }));
+          const vdouble ex = 0.5 * (si.exponent + get([&](const NeighbourRead1& q) {
+                                      return sets[static_cast<std::size_t>(q.set)].exponent;
+                                    }));
+          const vdouble hd = D == 1 ? hb : (D == 2 ? hb * hb : hb * hb * hb);
+          const vdouble t = wk * hd / (kernel_norm<K, D>() * ws);
+          const vdouble t2 = t * t;
+          vdouble f = t2 * t2;
+          if (stdx::any_of(ex != 4.0))
+            f = vdouble([&](auto l) { return ex[l] == 4.0 ? f[l] : std::pow(t[l], ex[l]); });
+          fn = 0.0;
+          stdx::where(eps > 0.0, fn) = f;
+        }
+      }
+      for (int l = 0; l < width && k0 + l < k_end; ++l) {
+        double* pd = &w.pair[4 * static_cast<std::size_t>(k0 + l)];
+        pd[0] = g[0][l];
+        pd[1] = g[1][l];
+        pd[2] = g[2][l];
+        pd[3] = fn[l];
+      }
+      // Volume weights V_j = m_j / rho_j: consistent across density jumps (a gas
+      // interface, particles of different sets). Padding lanes weigh nothing.
+      const vdouble vj = valid * get([](const NeighbourRead1& q) { return q.volume; });
+      vdouble dv[3];
+      for (int a = 0; a < 3; ++a)
+        dv[a] = vj * (get([a](const NeighbourRead1& q) { return q.v[a]; }) - vi[a]);
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) Lv[a][b] += dv[a] * g[b];
+      if (si.corrected)
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) Bv[a][b] -= (vj * dx[a]) * g[b];
+    }
+    double L[3][3], B[3][3];
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        L[a][b] = lane_sum(Lv[a][b]);
+        B[a][b] = lane_sum(Bv[a][b]);
+      }
+    if (si.corrected) {
+      // Normalised gradient L B^-1, B = sum V_j (x_j - x_i) (x) grad W: exact for a
+      // linear velocity field also near free surfaces. A particle with too few
+      // neighbours (B nearly singular) keeps the plain gradient. Below 3 dimensions B
+      // has zero rows for the directions without particles: those take the identity.
+      if constexpr (D < 3)
+        for (int a = D; a < 3; ++a) B[a][a] = 1;
+      double Bi[3][3];
+      if (invert3(B, Bi, 1e-3)) {
+        double Lc[3][3];
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b)
+            Lc[a][b] = L[a][0] * Bi[0][b] + L[a][1] * Bi[1][b] + L[a][2] * Bi[2][b];
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) L[a][b] = Lc[a][b];
+      }
+    }
+    const double d[6] = {L[0][0],
+                         L[1][1],
+                         L[2][2],
+                         0.5 * (L[0][1] + L[1][0]),
+                         0.5 * (L[1][2] + L[2][1]),
+                         0.5 * (L[0][2] + L[2][0])};
+    const double spin[3] = {0.5 * (L[2][1] - L[1][2]), 0.5 * (L[0][2] - L[2][0]),
+                            0.5 * (L[1][0] - L[0][1])};
+    // Continuity, time-centred: rho(n) = rho(n-1) (1 - tr D dt/2) / (1 + tr D dt/2).
+    const double tr = (d[0] + d[1] + d[2]) * dt;
+    p.rho[i] = p.rho[i] * (1 - 0.5 * tr) / (1 + 0.5 * tr);
+    // Objective stress rate: rotate the old stress by Hughes-Winget, as the element does.
+    double Q[3][3], s[6];
+    hex8::hughes_winget(spin, dt, Q);
+    for (int k = 0; k < 6; ++k) s[k] = p.stress[k][i];
+    hex8::rotate_symmetric(Q, s);
+    for (int k = 0; k < 6; ++k) {
+      p.stress[k][i] = s[k];
+      w.d[k][i] = d[k];
+    }
+    const double power =
+        s[0] * d[0] + s[1] * d[1] + s[2] * d[2] + 2 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
+    w.power_old[i] = power;
+    w.energy_pred[i] = p.energy[i] + power * dt / p.rho[i];
+  }
+}
+
+} // namespace
+
+void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelType kernel,
+                    const NeighbourList& nl, double dt, SphWorkspace& w) {
+  const std::size_t n = p.n_local;
+  w.pair.resize(4 * nl.pairs());
+  for (auto& d : w.d) d.resize(n);
+  w.power_old.resize(n);
+  w.energy_pred.resize(n);
+  w.read1.resize(p.n_all);
+  for (std::size_t i = 0; i < p.n_all; ++i) {
+    NeighbourRead1& r = w.read1[i];
+    for (int a = 0; a < 3; ++a) {
+      r.x[a] = p.x[a][i];
+      r.v[a] = p.v[a][i];
+    }
+    r.volume = p.mass[i] / p.rho[i];
+    r.h = p.h[i];
+    r.set = p.set[i];
+  }
+  const int dim = sets.empty() ? 3 : sets[0].dimensions;
+  if (kernel == KernelType::cubic_spline) {
+    if (dim == 1)
+      kinematics_pairs<KernelType::cubic_spline, 1>(p, sets, nl, dt, w);
+    else if (dim == 2)
+      kinematics_pairs<KernelType::cubic_spline, 2>(p, sets, nl, dt, w);
+    else
+      kinematics_pairs<KernelType::cubic_spline, 3>(p, sets, nl, dt, w);
+  } else {
+    if (dim == 2)
+      kinematics_pairs<KernelType::wendland_c2, 2>(p, sets, nl, dt, w);
+    else
+      kinematics_pairs<KernelType::wendland_c2, 3>(p, sets, nl, dt, w);
+  }
+
+  // Constitutive update through the batch interface, one run of a set's particles at a
+  // time (own particles are in ascending gid, so each set is one contiguous run).
+  constexpr std::size_t chunk = 64;
+  for (std::size_t i0 = 0; i0 < n;) {
+    const int set = p.set[i0];
+    std::size_t i1 = i0 + 1;
+    while (i1 < n && i1 - i0 < chunk && p.set[i1] == set) ++i1;
+    MaterialBatch b;
+    b.n = static_cast<int>(i1 - i0);
+    b.dt = dt;
+    for (int k = 0; k < 6; ++k) {
+      b.d[k] = w.d[k].data() + i0;
+      b.stress[k] = p.stress[k] + i0;
+    }
+    b.density = p.rho + i0;
+    b.plastic_strain = p.plastic_strain + i0;
+    b.temperature = p.temperature + i0;
+    b.wave_speed = p.wave_speed + i0;
+    b.energy = w.energy_pred.data() + i0;
+    sets[static_cast<std::size_t>(set)].material->update(b);
+    i0 = i1;
+  }
+
+  for (std::size_t i = 0; i < n; ++i) {
+    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
+    double s[6];
+    for (int k = 0; k < 6; ++k) s[k] = p.stress[k][i];
+    const double power = s[0] * w.d[0][i] + s[1] * w.d[1][i] + s[2] * w.d[2][i] +
+                         2 * (s[3] * w.d[3][i] + s[4] * w.d[4][i] + s[5] * w.d[5][i]);
+    const double rho = p.rho[i];
+    p.energy[i] += 0.5 * (w.power_old[i] + power) * dt / rho;
+    for (int k = 0; k < 6; ++k) p.S[k][i] = s[k];
+    double R[6] = {0, 0, 0, 0, 0, 0};
+    if (si.epsilon > 0) artificial_stress(s, si.epsilon, R);
+    for (int k = 0; k < 6; ++k) p.R[k][i] = R[k];
+  }
+}
+
+void sph_forces(const SphView& p, std::span<const SetParams> sets, const NeighbourList& nl,
+                SphWorkspace& w, SphResult& res) {
+  const std::size_t n = p.n_local;
+  w.read2.resize(p.n_all);
+  for (std::size_t i = 0; i < p.n_all; ++i) {
+    NeighbourRead2& r = w.read2[i];
+    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
+    for (int a = 0; a < 3; ++a) {
+      r.x[a] = p.x[a][i];
+      r.v[a] = p.v[a][i];
+    }
+    r.mass = p.mass[i];
+    r.rho = p.rho[i];
+    r.inv_rho = 1 / p.rho[i];
+    r.h = p.h[i];
+    r.c = p.wave_speed[i];
+    r.alpha = si.alpha;
+    r.beta = si.beta;
+    int any = 0;
+    for (int c = 0; c < 6; ++c) {
+      r.S[c] = p.S[c][i];
+      r.R[c] = p.R[c][i];
+      any |= p.R[c][i] != 0.0;
+    }
+    r.has_r = any;
+  }
+  const NeighbourRead2* rd = w.read2.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    const NeighbourRead2& pi = rd[i];
+    // The pairs `width` at a time, lanes summed in lane order at the end (see pass 1).
+    vdouble accv[3] = {0.0, 0.0, 0.0}, dev = 0.0, mumv = 0.0;
+    const std::int64_t k_end = nl.start[i + 1];
+    for (std::int64_t k0 = nl.start[i]; k0 < k_end; k0 += width) {
+      int idx[width];
+      for (int l = 0; l < width; ++l)
+        idx[l] = k0 + l < k_end ? nl.index[static_cast<std::size_t>(k0 + l)] : static_cast<int>(i);
+      auto get = [&](auto field) { return vdouble([&](auto l) { return field(rd[idx[l]]); }); };
+      auto pair = [&](int c) {
+        return vdouble([&](auto l) {
+          return k0 + static_cast<int>(l) < k_end ? w.pair[4 * static_cast<std::size_t>(k0 + l) + c]
+                                                  : 0.0;
+        });
+      };
+      const vdouble g[3] = {pair(0), pair(1), pair(2)};
+      const vdouble fn = pair(3);
+      vdouble dx[3], dv[3];
+      for (int a = 0; a < 3; ++a) {
+        dx[a] = pi.x[a] - get([a](const NeighbourRead2& q) { return q.x[a]; });
+        dv[a] = pi.v[a] - get([a](const NeighbourRead2& q) { return q.v[a]; });
+      }
+      const vdouble vr = dv[0] * dx[0] + dv[1] * dx[1] + dv[2] * dx[2];
+      vdouble visc = 0.0;
+      const auto approaching = vr < 0.0;
+      if (stdx::any_of(approaching)) {
+        const vdouble hb = 0.5 * (pi.h + get([](const NeighbourRead2& q) { return q.h; }));
+        const vdouble r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
+        const vdouble mu = hb * vr / (r2 + 0.01 * hb * hb);
+        const vdouble cb = 0.5 * (pi.c + get([](const NeighbourRead2& q) { return q.c; }));
+        // Pi_ij = (-alpha c mu + beta mu^2) / rho_ij with rho_ij = (rho_i + rho_j) / 2.
+        const vdouble pv =
+            (-(pi.alpha + get([](const NeighbourRead2& q) { return q.alpha; })) * cb * mu +
+             (pi.beta + get([](const NeighbourRead2& q) { return q.beta; })) * mu * mu) /
+            (pi.rho + get([](const NeighbourRead2& q) { return q.rho; }));
+        stdx::where(approaching, visc) = pv;
+        stdx::where(approaching, mumv) = stdx::max(mumv, -mu);
+      }
+      const vdouble irr = pi.inv_rho * get([](const NeighbourRead2& q) { return q.inv_rho; });
+      vdouble T[6];
+      for (int c = 0; c < 6; ++c)
+        T[c] = (pi.S[c] + get([c](const NeighbourRead2& q) { return q.S[c]; })) * irr;
+      vdouble rg = 0.0;
+      if (stdx::any_of(fn > 0.0) && (pi.has_r || stdx::any_of(get([](const NeighbourRead2& q) {
+                                                                return q.has_r ? 1.0 : 0.0;
+                                                              }) > 0.0))) {
+        const vdouble fi = fn * irr;
+        for (int c = 0; c < 6; ++c)
+          T[c] += fi * (pi.R[c] + get([c](const NeighbourRead2& q) { return q.R[c]; }));
+        // The artificial stress's own work on particle i (the stress's is in pass 1).
+        rg = fi * (dv[0] * (pi.R[0] * g[0] + pi.R[3] * g[1] + pi.R[5] * g[2]) +
+                   dv[1] * (pi.R[3] * g[0] + pi.R[1] * g[1] + pi.R[4] * g[2]) +
+                   dv[2] * (pi.R[5] * g[0] + pi.R[4] * g[1] + pi.R[2] * g[2]));
+      }
+      T[0] -= visc;
+      T[1] -= visc;
+      T[2] -= visc;
+      // Padding lanes have zero kernel gradients: they add nothing.
+      const vdouble mj = get([](const NeighbourRead2& q) { return q.mass; });
+      accv[0] += mj * (T[0] * g[0] + T[3] * g[1] + T[5] * g[2]);
+      accv[1] += mj * (T[3] * g[0] + T[1] * g[1] + T[4] * g[2]);
+      accv[2] += mj * (T[5] * g[0] + T[4] * g[1] + T[2] * g[2]);
+      // Half the viscous dissipation of the pair heats particle i.
+      const vdouble dvg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
+      dev += mj * (0.5 * visc * dvg - rg);
+    }
+    const double acc[3] = {lane_sum(accv[0]), lane_sum(accv[1]), lane_sum(accv[2])};
+    const double de = lane_sum(dev);
+    double mu_max = 0;
+    for (int l = 0; l < width; ++l) mu_max = std::max(mu_max, static_cast<double>(mumv[l]));
+    for (int a = 0; a < 3; ++a) p.force[a][i] = pi.mass * acc[a];
+    p.energy_rate[i] = de;
+    const double ci = pi.c;
+    const double dt = courant * pi.h / (ci + 1.2 * (pi.alpha * ci + pi.beta * mu_max));
+    if (dt < res.dt_stable || (dt == res.dt_stable && p.gid[i] < res.stable_gid)) {
+      res.dt_stable = dt;
+      res.stable_gid = p.gid[i];
+    }
+    const bool finite = std::isfinite(acc[0]) && std::isfinite(acc[1]) && std::isfinite(acc[2]) &&
+                        std::isfinite(p.stress[0][i]) && std::isfinite(pi.rho);
+    if (!finite && (res.nonfinite_gid < 0 || p.gid[i] < res.nonfinite_gid))
+      res.nonfinite_gid = p.gid[i];
+  }
+}
+
+} // namespace anvil::sph

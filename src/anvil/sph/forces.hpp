@@ -1,0 +1,138 @@
+// The particle phase's physics (cycle step 2) for the particles of one rank, knowing
+// nothing of MPI: SPH for solids with strength after Libersky and Petschek (1991) and
+// Swegle, Attaway and Heinstein (PRONTO's SPH, 1994), in two passes over precomputed
+// neighbour lists (neighbours.hpp):
+//
+//  1. kinematics: velocity gradient L_i = sum_j V_j (v_j - v_i) (x) grad_i W_ij with the
+//     volumes V_j = m_j / rho_j (optionally normalised, Randles and Libersky 1996),
+//     continuity d rho_i / dt = -rho_i tr L_i, stress rotated by Hughes-Winget with the
+//     spin and advanced by the material's batch update with D, internal energy from the
+//     stress power sigma : D / rho; then Monaghan's artificial stress R_i (Gray,
+//     Monaghan and Swift 2001) for the neighbours.
+//  2. forces: the symmetric conservative momentum equation that matches that gradient
+//     (so that the stress power and the forces' work cancel exactly, pair by pair)
+//     dv_i/dt = sum_j m_j ((sigma_i + sigma_j + f_ij^n (R_i + R_j)) / (rho_i rho_j)
+//                          - Pi_ij I) grad_i W_ij
+//     with Monaghan and Gingold's (1983) artificial viscosity Pi_ij and
+//     f_ij = W(r_ij) / W(dp); the work of Pi and R as an energy rate; the particle
+//     stable time step. The (sigma_i + sigma_j)/(rho_i rho_j) form with volume-weighted
+//     gradients stays consistent across density jumps (Sod's tube, different materials),
+//     where the sigma/rho^2 form with (1/rho_i) sum m_j weights does not.
+//
+// W is evaluated at the mean smoothing length h_ij = (h_i + h_j)/2, so grad_i W_ij =
+// -grad_j W_ji and the pair forces cancel exactly (momentum is conserved to round-off).
+// Every sum over neighbours is a function of the neighbour list alone (see neighbours.hpp
+// for its order): the pair loops run simd::width entries at a time, lane l summing the
+// entries l, l + width, ... in list order, and the lanes are added in lane order.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "anvil/material/material.hpp"
+#include "anvil/sph/kernel.hpp"
+#include "anvil/sph/neighbours.hpp"
+
+namespace anvil::sph {
+
+// The formulation's parameters of one particle set. Pair terms use the mean of the two
+// particles' sets (symmetric, so momentum stays conserved between sets).
+struct SetParams {
+  const Material* material = nullptr; // not owned
+  double rho0 = 0;                    // reference density, kg/m^3
+  double h0 = 0;                      // smoothing length at rho0, m
+  double alpha = 1, beta = 2;         // Monaghan-Gingold viscosity coefficients
+  double epsilon = 0;                 // artificial stress coefficient (0: off)
+  double exponent = 4;                // its exponent n
+  double w_spacing = 1;               // kernel shape w(q) at q = 1 / smoothing_ratio
+  bool corrected = false;             // normalised velocity gradient
+  int dimensions = 3;                 // of the particle model (1, 2 or 3)
+};
+
+// Courant number of the particle step: dt_i = courant h_i / (c_i + 1.2 (alpha c_i +
+// beta max_j |mu_ij|)) (Monaghan 1992).
+inline constexpr double courant = 0.3;
+
+// Arrays over the particles of one rank: own particles [0, n_local), ghost copies after
+// them up to n_all. `in` arrays hold n_all values, `own` arrays n_local, `all` arrays
+// n_all whose ghost part the caller fills between the two passes.
+struct SphView {
+  std::size_t n_local = 0, n_all = 0;
+  // in
+  const std::int64_t* gid = nullptr;
+  const int* set = nullptr;
+  const double* x[3] = {};
+  const double* v[3] = {}; // v(n - 1/2)
+  const double* mass = nullptr;
+  const double* h = nullptr;
+  // all: density (own part advanced by pass 1; ghost part old until the exchange)
+  double* rho = nullptr;
+  // own: state advanced by pass 1
+  double* stress[6] = {};
+  double* energy = nullptr; // specific internal energy, J/kg
+  double* plastic_strain = nullptr;
+  double* temperature = nullptr;
+  // all: written by pass 1 for own particles, read by pass 2 for all
+  double* wave_speed = nullptr;
+  double* S[6] = {}; // stress (a copy the ghosts receive), Pa
+  double* R[6] = {}; // artificial stress, Pa
+  // own, out of pass 2
+  double* force[3] = {};         // N
+  double* energy_rate = nullptr; // J/(kg s) from viscosity and artificial stress
+};
+
+struct SphResult {
+  double dt_stable = 1e300;        // smallest particle stable step, s
+  std::int64_t stable_gid = -1;    // particle that controls it
+  std::int64_t nonfinite_gid = -1; // smallest gid with a non-finite force or state, or -1
+};
+
+// What one pass reads of a neighbour, packed per particle (one or a few cache lines
+// instead of one per array): built for own and ghost particles at the start of a pass.
+struct NeighbourRead1 {
+  double x[3], v[3];
+  double volume; // m / rho
+  double h;
+  int set;
+};
+struct NeighbourRead2 {
+  double x[3], v[3];
+  double mass, rho, inv_rho, h, c;
+  double alpha, beta; // the particle's set's viscosity coefficients
+  double S[6], R[6];
+  int has_r; // R is not zero
+};
+
+// Scratch kept between cycles (the cycle allocates nothing in steady state).
+struct SphWorkspace {
+  std::vector<NeighbourRead1> read1;
+  std::vector<NeighbourRead2> read2;
+  std::vector<double> pair;        // per neighbour entry: grad W (3), f^n
+  std::vector<double> d[6];        // rate of deformation of own particles
+  std::vector<double> power_old;   // rotated old stress : D
+  std::vector<double> energy_pred; // e predicted at the new state (equations of state)
+};
+
+// Pass 1 over own particles, over the interval dt (the previous step). Also fills the
+// pair data (kernel gradients) that pass 2 reuses.
+void sph_kinematics(const SphView& v, std::span<const SetParams> sets, KernelType kernel,
+                    const NeighbourList& nl, double dt, SphWorkspace& work);
+
+// Pass 2 over own particles: forces at t(n), energy rates, stable step.
+void sph_forces(const SphView& v, std::span<const SetParams> sets, const NeighbourList& nl,
+                SphWorkspace& work, SphResult& result);
+
+// Smoothing length at density rho: h0 (rho0 / rho)^(1/d) (constant mass in the support).
+inline double smoothing_length(const SetParams& s, double rho) {
+  const double r = s.rho0 / rho;
+  return s.h0 * (s.dimensions == 3 ? std::cbrt(r) : (s.dimensions == 2 ? std::sqrt(r) : r));
+}
+
+// Principal values and axes of a symmetric tensor (xx yy zz xy yz xz) by cyclic Jacobi
+// with a fixed number of sweeps (the same operations for every particle): s = Q diag Q^T,
+// columns of Q the axes.
+void principal(const double s[6], double lambda[3], double Q[3][3]);
+
+} // namespace anvil::sph

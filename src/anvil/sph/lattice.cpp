@@ -1,0 +1,73 @@
+#include "anvil/sph/lattice.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace anvil::sph {
+
+Lattice generate_lattice(const LatticeSpec& l, int dims) {
+  Lattice out;
+  const double s = l.spacing;
+  switch (l.shape) {
+  case LatticeSpec::Shape::box: {
+    int n[3];
+    double d[3];
+    for (int i = 0; i < 3; ++i) {
+      const double len = l.max[i] - l.min[i];
+      n[i] = std::max(1, static_cast<int>(std::lround(len / s)));
+      d[i] = len / n[i];
+      if (i >= dims) { // one layer at the mid-plane (mid-line), unit extent
+        n[i] = 1;
+        d[i] = len;
+      }
+    }
+    out.points.reserve(static_cast<std::size_t>(n[0]) * n[1] * n[2]);
+    for (int k = 0; k < n[2]; ++k)
+      for (int j = 0; j < n[1]; ++j)
+        for (int i = 0; i < n[0]; ++i)
+          out.points.push_back(
+              {l.min.x + (i + 0.5) * d[0], l.min.y + (j + 0.5) * d[1], l.min.z + (k + 0.5) * d[2]});
+    out.volume = d[0] * (dims >= 2 ? d[1] : 1.0) * (dims >= 3 ? d[2] : 1.0);
+    break;
+  }
+  case LatticeSpec::Shape::sphere: {
+    const int m = static_cast<int>(std::ceil(l.radius / s)) + 1;
+    const double r2 = l.radius * l.radius;
+    const int mz = dims == 3 ? m : 0; // a disc in 2-D
+    for (int k = -mz; k < std::max(mz, 1); ++k)
+      for (int j = -m; j < m; ++j)
+        for (int i = -m; i < m; ++i) {
+          const Vec3 o{(i + 0.5) * s, (j + 0.5) * s, dims == 3 ? (k + 0.5) * s : 0.0};
+          if (dot(o, o) < r2) out.points.push_back(l.center + o);
+        }
+    out.volume = dims == 3 ? s * s * s : s * s;
+    break;
+  }
+  case LatticeSpec::Shape::cylinder: {
+    const int a = l.axis, b = (a + 1) % 3, c = (a + 2) % 3;
+    const int layers = dims == 3 ? std::max(1, static_cast<int>(std::lround(l.length / s))) : 1;
+    const double da = l.length / layers;
+    const int m = static_cast<int>(std::ceil(l.radius / s)) + 1;
+    const double r2 = l.radius * l.radius, ri2 = l.inner_radius * l.inner_radius;
+    for (int k = 0; k < layers; ++k)
+      for (int j = -m; j < m; ++j)
+        for (int i = -m; i < m; ++i) {
+          const double u = (i + 0.5) * s, w = (j + 0.5) * s;
+          if (u * u + w * w >= r2 || u * u + w * w < ri2) continue;
+          Vec3 p = l.origin;
+          p[a] += dims == 3 ? (k + 0.5) * da : 0.0; // 2-D: the base plane
+          // Right-handed (b, c, a): x then y across an axis along z.
+          p[b] += u;
+          p[c] += w;
+          out.points.push_back(p);
+        }
+    out.volume = dims == 3 ? s * s * da : s * s;
+    break;
+  }
+  }
+  out.spacing =
+      dims == 3 ? std::cbrt(out.volume) : (dims == 2 ? std::sqrt(out.volume) : out.volume);
+  return out;
+}
+
+} // namespace anvil::sph

@@ -1,0 +1,31 @@
+// Particle lattices (deck `particles: NAME: {generate: ...}`): simple cubic lattices that
+// fill a box, a sphere or a cylinder, one particle at the centre of each lattice cell
+// whose centre lies inside the shape. Deterministic order (the global particle ids):
+// z slowest, then y, then x (for a cylinder: along the axis slowest).
+#pragma once
+
+#include <vector>
+
+#include "anvil/core/vec3.hpp"
+#include "anvil/io/config.hpp"
+
+namespace anvil::sph {
+
+struct Lattice {
+  std::vector<Vec3> points;
+  double volume = 0;  // volume per particle, m^3 (the same for every particle of a lattice)
+  double spacing = 0; // mean spacing actually used, m (volume^(1/dimensions))
+};
+
+// Box: n_i = max(1, round(L_i / s)) cells per direction, spacing L_i / n_i, so the
+// particles fill the box exactly. Sphere: cells of edge s centred on the sphere's
+// centre's lattice (c + (k + 1/2) s), kept when inside. Cylinder: n = round(length / s)
+// layers of spacing length / n along the axis, cross-section as the sphere's (without
+// the points inside inner_radius: a ring or a tube).
+// In fewer than 3 dimensions (SphConfig::dimensions) the lattice is one layer: in 2-D
+// the plane z = centre of the shape (a box's mid-plane, a sphere's centre: a disc; a
+// cylinder must lie along z: its cross-section, a disc or a ring), in 1-D the line
+// y, z = the box's centre (boxes only); volume is then per unit thickness or area.
+Lattice generate_lattice(const LatticeSpec& spec, int dimensions = 3);
+
+} // namespace anvil::sph

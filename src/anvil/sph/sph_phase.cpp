@@ -1,0 +1,365 @@
+#include "anvil/sph/sph_phase.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <fmt/format.h>
+
+#include "anvil/sph/lattice.hpp"
+
+namespace anvil::sph {
+
+namespace {
+double seconds_since(PhaseTimers::clock::time_point t0) {
+  return std::chrono::duration<double>(PhaseTimers::clock::now() - t0).count();
+}
+} // namespace
+
+SphPhase::SphPhase(const Config& config, const std::function<const Material*(int)>& material,
+                   const Comm& comm)
+    : comm_(comm), rcb_(comm), threshold_(config.sph.rebalance_threshold) {
+  const auto& psets = config.particles;
+  for (std::size_t s = 0; s < psets.size(); ++s) {
+    const auto& ps = psets[s];
+    if (ps.kernel != psets[0].kernel)
+      throw InputError({ps.where.file, ps.where.line, ps.where.key + ".kernel"},
+                       "every particle set must use the same kernel");
+  }
+  if (!psets.empty())
+    kernel_ = psets[0].kernel == ParticleSetConfig::Kernel::wendland_c2 ? KernelType::wendland_c2
+                                                                        : KernelType::cubic_spline;
+  // Every rank generates every lattice (deterministic) and keeps its share of ids.
+  std::vector<Lattice> lattices;
+  set_offsets_.assign(1, 0);
+  for (std::size_t s = 0; s < psets.size(); ++s) {
+    const LatticeSpec& ls = psets[s].lattice;
+    if (config.sph.dimensions == 1 && ls.shape != LatticeSpec::Shape::box)
+      throw InputError(psets[s].where, "a one-dimensional particle model takes boxes only");
+    if (config.sph.dimensions == 2 && ls.shape == LatticeSpec::Shape::cylinder && ls.axis != 2)
+      throw InputError(psets[s].where, "in two dimensions a cylinder's axis must be z");
+    lattices.push_back(generate_lattice(ls, config.sph.dimensions));
+    if (lattices.back().points.empty())
+      throw InputError(psets[s].where, "the particle set's shape holds no lattice point: "
+                                       "make the spacing smaller than the shape");
+    set_offsets_.push_back(set_offsets_.back() +
+                           static_cast<std::int64_t>(lattices.back().points.size()));
+    const Material* m = material(static_cast<int>(s));
+    SetParams sp;
+    sp.material = m;
+    sp.rho0 = m->elastic().density;
+    sp.h0 = psets[s].smoothing_ratio * lattices.back().spacing;
+    sp.alpha = psets[s].viscosity_linear;
+    sp.beta = psets[s].viscosity_quadratic;
+    sp.epsilon = psets[s].artificial_stress;
+    sp.exponent = psets[s].artificial_stress_exponent;
+    sp.w_spacing = kernel_shape(kernel_, 1.0 / psets[s].smoothing_ratio);
+    sp.corrected = psets[s].corrected_gradient;
+    sp.dimensions = config.sph.dimensions;
+    sets_.push_back(sp);
+  }
+  global_count_ = set_offsets_.back();
+  const std::int64_t P = comm_.size(), r = comm_.rank();
+  const std::int64_t first = global_count_ * r / P, last = global_count_ * (r + 1) / P;
+  const auto n = static_cast<std::size_t>(last - first);
+  p_.gid.resize(n);
+  p_.set.resize(n);
+  for (auto& a : p_.x) a.resize(n);
+  for (auto& a : p_.v) a.assign(n, 0.0);
+  p_.mass.resize(n);
+  p_.rho.resize(n);
+  p_.h.resize(n);
+  for (auto& a : p_.f) a.assign(n, 0.0);
+  for (auto& a : p_.stress) a.assign(n, 0.0);
+  p_.energy.resize(n);
+  p_.plastic_strain.assign(n, 0.0);
+  p_.temperature.resize(n);
+  p_.wave_speed.resize(n);
+  p_.constrained.assign(n, 0);
+  for (auto& a : p_.v_bc) a.assign(n, 0.0);
+  p_.last_face.assign(n, -1);
+  std::size_t k = 0;
+  for (std::int64_t g = first; g < last; ++g, ++k) {
+    const auto s = static_cast<std::size_t>(
+        std::upper_bound(set_offsets_.begin(), set_offsets_.end(), g) - set_offsets_.begin() - 1);
+    const Vec3& x = lattices[s].points[static_cast<std::size_t>(g - set_offsets_[s])];
+    const SetParams& sp = sets_[s];
+    p_.gid[k] = g;
+    p_.set[k] = static_cast<int>(s);
+    for (int i = 0; i < 3; ++i) p_.x[i][k] = x[i];
+    p_.mass[k] = sp.rho0 * lattices[s].volume;
+    p_.rho[k] = sp.rho0;
+    p_.h[k] = sp.h0;
+    const double p0 = sp.material->initial_pressure();
+    for (int i = 0; i < 3; ++i) p_.stress[i][k] = -p0;
+    p_.energy[k] = sp.material->initial_energy();
+    p_.temperature[k] = sp.material->initial_temperature();
+    p_.wave_speed[k] = std::sqrt(sp.material->elastic().plane_wave_modulus() / sp.rho0);
+  }
+  p_.x0 = p_.x;
+
+  // The first partition, and every particle to its box.
+  const RcbPoints pts{p_.x[0], p_.x[1], p_.x[2], p_.gid, {}};
+  rcb_.partition(pts);
+  ++stats_.rebalances;
+  dest_.assign(rcb_.destinations().begin(), rcb_.destinations().end());
+  migrate(dest_);
+}
+
+int SphPhase::find(std::int64_t gid) const {
+  const std::size_t n = p_.size();
+  const auto it =
+      std::lower_bound(p_.gid.begin(), p_.gid.begin() + static_cast<std::ptrdiff_t>(n), gid);
+  return it != p_.gid.begin() + static_cast<std::ptrdiff_t>(n) && *it == gid
+             ? static_cast<int>(it - p_.gid.begin())
+             : -1;
+}
+
+// Moves every field of every own particle to dest[i], then restores ascending gid.
+void SphPhase::migrate(std::span<const int> dest) {
+  move_plan_.build(comm_, dest);
+  const std::size_t nr = move_plan_.recv_count();
+  auto move = [&](auto& field) {
+    using T = typename std::decay_t<decltype(field)>::value_type;
+    std::vector<T>* tmp = scratch<T>();
+    tmp->resize(nr);
+    move_plan_.forward(std::span<const T>(field), std::span<T>(*tmp));
+    field.swap(*tmp);
+  };
+  p_.for_each_field(move);
+  sort_by_gid();
+}
+
+void SphPhase::sort_by_gid() {
+  const std::size_t n = p_.size();
+  if (std::is_sorted(p_.gid.begin(), p_.gid.end())) return;
+  perm_.resize(n);
+  std::iota(perm_.begin(), perm_.end(), 0);
+  std::sort(perm_.begin(), perm_.end(), [&](int a, int b) {
+    return p_.gid[static_cast<std::size_t>(a)] < p_.gid[static_cast<std::size_t>(b)];
+  });
+  auto apply = [&](auto& field) {
+    using T = typename std::decay_t<decltype(field)>::value_type;
+    std::vector<T>& out = *scratch<T>();
+    out.resize(n);
+    for (std::size_t k = 0; k < n; ++k) out[k] = field[static_cast<std::size_t>(perm_[k])];
+    field.swap(out);
+  };
+  p_.for_each_field(apply);
+}
+
+void SphPhase::resize_neighbour_fields(std::size_t n) {
+  p_.gid.resize(n);
+  p_.set.resize(n);
+  for (auto& a : p_.x) a.resize(n);
+  for (auto& a : p_.v) a.resize(n);
+  p_.mass.resize(n);
+  p_.rho.resize(n);
+  p_.h.resize(n);
+  p_.wave_speed.resize(n);
+}
+
+void SphPhase::exchange_ghosts_in() {
+  const std::size_t n = p_.size();
+  in_send_.resize(ghost_src_.size());
+  for (std::size_t k = 0; k < ghost_src_.size(); ++k) {
+    const auto i = static_cast<std::size_t>(ghost_src_[k]);
+    GhostIn& g = in_send_[k];
+    g.gid = p_.gid[i];
+    g.set = p_.set[i];
+    for (int d = 0; d < 3; ++d) {
+      g.x[d] = p_.x[d][i];
+      g.v[d] = p_.v[d][i];
+    }
+    g.mass = p_.mass[i];
+    g.rho = p_.rho[i];
+    g.h = p_.h[i];
+  }
+  ghost_plan_.forward(in_send_, in_recv_);
+  const std::size_t ng = in_recv_.size();
+  resize_neighbour_fields(n + ng);
+  for (std::size_t k = 0; k < ng; ++k) {
+    const GhostIn& g = in_recv_[k];
+    const std::size_t i = n + k;
+    p_.gid[i] = g.gid;
+    p_.set[i] = g.set;
+    for (int d = 0; d < 3; ++d) {
+      p_.x[d][i] = g.x[d];
+      p_.v[d][i] = g.v[d];
+    }
+    p_.mass[i] = g.mass;
+    p_.rho[i] = g.rho;
+    p_.h[i] = g.h;
+  }
+}
+
+void SphPhase::exchange_ghosts_out() {
+  const std::size_t n = p_.stress[0].size(); // own particles (not extended)
+  out_send_.resize(ghost_src_.size());
+  for (std::size_t k = 0; k < ghost_src_.size(); ++k) {
+    const auto i = static_cast<std::size_t>(ghost_src_[k]);
+    GhostOut& g = out_send_[k];
+    for (int c = 0; c < 6; ++c) {
+      g.S[c] = S_[c][i];
+      g.R[c] = R_[c][i];
+    }
+    g.rho = p_.rho[i];
+    g.c = p_.wave_speed[i];
+  }
+  ghost_plan_.forward(out_send_, out_recv_);
+  for (std::size_t k = 0; k < out_recv_.size(); ++k) {
+    const GhostOut& g = out_recv_[k];
+    const std::size_t i = n + k;
+    for (int c = 0; c < 6; ++c) {
+      S_[c][i] = g.S[c];
+      R_[c][i] = g.R[c];
+    }
+    p_.rho[i] = g.rho;
+    p_.wave_speed[i] = g.c;
+  }
+}
+
+void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
+  ++stats_.cycles;
+  const int me = comm_.rank();
+  std::size_t n = p_.size();
+
+  // (1) Upkeep: one reduction of the largest count, the escape flag and the largest h.
+  {
+    ScopedPhase t(timers, Phase::sph);
+    const Box3 box = rcb_.box(me);
+    double escaped = 0, hmax = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 x{p_.x[0][i], p_.x[1][i], p_.x[2][i]};
+      escaped = box.contains(x) ? escaped : 1.0;
+      hmax = std::max(hmax, p_.h[i]);
+    }
+    double red[3] = {static_cast<double>(n), escaped, hmax};
+    comm_.max(std::span<double>(red, 3));
+    const double mean = static_cast<double>(global_count_) / comm_.size();
+    stats_.imbalance = mean > 0 ? red[0] / mean : 1.0;
+    stats_.imbalance_max = std::max(stats_.imbalance_max, stats_.imbalance);
+    if (stats_.imbalance > threshold_) {
+      const auto t0 = PhaseTimers::clock::now();
+      {
+        ScopedPhase tr(timers, Phase::rebalance);
+        const RcbPoints pts{std::span<const double>(p_.x[0]),
+                            std::span<const double>(p_.x[1]),
+                            std::span<const double>(p_.x[2]),
+                            std::span<const std::int64_t>(p_.gid),
+                            {}};
+        rcb_.repartition(pts);
+        ++stats_.rebalances;
+      }
+      stats_.seconds_rebalance += seconds_since(t0);
+      const auto t1 = PhaseTimers::clock::now();
+      {
+        ScopedPhase tr(timers, Phase::transfer);
+        dest_.assign(rcb_.destinations().begin(), rcb_.destinations().end());
+        migrate(dest_);
+      }
+      stats_.seconds_migrate += seconds_since(t1);
+    } else if (red[1] > 0) {
+      const auto t1 = PhaseTimers::clock::now();
+      ScopedPhase tr(timers, Phase::transfer);
+      dest_.resize(n);
+      for (std::size_t i = 0; i < n; ++i)
+        dest_[i] = rcb_.owner({p_.x[0][i], p_.x[1][i], p_.x[2][i]});
+      migrate(dest_);
+      ++stats_.migrations;
+      stats_.seconds_migrate += seconds_since(t1);
+    }
+    n = p_.size();
+    hmax_ = red[2];
+  }
+
+  // (2) Ghosts: copies of the particles whose support box leaves this rank's box.
+  {
+    const auto t0 = PhaseTimers::clock::now();
+    ScopedPhase t(timers, Phase::transfer);
+    const double reach = support_factor * hmax_;
+    const Box3 box = rcb_.box(me);
+    ghost_src_.clear();
+    ghost_dest_.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 x{p_.x[0][i], p_.x[1][i], p_.x[2][i]};
+      const Box3 b{{x.x - reach, x.y - reach, x.z - reach},
+                   {x.x + reach, x.y + reach, x.z + reach}};
+      if (b.lo.x > box.lo.x && b.lo.y > box.lo.y && b.lo.z > box.lo.z && b.hi.x < box.hi.x &&
+          b.hi.y < box.hi.y && b.hi.z < box.hi.z)
+        continue;
+      rcb_.overlapping(b, ranks_);
+      for (int r : ranks_)
+        if (r != me) {
+          ghost_src_.push_back(static_cast<int>(i));
+          ghost_dest_.push_back(r);
+        }
+    }
+    ghost_plan_.build(comm_, ghost_dest_);
+    exchange_ghosts_in();
+    stats_.ghosts = static_cast<std::int64_t>(in_recv_.size());
+    stats_.seconds_ghosts += seconds_since(t0);
+  }
+
+  const std::size_t na = p_.gid.size();
+  for (int c = 0; c < 6; ++c) {
+    S_[c].resize(na);
+    R_[c].resize(na);
+  }
+  for (auto& a : p_.f) a.resize(n);
+  energy_rate_.resize(n);
+  SphView view;
+  view.n_local = n;
+  view.n_all = na;
+  view.gid = p_.gid.data();
+  view.set = p_.set.data();
+  for (int d = 0; d < 3; ++d) {
+    view.x[d] = p_.x[d].data();
+    view.v[d] = p_.v[d].data();
+    view.force[d] = p_.f[d].data();
+  }
+  view.mass = p_.mass.data();
+  view.h = p_.h.data();
+  view.rho = p_.rho.data();
+  for (int c = 0; c < 6; ++c) {
+    view.stress[c] = p_.stress[c].data();
+    view.S[c] = S_[c].data();
+    view.R[c] = R_[c].data();
+  }
+  view.energy = p_.energy.data();
+  view.plastic_strain = p_.plastic_strain.data();
+  view.temperature = p_.temperature.data();
+  view.wave_speed = p_.wave_speed.data();
+  view.energy_rate = energy_rate_.data();
+
+  // (3)-(4) Neighbours and pass 1.
+  {
+    const auto t0 = PhaseTimers::clock::now();
+    ScopedPhase t(timers, Phase::sph);
+    find_neighbours(p_.x[0], p_.x[1], p_.x[2], p_.h, p_.gid, n, 2 * support_factor * hmax_ / 2,
+                    nwork_, nlist_);
+    stats_.pairs = static_cast<std::int64_t>(nlist_.pairs());
+    sph_kinematics(view, sets_, kernel_, nlist_, dt_prev, work_);
+    stats_.seconds_compute += seconds_since(t0);
+  }
+  // (5) The ghosts' new state.
+  {
+    const auto t0 = PhaseTimers::clock::now();
+    ScopedPhase t(timers, Phase::transfer);
+    exchange_ghosts_out();
+    stats_.seconds_ghosts += seconds_since(t0);
+  }
+  // (6) Pass 2, then the smoothing lengths for the next cycle.
+  {
+    const auto t0 = PhaseTimers::clock::now();
+    ScopedPhase t(timers, Phase::sph);
+    result_ = SphResult{};
+    sph_forces(view, sets_, nlist_, work_, result_);
+    resize_neighbour_fields(n);
+    for (std::size_t i = 0; i < n; ++i)
+      p_.h[i] = smoothing_length(sets_[static_cast<std::size_t>(p_.set[i])], p_.rho[i]);
+    stats_.seconds_compute += seconds_since(t0);
+  }
+}
+
+} // namespace anvil::sph

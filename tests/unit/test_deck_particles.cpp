@@ -1,0 +1,224 @@
+// The deck's `particles:` and `eos:` keys (DESIGN.md section 4, docs/sph.md): valid
+// particle sets become typed configuration, lattices hold the expected particles, and
+// bad input is an InputError naming file, line and key.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "anvil/io/deck.hpp"
+#include "anvil/material/material.hpp"
+#include "anvil/sph/kernel.hpp"
+#include "anvil/sph/lattice.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using namespace anvil;
+
+const char* good = R"(termination: {time: 1.0e-5}
+materials:
+  copper: {model: j2_plasticity, density: 8930, youngs_modulus: 117.0e9,
+           poissons_ratio: 0.35, yield_stress: 0.4e9,
+           eos: {model: mie_gruneisen, c0: 3940, s: 1.49, gamma0: 2.0}}
+  gas: {model: ideal_gas, density: 1.2, specific_energy: 2.1e5}
+particles:
+  ball:
+    generate: {shape: sphere, center: [0, 0, 0.02], radius: 5.0e-3, spacing: 1.0e-3}
+    material: copper
+    smoothing_ratio: 1.2
+    kernel: wendland_c2
+    viscosity: {linear: 0.5, quadratic: 1.0}
+    artificial_stress: {epsilon: 0.2, exponent: 3}
+    corrected_gradient: true
+  air: {generate: {shape: box, min: [0, 0, 0], max: [0.01, 0.01, 0.01], spacing: 1.0e-3},
+        material: gas, kernel: wendland_c2}
+sph: {rebalance_threshold: 1.5}
+initial_conditions:
+  - {part: ball, velocity: [0, 0, -100.0]}
+boundary_conditions:
+  - {set: {part: air, box: {min: [-1, -1, -1], max: [1, 1, 1.0e-4]}}, fix: all}
+probes:
+  - {name: c, at: [0, 0, 0.02]}
+)";
+
+void expect_error(const std::string& from, const std::string& to,
+                  std::initializer_list<std::string> fragments) {
+  std::string text = good;
+  const auto pos = text.find(from);
+  ASSERT_NE(pos, std::string::npos) << from;
+  text.replace(pos, from.size(), to);
+  try {
+    test::deck(text, "deck.yaml");
+    FAIL() << "no error for " << to;
+  } catch (const InputError& e) {
+    for (const auto& f : fragments)
+      EXPECT_NE(std::string(e.what()).find(f), std::string::npos)
+          << e.what() << "\n  missing: " << f;
+  }
+}
+
+TEST(DeckParticles, ParsesParticleSetsAndEos) {
+  const Config c = test::deck(good);
+  EXPECT_TRUE(c.parts.empty()); // a deck of particles only
+  ASSERT_EQ(c.particles.size(), 2u);
+  const auto& b = c.particles[0];
+  EXPECT_EQ(b.name, "ball");
+  EXPECT_EQ(b.lattice.shape, LatticeSpec::Shape::sphere);
+  EXPECT_DOUBLE_EQ(b.lattice.radius, 5.0e-3);
+  EXPECT_DOUBLE_EQ(b.smoothing_ratio, 1.2);
+  EXPECT_EQ(b.kernel, ParticleSetConfig::Kernel::wendland_c2);
+  EXPECT_DOUBLE_EQ(b.viscosity_linear, 0.5);
+  EXPECT_DOUBLE_EQ(b.viscosity_quadratic, 1.0);
+  EXPECT_DOUBLE_EQ(b.artificial_stress, 0.2);
+  EXPECT_DOUBLE_EQ(b.artificial_stress_exponent, 3);
+  EXPECT_TRUE(b.corrected_gradient);
+  // Defaults.
+  const auto& a = c.particles[1];
+  EXPECT_DOUBLE_EQ(a.smoothing_ratio, 1.3);
+  EXPECT_DOUBLE_EQ(a.viscosity_linear, 1.0);
+  EXPECT_DOUBLE_EQ(a.viscosity_quadratic, 2.0);
+  EXPECT_DOUBLE_EQ(a.artificial_stress, 0.3);
+  EXPECT_FALSE(a.corrected_gradient);
+  EXPECT_EQ(c.particle_set("air"), 1);
+  EXPECT_DOUBLE_EQ(c.sph.rebalance_threshold, 1.5);
+  EXPECT_EQ(c.materials[0].eos_model, "mie_gruneisen");
+  EXPECT_DOUBLE_EQ(c.materials[0].eos_params.at("c0"), 3940);
+  EXPECT_DOUBLE_EQ(c.materials[1].params.at("gamma"), 1.4); // default
+}
+
+TEST(DeckParticles, BadInputNamesKeyAndLine) {
+  expect_error("shape: sphere", "shape: cone",
+               {"deck.yaml:9", "particles.ball.generate.shape", "cone"});
+  expect_error("radius: 5.0e-3, spacing", "radius: 5.0e-3, spcing: 1, spacing",
+               {"deck.yaml:9", "spcing", "unknown key"});
+  expect_error("material: copper\n", "material: bronze\n", {"deck.yaml:10", "bronze"});
+  expect_error("kernel: wendland_c2\n", "kernel: gaussian\n", {"deck.yaml:12", "gaussian"});
+  expect_error("smoothing_ratio: 1.2", "smoothing_ratio: 5", {"deck.yaml:11", "smoothing_ratio"});
+  expect_error("linear: 0.5", "linear: -0.5", {"deck.yaml:13", "viscosity.linear", "negative"});
+  expect_error("epsilon: 0.2", "epsilon: 2", {"deck.yaml:14", "artificial_stress.epsilon"});
+  expect_error("corrected_gradient: true", "corrected_gradient: maybe",
+               {"deck.yaml:15", "corrected_gradient"});
+  expect_error("c0: 3940", "c0: -3940", {"deck.yaml:5", "eos.c0", "impossible"});
+  expect_error("model: mie_gruneisen", "model: tillotson", {"deck.yaml:5", "tillotson"});
+  expect_error("spacing: 1.0e-3}\n    material", "spacing: 1.0e-9}\n    material",
+               {"deck.yaml:9", "spacing", "2e9"});
+  expect_error("part: ball", "part: bal", {"deck.yaml:20", "bal"});
+  expect_error("sph: {rebalance_threshold: 1.5}", "sph: {dimensions: 4}",
+               {"deck.yaml:18", "sph.dimensions"});
+}
+
+TEST(DeckParticles, FluidsAndEquationsOfStateAreForParticlesOnly) {
+  const std::string fe = std::string(good) + R"(parts:
+  plate:
+    mesh: {generate: box, min: [0, 0, 0], max: [1, 1, 1], divisions: [1, 1, 1]}
+    material: gas
+)";
+  try {
+    test::deck(fe, "deck.yaml");
+    FAIL() << "an FE part of ideal gas was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("parts.plate.material"), std::string::npos) << e.what();
+  }
+}
+
+// Lattices: counts and volumes (the mass is density times volume).
+TEST(Lattice, BoxSphereCylinderRing) {
+  LatticeSpec box;
+  box.min = {0, 0, 0};
+  box.max = {0.01, 0.02, 0.03};
+  box.spacing = 1e-3;
+  const auto b = sph::generate_lattice(box);
+  EXPECT_EQ(b.points.size(), 10u * 20u * 30u);
+  EXPECT_NEAR(b.volume, 1e-9, 1e-21);
+  EXPECT_NEAR(b.points[1].x - b.points[0].x, 1e-3, 1e-15); // x fastest (lattice order)
+
+  LatticeSpec sphere;
+  sphere.shape = LatticeSpec::Shape::sphere;
+  sphere.radius = 0.01;
+  sphere.spacing = 1e-3;
+  const auto s = sph::generate_lattice(sphere);
+  // The particles' volume approximates the sphere's within 2%.
+  const double v = 4.0 / 3.0 * M_PI * 1e-6;
+  EXPECT_LT(std::abs(s.points.size() * s.volume / v - 1), 0.02);
+
+  LatticeSpec ring;
+  ring.shape = LatticeSpec::Shape::cylinder;
+  ring.radius = 0.04;
+  ring.inner_radius = 0.03;
+  ring.length = 0.002;
+  ring.spacing = 1e-3;
+  const auto r = sph::generate_lattice(ring, 2);
+  const double area = M_PI * (0.04 * 0.04 - 0.03 * 0.03);
+  EXPECT_LT(std::abs(r.points.size() * r.volume / area - 1), 0.02);
+  for (const auto& p : r.points) {
+    EXPECT_EQ(p.z, 0.0); // one layer in 2-D
+    EXPECT_GE(std::hypot(p.x, p.y), 0.03);
+  }
+}
+
+// The kernels are normalised (integral of W over space is 1) and the branch-free forms
+// agree with the reference ones.
+TEST(Kernel, NormalisedAndConsistent) {
+  for (auto k : {sph::KernelType::cubic_spline, sph::KernelType::wendland_c2}) {
+    const double h = 0.7;
+    double sum = 0;
+    const int n = 4000;
+    const double dr = 2 * h / n;
+    for (int i = 0; i < n; ++i) {
+      const double r = (i + 0.5) * dr;
+      double w, dwr;
+      sph::kernel(k, r, h, w, dwr);
+      sum += 4 * M_PI * r * r * w * dr;
+      double wf, dwf;
+      if (k == sph::KernelType::cubic_spline)
+        sph::kernel_fast<sph::KernelType::cubic_spline, 3>(r, h, wf, dwf);
+      else
+        sph::kernel_fast<sph::KernelType::wendland_c2, 3>(r, h, wf, dwf);
+      EXPECT_NEAR(wf, w, 1e-12 * std::abs(w) + 1e-14);
+      EXPECT_NEAR(dwf, dwr, 1e-9 * std::abs(dwr) + 1e-12);
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-5);
+  }
+  // 2-D cubic spline: integral of W over the plane is 1.
+  double sum = 0;
+  const int n = 4000;
+  const double h = 1.0, dr = 2 * h / n;
+  for (int i = 0; i < n; ++i) {
+    const double r = (i + 0.5) * dr;
+    double w, dwr;
+    sph::kernel_fast<sph::KernelType::cubic_spline, 2>(r, h, w, dwr);
+    sum += 2 * M_PI * r * w * dr;
+  }
+  EXPECT_NEAR(sum, 1.0, 1e-5);
+}
+
+// Mie-Gruneisen through a strength model: pressure at a compression from the Hugoniot.
+TEST(Eos, MieGruneisenReplacesThePressure) {
+  const ParamValues p{{"density", 8930}, {"youngs_modulus", 117e9}, {"poissons_ratio", 0.35}};
+  const ParamValues e{{"c0", 3940}, {"s", 1.49}, {"gamma0", 2.0}};
+  const auto m = make_material("elastic", p, "mie_gruneisen", e);
+  EXPECT_TRUE(m->needs_energy());
+  double d[6] = {0, 0, 0, 0, 0, 0}, s[6] = {0, 0, 0, 1e6, 0, 0};
+  double rho = 8930 * 1.1, energy = 0, ep = 0, T = 0, c = 0;
+  MaterialBatch b;
+  b.n = 1;
+  b.dt = 1e-9;
+  for (int k = 0; k < 6; ++k) {
+    b.d[k] = &d[k];
+    b.stress[k] = &s[k];
+  }
+  b.density = &rho;
+  b.plastic_strain = &ep;
+  b.temperature = &T;
+  b.wave_speed = &c;
+  b.energy = &energy;
+  m->update(b);
+  const double mu = 0.1, A = 8930 * 3940.0 * 3940.0;
+  const double p_h = A * mu * (1 + (1 - 1.0) * mu) / std::pow(1 - 0.49 * mu, 2);
+  EXPECT_NEAR(-s[0], p_h, 1e-9 * p_h);
+  EXPECT_NEAR(-s[1], p_h, 1e-9 * p_h);
+  EXPECT_NEAR(s[3], 1e6, 1e-6); // the deviator is the strength model's
+  EXPECT_GT(c, 3940);
+}
+
+} // namespace
