@@ -625,7 +625,8 @@ TEST(ReadersDeck, BadMeshFilesExitWithStatusTwo) {
       {"truncated.msh", good.substr(0, good.size() / 2), "truncated?"},
       {"tet.msh", good.substr(0, good.find("3 1 5 4")) + "3 1 4 1\n12 1 13 25 16\n$EndElements\n",
        "tetrahedron"},
-      {"model.k", "*KEYWORD\n", "unknown format"},
+      {"model.k", "*KEYWORD\n*NODE\n1 x\n", "model.k:3: *NODE.NID"},
+      {"model.inp", "*HEADING\n", "unknown format"},
   };
   for (const auto& f : files) {
     SCOPED_TRACE(f.name);

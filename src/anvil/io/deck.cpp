@@ -169,6 +169,7 @@ std::vector<std::string> generated_sets(MeshConfig::Kind kind) {
   case MeshConfig::Kind::can:
     return {"bottom", "top", "inner", "outer"};
   case MeshConfig::Kind::file:
+  case MeshConfig::Kind::embedded:
     return {};
   }
   return {};
@@ -565,9 +566,21 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 
   if (top.has("output")) {
     const Node o = top.child("output");
-    o.check_keys({"fields_every", "history_every"});
+    o.check_keys({"fields_every", "history_every", "format"});
     if (o.has("fields_every")) c.fields_every = o.child("fields_every").positive();
     if (o.has("history_every")) c.history_every = o.child("history_every").positive();
+    if (o.has("format")) {
+      const std::string f = o.child("format").str();
+      if (f == "vtu")
+        c.output_format = OutputFormat::vtu;
+      else if (f == "exodus")
+        c.output_format = OutputFormat::exodus;
+      else if (f == "both")
+        c.output_format = OutputFormat::both;
+      else
+        o.child("format").fail(
+            fmt::format("unknown output format '{}' (expected vtu, exodus or both)", f));
+    }
   }
   return c;
 }
