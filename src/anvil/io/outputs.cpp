@@ -87,7 +87,8 @@ Outputs::Outputs(const Simulation& sim, OutputOptions options)
   if (sim_.comm().rank() == 0) {
     try {
       make_directories(opt_.directory);
-      make_directories(opt_.directory + "/fields");
+      if (sim_.config().output_format != OutputFormat::exodus)
+        make_directories(opt_.directory + "/fields");
     } catch (const InputError& e) {
       ok = 0;
       err = e.what();
@@ -123,6 +124,7 @@ void Outputs::begin() {
   // The first row is the state the deck gave, at t = 0 (collective).
   const Sample initial = sim_.sample();
   write_history_row(initial);
+  if (c.output_format != OutputFormat::vtu) open_exodus();
   write_fields();
   next_fields_ = c.fields_every > 0 ? c.fields_every : std::numeric_limits<double>::infinity();
   next_history_ = c.history_every;
@@ -160,13 +162,40 @@ void Outputs::after_step() {
   progress(last);
 }
 
+// Runs `write` on every rank; if it fails on any, every rank throws the InputError of the
+// lowest failing rank (a write error on one rank must not leave the others waiting).
+template <class F>
+void collective_write(const Comm& comm, F&& write) {
+  std::string err;
+  try {
+    write();
+  } catch (const InputError& e) {
+    err = e.what();
+  }
+  const std::int64_t failed = comm.min(err.empty() ? static_cast<std::int64_t>(comm.size())
+                                                   : static_cast<std::int64_t>(comm.rank()));
+  if (failed == comm.size()) return;
+  comm.broadcast(err, static_cast<int>(failed));
+  throw InputError(err);
+}
+
+void Outputs::open_exodus() {
+  const VtuPiece layout = fe_piece(sim_); // collective: every rank lists the same arrays
+  collective_write(sim_.comm(), [&] {
+    exodus_ = std::make_unique<ExodusWriter>(
+        exodus_path(opt_.directory, sim_.comm().size(), sim_.comm().rank()), sim_, layout);
+  });
+}
+
 void Outputs::write_fields() {
   const Clock& clk = sim_.clock();
   if (last_field_cycle_ == clk.cycle) return;
   last_field_cycle_ = clk.cycle;
-  const std::string stem = fmt::format("step_{:06d}", field_count_++);
   VtuPiece piece = fe_piece(sim_);
   piece.time = clk.time;
+  if (exodus_) collective_write(sim_.comm(), [&] { exodus_->write_step(clk.time, piece); });
+  if (sim_.config().output_format == OutputFormat::exodus) return;
+  const std::string stem = fmt::format("step_{:06d}", field_count_++);
   write_vtu(fmt::format("{}/fields/{}_r{:04d}.vtu", opt_.directory, stem, sim_.comm().rank()),
             piece);
   sim_.comm().barrier(); // every piece is complete before the index names it
