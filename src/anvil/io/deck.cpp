@@ -190,8 +190,10 @@ MaterialConfig parse_material(const std::string& name, const Node& n) {
   m.model = model;
   for (const auto& [key, v] : n.entries()) {
     if (key == "model") continue;
+    // A named copy: clang before 16 cannot capture a structured binding in a lambda.
+    const std::string& name = key;
     const auto spec = std::find_if(info->params.begin(), info->params.end(),
-                                   [&](const ParamSpec& p) { return p.name == key; });
+                                   [&](const ParamSpec& p) { return p.name == name; });
     if (spec == info->params.end()) {
       std::string list;
       for (const auto& p : info->params) list += (list.empty() ? "" : ", ") + std::string(p.name);
