@@ -226,6 +226,30 @@ MaterialConfig parse_material(const std::string& name, const Node& n) {
   return m;
 }
 
+// Elements a generator would make (as a double: the product of three divisions of up to
+// 1e8 overflows any integer).
+double generated_elements(const MeshConfig& mc) {
+  switch (mc.kind) {
+  case MeshConfig::Kind::box:
+    return 1.0 * mc.box.divisions[0] * mc.box.divisions[1] * mc.box.divisions[2];
+  case MeshConfig::Kind::cylinder: {
+    const double c = std::max(1, mc.cylinder.divisions[0] / 2), n = 2 * c;
+    const double ring = mc.cylinder.divisions[0] - c;
+    return (n * n + 4 * n * ring) * mc.cylinder.divisions[1];
+  }
+  case MeshConfig::Kind::can:
+    return 1.0 * mc.can.divisions[0] * mc.can.divisions[1] * mc.can.divisions[2];
+  case MeshConfig::Kind::file:
+  case MeshConfig::Kind::embedded:
+    return 0;
+  }
+  return 0;
+}
+
+// Every rank builds the whole mesh, and the generators count in 32-bit integers in places:
+// a part is capped well below both limits.
+constexpr double max_generated_elements = 1e9;
+
 MeshConfig parse_mesh(const Node& n, const std::string& base_dir) {
   MeshConfig mc;
   mc.where = n.where();
@@ -275,6 +299,11 @@ MeshConfig parse_mesh(const Node& n, const std::string& base_dir) {
     n.child("generate")
         .fail(fmt::format("unknown generator '{}' (expected box, cylinder or can)", gen));
   }
+  if (const double count = generated_elements(mc); count > max_generated_elements)
+    n.child("divisions")
+        .fail(fmt::format("these divisions make {:.3g} elements; a generated part may have at "
+                          "most {:.0e}",
+                          count, max_generated_elements));
   return mc;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <new>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -45,6 +46,10 @@ Mesh part_mesh(const PartConfig& p) {
     }
   } catch (const std::invalid_argument& e) {
     throw InputError(p.mesh.where, e.what());
+  } catch (const std::bad_alloc&) {
+    throw InputError(p.mesh.where, "the generated mesh does not fit in memory");
+  } catch (const std::length_error&) {
+    throw InputError(p.mesh.where, "the generated mesh does not fit in memory");
   }
   const auto reader = mesh_reader(p.mesh.file);
   if (!reader)
