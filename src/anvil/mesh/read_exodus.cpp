@@ -9,10 +9,12 @@
 #include <limits>
 #include <new>
 #include <stdexcept>
+#include <string_view>
 #include <vector>
 
 #include <exodusII.h>
 #include <fmt/format.h>
+#include <netcdf.h>
 
 #include "anvil/core/error.hpp"
 
@@ -41,6 +43,8 @@ public:
 
   int id() const { return id_; }
   const std::string& path() const { return path_; }
+  // Whether the coordinates are three variables (coordx, ...) rather than one (coord).
+  bool stored_coordinates_separately() const { return stored_values("coordx") >= 0; }
 
   [[noreturn]] void fail(const std::string& message) const {
     throw InputError(SourceLocation{path_, 0, ""}, message);
@@ -51,7 +55,43 @@ public:
     if (rc < 0) fail(fmt::format("cannot read {}{}", what, library_message()));
   }
 
+  // Throws unless the netCDF variable `var` stores exactly `n` values. The Exodus library
+  // reads whole variables into the caller's buffer, sized from the counts it reports
+  // (dimensions of their own): in a corrupt file the two disagree, and the read would
+  // write past the buffer. Every bulk read is checked with this first.
+  void expect_values(const std::string& var, std::int64_t n, const std::string& what) const {
+    const std::int64_t have = stored_values(var);
+    if (have != n)
+      fail(fmt::format("{} is corrupt: its variable {} {} where the counts give {}", what, var,
+                       have < 0 ? std::string("is missing or malformed")
+                                : fmt::format("holds {} values", have),
+                       n));
+  }
+
 private:
+  // Values the netCDF variable `var` holds (the product of its dimensions, the record
+  // dimension at its current length), or -1 when the file has no such variable. The
+  // Exodus file id is the netCDF id.
+  std::int64_t stored_values(const std::string& var) const {
+    int varid = -1, ndims = 0;
+    if (nc_inq_varid(id_, var.c_str(), &varid) != NC_NOERR) return -1;
+    if (nc_inq_varndims(id_, varid, &ndims) != NC_NOERR || ndims < 0 || ndims > NC_MAX_VAR_DIMS)
+      return -1;
+    int dims[NC_MAX_VAR_DIMS];
+    if (nc_inq_vardimid(id_, varid, dims) != NC_NOERR) return -1;
+    std::int64_t total = 1;
+    for (int d = 0; d < ndims; ++d) {
+      std::size_t len = 0;
+      if (nc_inq_dimlen(id_, dims[d], &len) != NC_NOERR) return -1;
+      if (len != 0 &&
+          static_cast<std::uint64_t>(total) >
+              static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()) / len)
+        return -1;
+      total *= static_cast<std::int64_t>(len);
+    }
+    return total;
+  }
+
   // The Exodus library's own explanation of its last error, for the user.
   static std::string library_message() {
     const char* msg = nullptr;
@@ -176,6 +216,39 @@ std::string classic_netcdf_problem(const std::string& path) {
   return "";
 }
 
+// Returns what in the file would make the Exodus library write past its own buffers, or an
+// empty string. Opening the file reads global attributes into single numbers (more values
+// overflow them), and reading a block copies its element type into a buffer of
+// MAX_STR_LENGTH + 1 characters: both are checked through netCDF before the library sees
+// the file. A file netCDF cannot open is left to ex_open to report.
+std::string exodus_attribute_problem(const std::string& path) {
+  int ncid = -1;
+  if (nc_open(path.c_str(), NC_NOWRITE, &ncid) != NC_NOERR) return "";
+  std::string problem;
+  for (const char* att : {"api_version", "version", "floating_point_word_size", "file_size",
+                          "maximum_name_length", "int64_status", "last_written_time"}) {
+    std::size_t len = 0;
+    if (nc_inq_attlen(ncid, NC_GLOBAL, att, &len) == NC_NOERR && len != 1) {
+      problem = fmt::format("the global attribute {} has {} values instead of one", att, len);
+      break;
+    }
+  }
+  int nvars = 0;
+  if (problem.empty() && nc_inq_nvars(ncid, &nvars) == NC_NOERR) {
+    for (int v = 0; v < nvars && problem.empty(); ++v) {
+      std::size_t len = 0;
+      char name[NC_MAX_NAME + 1] = {};
+      if (nc_inq_varname(ncid, v, name) != NC_NOERR) continue;
+      if (std::string_view(name).substr(0, 7) != "connect") continue;
+      if (nc_inq_attlen(ncid, v, "elem_type", &len) == NC_NOERR && len > MAX_STR_LENGTH)
+        problem = fmt::format("the element type of {} has {} characters (at most {})", name, len,
+                              MAX_STR_LENGTH);
+    }
+  }
+  nc_close(ncid);
+  return problem;
+}
+
 // Names of the `count` entities of `type` in file order; an empty string where the file
 // gives none.
 std::vector<std::string> entity_names(const ExodusFile& f, ex_entity_type type, std::int64_t count,
@@ -197,10 +270,21 @@ std::vector<std::string> entity_names(const ExodusFile& f, ex_entity_type type, 
   return out;
 }
 
+// Ids of the `count` entities of `type` in file order; two entities with one id are an
+// error (the library would give both the first one's data).
 std::vector<std::int64_t> entity_ids(const ExodusFile& f, ex_entity_type type, std::int64_t count,
                                      const char* what) {
   std::vector<std::int64_t> ids(static_cast<std::size_t>(count));
-  if (count > 0) f.check(ex_get_ids(f.id(), type, ids.data()), what);
+  if (count == 0) return ids;
+  const char* var = type == EX_ELEM_BLOCK ? "eb_prop1"
+                    : type == EX_NODE_SET ? "ns_prop1"
+                                          : "ss_prop1";
+  f.expect_values(var, count, what);
+  f.check(ex_get_ids(f.id(), type, ids.data()), what);
+  std::vector<std::int64_t> sorted = ids;
+  std::sort(sorted.begin(), sorted.end());
+  if (const auto dup = std::adjacent_find(sorted.begin(), sorted.end()); dup != sorted.end())
+    f.fail(fmt::format("{}: two entities have id {}", what, *dup));
   return ids;
 }
 
@@ -242,6 +326,12 @@ Mesh read_all(const ExodusFile& f) {
   const std::int64_t nn = init.num_nodes;
   if (nn > 0) {
     std::vector<double> x(nn), y(nn), z(nn);
+    if (f.stored_coordinates_separately()) {
+      for (const char* var : {"coordx", "coordy", "coordz"})
+        f.expect_values(var, nn, "the node coordinates");
+    } else {
+      f.expect_values("coord", 3 * nn, "the node coordinates");
+    }
     f.check(ex_get_coord(f.id(), x.data(), y.data(), z.data()), "the node coordinates");
     mesh.nodes.resize(nn);
     for (std::int64_t i = 0; i < nn; ++i) {
@@ -260,8 +350,10 @@ Mesh read_all(const ExodusFile& f) {
     const std::int64_t bid = block_ids[b];
     const std::string name = block_names[b].empty() ? fmt::format("block_{}", bid) : block_names[b];
     const std::string label = fmt::format("element block '{}' (id {})", name, bid);
-    // Larger than MAX_STR_LENGTH + 1, which is all the library writes.
-    std::vector<char> type(256, '\0');
+    // The library copies the element type attribute into this buffer; its length was
+    // checked against MAX_STR_LENGTH before the file was opened (exodus_attribute_problem).
+    const std::string conn_var = fmt::format("connect{}", b + 1);
+    std::vector<char> type(MAX_STR_LENGTH + 2, '\0');
     std::int64_t count = 0, npe = 0, edges = 0, faces = 0, attrs = 0;
     f.check(
         ex_get_block(f.id(), EX_ELEM_BLOCK, bid, type.data(), &count, &npe, &edges, &faces, &attrs),
@@ -279,6 +371,7 @@ Mesh read_all(const ExodusFile& f) {
     fits(count * npe, "connectivity entries in " + label);
     ElementBlock eb{name, {}};
     if (count > 0) {
+      f.expect_values(conn_var, count * npe, "the connectivity of " + label);
       std::vector<std::int64_t> conn(static_cast<std::size_t>(count * npe));
       f.check(ex_get_conn(f.id(), EX_ELEM_BLOCK, bid, conn.data(), nullptr, nullptr),
               "the connectivity of " + label);
@@ -312,7 +405,10 @@ Mesh read_all(const ExodusFile& f) {
     if (count < 0) f.fail(label + " has a negative size");
     fits(count, "entries in " + label);
     std::vector<std::int64_t> ids(static_cast<std::size_t>(count));
-    if (count > 0) f.check(ex_get_set(f.id(), EX_NODE_SET, ns_ids[s], ids.data(), nullptr), label);
+    if (count > 0) {
+      f.expect_values(fmt::format("node_ns{}", s + 1), count, label);
+      f.check(ex_get_set(f.id(), EX_NODE_SET, ns_ids[s], ids.data(), nullptr), label);
+    }
     for (auto& n : ids) {
       if (n < 1 || n > nn)
         f.fail(fmt::format("{} contains node {}, but the file has nodes 1 to {}", label, n, nn));
@@ -336,8 +432,11 @@ Mesh read_all(const ExodusFile& f) {
     if (count < 0) f.fail(label + " has a negative size");
     fits(count, "entries in " + label);
     std::vector<std::int64_t> elems(static_cast<std::size_t>(count)), sides(elems.size());
-    if (count > 0)
+    if (count > 0) {
+      f.expect_values(fmt::format("elem_ss{}", s + 1), count, label);
+      f.expect_values(fmt::format("side_ss{}", s + 1), count, label);
       f.check(ex_get_set(f.id(), EX_SIDE_SET, ss_ids[s], elems.data(), sides.data()), label);
+    }
     std::vector<SideEntry> entries;
     entries.reserve(elems.size());
     for (std::size_t i = 0; i < elems.size(); ++i) {
@@ -360,6 +459,8 @@ Mesh read_all(const ExodusFile& f) {
 Mesh read_exodus(const std::string& path) {
   try {
     if (const auto problem = classic_netcdf_problem(path); !problem.empty())
+      throw InputError(SourceLocation{path, 0, ""}, "not a readable Exodus II file: " + problem);
+    if (const auto problem = exodus_attribute_problem(path); !problem.empty())
       throw InputError(SourceLocation{path, 0, ""}, "not a readable Exodus II file: " + problem);
     const ExodusFile f(path);
     // Names longer than the library's default of 32 characters would come back cut.
