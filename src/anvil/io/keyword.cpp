@@ -1724,17 +1724,20 @@ Config KeywordReader::config(const std::string& deck_file) {
   // Probes: *DATABASE_HISTORY_NODE, at the node's position (anvil probes the nearest node,
   // the lowest id among coincident ones).
   std::set<std::int64_t> probed;
+  std::map<std::array<double, 3>, std::int64_t> first_at; // position -> first node there
+  if (!history_nodes_.empty())
+    for (std::size_t j = 0; j < nodes_.size(); ++j)
+      first_at.emplace(std::array<double, 3>{nodes_[j].x, nodes_[j].y, nodes_[j].z},
+                       static_cast<std::int64_t>(j));
   for (const auto& [nid, at] : history_nodes_) {
     const auto pos = node_position(nid, at, "*DATABASE_HISTORY_NODE", "the history node list");
     if (!probed.insert(nid).second) continue;
     const Vec3 x = nodes_[pos];
-    for (std::int64_t j = 0; j < pos; ++j)
-      if (nodes_[j] == x) {
-        warnings.push_back(fmt::format("{}: history node {} lies on node {} (same coordinates); "
-                                       "the probe follows node {}",
-                                       at.str(), nid, node_ids_[j], node_ids_[j]));
-        break;
-      }
+    const std::int64_t j = first_at.at({x.x, x.y, x.z});
+    if (j != pos)
+      warnings.push_back(fmt::format("{}: history node {} lies on node {} (same coordinates); "
+                                     "the probe follows node {}",
+                                     at.str(), nid, node_ids_[j], node_ids_[j]));
     c.probes.push_back(
         ProbeConfig{fmt::format("node{}", nid), x, at.loc("*DATABASE_HISTORY_NODE")});
   }
