@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "anvil/core/error.hpp"
-#include "anvil/io/deck.hpp"
 #include "anvil/io/decompose.hpp"
+#include "anvil/io/input.hpp"
 #include "anvil/parallel/comm.hpp"
 #include "anvil/solver/can_crush.hpp"
 #include "anvil/solver/run.hpp"
@@ -19,8 +19,15 @@
 
 namespace {
 
+// What the deck reader accepted but could not take over exactly, on rank 0.
+void print_warnings(const anvil::Config& config, const anvil::Comm& comm) {
+  if (comm.rank() != 0) return;
+  for (const auto& w : config.warnings) std::fprintf(stderr, "anvil: warning: %s\n", w.c_str());
+}
+
 int check(const std::string& deck, const anvil::Comm& comm) {
-  const anvil::Config config = anvil::read_deck(deck);
+  const anvil::Config config = anvil::read_input(deck);
+  print_warnings(config, comm);
   anvil::Simulation sim(config, comm);
   const double dt = sim.stable_time_step();
   // Particle sets: mass per set (a reduction: before rank 0 prints alone).
@@ -76,7 +83,7 @@ int main(int argc, char** argv) {
   std::string deck, outdir = "out";
   bool quiet = false;
   auto* run = app.add_subcommand("run", "run a deck (under mpirun -np P for P ranks)");
-  run->add_option("deck", deck, "the YAML deck")->required();
+  run->add_option("deck", deck, "the deck: YAML, or LS-DYNA keyword (.k, .key, .dyn)")->required();
   run->add_option("-o,--output", outdir, "output directory")->capture_default_str();
   run->add_flag("-q,--quiet", quiet, "no progress line");
   std::string restart;
@@ -84,9 +91,14 @@ int main(int argc, char** argv) {
   run->add_option("--restart", restart, "continue from a checkpoint (any number of ranks)");
   run->add_option("--stop-at-cycle", stop_at, "stop as if by SIGTERM at this cycle (testing)")
       ->group("");
+  std::string format;
+  run->add_option("--format", format,
+                  "field output format, overriding the deck's output.format (a keyword deck "
+                  "has none)")
+      ->check(CLI::IsMember({"vtu", "exodus", "both"}));
   auto* chk =
       app.add_subcommand("check", "validate a deck and its mesh; print counts, masses, stable dt");
-  chk->add_option("deck", deck, "the YAML deck")->required();
+  chk->add_option("deck", deck, "the deck: YAML, or LS-DYNA keyword (.k, .key, .dyn)")->required();
 
   auto* dec =
       app.add_subcommand("decompose", "under mpirun: the decompositions at t = 0, as VTU and JSON");
@@ -127,12 +139,16 @@ int main(int argc, char** argv) {
 
   try {
     if (*run) {
-      const anvil::Config config = anvil::read_deck(deck);
+      anvil::Config config = anvil::read_input(deck);
+      print_warnings(config, comm);
+      if (format == "vtu") config.output_format = anvil::OutputFormat::vtu;
+      if (format == "exodus") config.output_format = anvil::OutputFormat::exodus;
+      if (format == "both") config.output_format = anvil::OutputFormat::both;
       return anvil::run(config, {outdir, !quiet, restart, stop_at}, comm);
     }
     if (*chk) return check(deck, comm);
     if (*dec) {
-      anvil::write_decomposition(anvil::read_deck(deck), outdir, comm);
+      anvil::write_decomposition(anvil::read_input(deck), outdir, comm);
       return 0;
     }
     if (*can) {

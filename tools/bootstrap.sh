@@ -10,7 +10,8 @@ cd "$here"
 
 packages=(build-essential cmake clang-format libopenmpi-dev openmpi-bin libmetis-dev
           libexodusii-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev libgtest-dev
-          libbenchmark-dev python3-matplotlib python3-numpy)
+          libbenchmark-dev python3-matplotlib python3-numpy python3-netcdf4
+          clang libclang-rt-14-dev)  # clang + compiler-rt: sanitizers and libFuzzer (tools/ci_extra.sh)
 if [ "${ANVIL_SKIP_APT:-0}" != 1 ]; then
   missing=()
   for p in "${packages[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done

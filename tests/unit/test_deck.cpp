@@ -2,6 +2,8 @@
 // InputError naming file, line and key.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include "anvil/io/deck.hpp"
 #include "test_support.hpp"
 
@@ -121,6 +123,28 @@ TEST(Deck, MissingMeshFile) {
   expect_error("{generate: cylinder, radius: 3.2e-3, length: 32.4e-3, axis: z, divisions: [8, 40]}",
                "{file: no_such_mesh.exo}",
                {"deck.yaml:9", "parts.bar.mesh.file", "does not exist"});
+}
+
+// Divisions whose node count would overflow the generators' arithmetic (a box of
+// 4194303^3 elements wraps its node count to 0) stop at the deck.
+TEST(Deck, HugeGeneratedMeshesAreRejected) {
+  for (const char* mesh :
+       {"{generate: box, min: [0,0,0], max: [1,1,1], divisions: [4194303, 4194303, 4194303]}",
+        "{generate: cylinder, radius: 1, length: 1, divisions: [100000000, 1]}",
+        "{generate: can, radius: 1, height: 1, thickness: 0.1, divisions: [100000, 100000, 1]}"}) {
+    SCOPED_TRACE(mesh);
+    try {
+      test::deck(fmt::format("termination: {{cycles: 1}}\nmaterials:\n  s: {{model: elastic, "
+                             "density: 1, youngs_modulus: 1, poissons_ratio: 0}}\nparts:\n  p:\n"
+                             "    mesh: {}\n    material: s\n",
+                             mesh));
+      ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("test.yaml:6: parts.p.mesh.divisions"),
+                std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 } // namespace

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,12 +30,16 @@ struct MaterialConfig {
 };
 
 struct MeshConfig {
-  enum class Kind { box, cylinder, can, file };
+  // embedded: the mesh came with the deck (an LS-DYNA keyword deck holds its nodes and
+  // elements); parts that share one embedded mesh share its nodes.
+  enum class Kind { box, cylinder, can, file, embedded };
   Kind kind = Kind::box;
   BoxSpec box;
   CylinderSpec cylinder;
   CanSpec can;
-  std::string file; // resolved relative to the deck's directory
+  std::string file;                     // resolved relative to the deck's directory
+  std::shared_ptr<const Mesh> embedded; // Kind::embedded: the deck's mesh, shared by parts
+  std::size_t embedded_block = 0;       // Kind::embedded: this part's block in it
   SourceLocation where;
 };
 
@@ -138,6 +143,9 @@ struct ProbeConfig {
   SourceLocation where;
 };
 
+// Which field files a run writes (DESIGN.md section 4, `output.format`).
+enum class OutputFormat { vtu, exodus, both };
+
 struct Config {
   std::string title;
   std::string deck_file;
@@ -148,6 +156,7 @@ struct Config {
   double fields_every = 0;               // 0: first and last only
   double checkpoint_every = 0;           // 0: checkpoints only when stopped by a signal
   double history_every = 0;              // 0: every cycle
+  OutputFormat output_format = OutputFormat::vtu;
   std::vector<MaterialConfig> materials;
   std::vector<PartConfig> parts;
   std::vector<ParticleSetConfig> particles;
@@ -158,6 +167,9 @@ struct Config {
   std::vector<ProbeConfig> probes;
   std::vector<ContactConfig> contact; // at most one
   std::vector<RigidWallConfig> rigid_walls;
+  // What the reader accepted but could not take over exactly (an LS-DYNA keyword that
+  // anvil ignores, a material option it approximates); the command line prints them.
+  std::vector<std::string> warnings;
 
   const MaterialConfig* material(const std::string& name) const;
   // Index of the particle set of that name, or -1.

@@ -176,6 +176,7 @@ std::vector<std::string> generated_sets(MeshConfig::Kind kind) {
   case MeshConfig::Kind::can:
     return {"bottom", "top", "inner", "outer"};
   case MeshConfig::Kind::file:
+  case MeshConfig::Kind::embedded:
     return {};
   }
   return {};
@@ -257,8 +258,10 @@ MaterialConfig parse_material(const std::string& name, const Node& n) {
       parse_eos(m, v);
       continue;
     }
+    // A named copy: clang before 16 cannot capture a structured binding in a lambda.
+    const std::string& name = key;
     const auto spec = std::find_if(info->params.begin(), info->params.end(),
-                                   [&](const ParamSpec& p) { return p.name == key; });
+                                   [&](const ParamSpec& p) { return p.name == name; });
     if (spec == info->params.end()) {
       std::string list;
       for (const auto& p : info->params) list += (list.empty() ? "" : ", ") + std::string(p.name);
@@ -272,6 +275,30 @@ MaterialConfig parse_material(const std::string& name, const Node& n) {
                      "melt_temperature must exceed room_temperature");
   return m;
 }
+
+// Elements a generator would make (as a double: the product of three divisions of up to
+// 1e8 overflows any integer).
+double generated_elements(const MeshConfig& mc) {
+  switch (mc.kind) {
+  case MeshConfig::Kind::box:
+    return 1.0 * mc.box.divisions[0] * mc.box.divisions[1] * mc.box.divisions[2];
+  case MeshConfig::Kind::cylinder: {
+    const double c = std::max(1, mc.cylinder.divisions[0] / 2), n = 2 * c;
+    const double ring = mc.cylinder.divisions[0] - c;
+    return (n * n + 4 * n * ring) * mc.cylinder.divisions[1];
+  }
+  case MeshConfig::Kind::can:
+    return 1.0 * mc.can.divisions[0] * mc.can.divisions[1] * mc.can.divisions[2];
+  case MeshConfig::Kind::file:
+  case MeshConfig::Kind::embedded:
+    return 0;
+  }
+  return 0;
+}
+
+// Every rank builds the whole mesh, and the generators count in 32-bit integers in places:
+// a part is capped well below both limits.
+constexpr double max_generated_elements = 1e9;
 
 MeshConfig parse_mesh(const Node& n, const std::string& base_dir) {
   MeshConfig mc;
@@ -322,6 +349,11 @@ MeshConfig parse_mesh(const Node& n, const std::string& base_dir) {
     n.child("generate")
         .fail(fmt::format("unknown generator '{}' (expected box, cylinder or can)", gen));
   }
+  if (const double count = generated_elements(mc); count > max_generated_elements)
+    n.child("divisions")
+        .fail(fmt::format("these divisions make {:.3g} elements; a generated part may have at "
+                          "most {:.0e}",
+                          count, max_generated_elements));
   return mc;
 }
 
@@ -770,9 +802,21 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 
   if (top.has("output")) {
     const Node o = top.child("output");
-    o.check_keys({"fields_every", "history_every"});
+    o.check_keys({"fields_every", "history_every", "format"});
     if (o.has("fields_every")) c.fields_every = o.child("fields_every").positive();
     if (o.has("history_every")) c.history_every = o.child("history_every").positive();
+    if (o.has("format")) {
+      const std::string f = o.child("format").str();
+      if (f == "vtu")
+        c.output_format = OutputFormat::vtu;
+      else if (f == "exodus")
+        c.output_format = OutputFormat::exodus;
+      else if (f == "both")
+        c.output_format = OutputFormat::both;
+      else
+        o.child("format").fail(
+            fmt::format("unknown output format '{}' (expected vtu, exodus or both)", f));
+    }
   }
   return c;
 }

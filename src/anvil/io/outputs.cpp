@@ -135,6 +135,23 @@ VtuPiece particle_piece(const Simulation& sim) {
   return p;
 }
 
+// Runs `write` on every rank; if it fails on any, every rank throws the InputError of the
+// lowest failing rank (a write error on one rank must not leave the others waiting).
+template <class F>
+void collective_write(const Comm& comm, F&& write) {
+  std::string err;
+  try {
+    write();
+  } catch (const InputError& e) {
+    err = e.what();
+  }
+  const std::int64_t failed = comm.min(err.empty() ? static_cast<std::int64_t>(comm.size())
+                                                   : static_cast<std::int64_t>(comm.rank()));
+  if (failed == comm.size()) return;
+  comm.broadcast(err, static_cast<int>(failed));
+  throw InputError(err);
+}
+
 Outputs::Outputs(const Simulation& sim, OutputOptions options)
     : sim_(sim), opt_(std::move(options)) {
   // Rank 0 creates the directories; the others wait for it.
@@ -143,7 +160,8 @@ Outputs::Outputs(const Simulation& sim, OutputOptions options)
   if (sim_.comm().rank() == 0) {
     try {
       make_directories(opt_.directory);
-      make_directories(opt_.directory + "/fields");
+      if (sim_.config().output_format != OutputFormat::exodus || sim_.sph())
+        make_directories(opt_.directory + "/fields");
     } catch (const InputError& e) {
       ok = 0;
       err = e.what();
@@ -185,6 +203,7 @@ void Outputs::begin() {
   // The first row is the state the deck gave, at t = 0 (collective).
   const Sample initial = sim_.sample();
   write_history_row(initial);
+  if (c.output_format != OutputFormat::vtu) open_exodus("results");
   write_fields();
   next_fields_ = c.fields_every > 0 ? c.fields_every : std::numeric_limits<double>::infinity();
   next_history_ = c.history_every;
@@ -197,6 +216,14 @@ void Outputs::resume(const OutputState& state) {
   field_count_ = state.field_count;
   pvd_ = state.pvd;
   last_field_cycle_ = sim_.clock().cycle; // the fields at the checkpoint were written then
+  // A restart may run on another number of ranks, so the Exodus files of the first run
+  // cannot be extended: the continuation goes to results-sCYCLE.exo[.P.R], starting with
+  // the checkpoint's state (the earlier files stay as they were).
+  if (sim_.config().output_format != OutputFormat::vtu) {
+    open_exodus(fmt::format("results-s{:06d}", sim_.clock().cycle));
+    VtuPiece piece = fe_piece(sim_);
+    collective_write(sim_.comm(), [&] { exodus_->write_step(sim_.clock().time, piece); });
+  }
   if (sim_.comm().rank() != 0) return;
   // Keep the history rows before the restart time (a killed run may have written rows past
   // its last checkpoint), then append.
@@ -262,13 +289,25 @@ void Outputs::after_step() {
   progress(last);
 }
 
+void Outputs::open_exodus(const std::string& stem) {
+  const VtuPiece layout = fe_piece(sim_); // collective: every rank lists the same arrays
+  collective_write(sim_.comm(), [&] {
+    exodus_ = std::make_unique<ExodusWriter>(
+        exodus_path(opt_.directory, sim_.comm().size(), sim_.comm().rank(), stem), sim_, layout);
+  });
+}
+
 void Outputs::write_fields() {
   const Clock& clk = sim_.clock();
   if (last_field_cycle_ == clk.cycle) return;
   last_field_cycle_ = clk.cycle;
-  const std::string stem = fmt::format("step_{:06d}", field_count_++);
   VtuPiece piece = fe_piece(sim_);
   piece.time = clk.time;
+  if (exodus_) collective_write(sim_.comm(), [&] { exodus_->write_step(clk.time, piece); });
+  const std::string stem = fmt::format("step_{:06d}", field_count_++);
+  // Particles have no place in the Exodus files: they are always written as VTU.
+  if (sim_.sph()) write_particles(stem);
+  if (sim_.config().output_format == OutputFormat::exodus) return;
   write_vtu(fmt::format("{}/fields/{}_r{:04d}.vtu", opt_.directory, stem, sim_.comm().rank()),
             piece);
   sim_.comm().barrier(); // every piece is complete before the index names it
@@ -280,7 +319,6 @@ void Outputs::write_fields() {
     pvd_.emplace_back(clk.time, fmt::format("fields/{}.pvtu", stem));
     write_pvd(opt_.directory + "/results.pvd", pvd_);
   }
-  if (sim_.sph()) write_particles(stem);
 }
 
 // The particles of the same output as their own series (particles.pvd): one .vtu piece

@@ -1,15 +1,18 @@
 // The results of a run in OUTDIR (DESIGN.md section 4): results.pvd with a .pvtu and
-// per-rank .vtu pieces per field output, history.csv (energies and probes), and
-// summary.json; plus the progress line on rank 0. Every method is collective.
+// per-rank .vtu pieces per field output and/or Exodus II files (exodus.hpp), as the deck's
+// output.format says, history.csv (energies and probes), and summary.json; plus the
+// progress line on rank 0. Every method is collective.
 #pragma once
 
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "anvil/io/checkpoint.hpp"
+#include "anvil/io/exodus.hpp"
 #include "anvil/io/vtu.hpp"
 #include "anvil/solver/simulation.hpp"
 
@@ -43,6 +46,7 @@ private:
   void write_fields();
   std::string history_header() const;
   void write_particles(const std::string& stem);
+  void open_exodus(const std::string& stem);
   void write_history_row(const Sample& s);
   void write_summary(int status, const std::string& message);
   void progress(bool last);
@@ -51,6 +55,8 @@ private:
   OutputOptions opt_;
   std::vector<std::pair<double, std::string>> pvd_;
   std::vector<std::pair<double, std::string>> particle_pvd_;
+  std::unique_ptr<ExodusWriter> exodus_; // this rank's Exodus file, when the format asks
+
   std::FILE* history_ = nullptr;
   double next_fields_ = 0, next_history_ = 0;
   std::int64_t last_field_cycle_ = -1;

@@ -63,7 +63,8 @@ void require(bool ok, const char* what) {
 } // namespace
 
 Mesh generate_box(const BoxSpec& s) {
-  const auto [nx, ny, nz] = s.divisions;
+  // Plain names, not a structured binding: clang before 16 cannot capture one in a lambda.
+  const int nx = s.divisions[0], ny = s.divisions[1], nz = s.divisions[2];
   require(nx > 0 && ny > 0 && nz > 0, "box divisions must be positive");
   require(s.max.x > s.min.x && s.max.y > s.min.y && s.max.z > s.min.z,
           "box max must exceed min in every direction");
@@ -196,7 +197,7 @@ Mesh generate_can(const CanSpec& s) {
   require(s.radius > 0 && s.height > 0 && s.thickness > 0,
           "can radius, height and thickness must be positive");
   require(s.thickness < 2 * s.radius, "can wall thickness must be less than its diameter");
-  const auto [na, nh, nt] = s.divisions;
+  const int na = s.divisions[0], nh = s.divisions[1], nt = s.divisions[2];
   require(na >= 3 && nh >= 1 && nt >= 1,
           "can divisions need >= 3 around, >= 1 along the axis, >= 1 through the wall");
   std::vector<std::array<double, 2>> pts;

@@ -1,18 +1,28 @@
 #include "anvil/mesh/read_exodus.hpp"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <new>
+#include <optional>
 #include <stdexcept>
+#include <string_view>
 #include <vector>
 
 #include <exodusII.h>
 #include <fmt/format.h>
+#include <netcdf.h>
 
 #include "anvil/core/error.hpp"
 
@@ -41,6 +51,8 @@ public:
 
   int id() const { return id_; }
   const std::string& path() const { return path_; }
+  // Whether the coordinates are three variables (coordx, ...) rather than one (coord).
+  bool stored_coordinates_separately() const { return stored_values("coordx") >= 0; }
 
   [[noreturn]] void fail(const std::string& message) const {
     throw InputError(SourceLocation{path_, 0, ""}, message);
@@ -51,7 +63,43 @@ public:
     if (rc < 0) fail(fmt::format("cannot read {}{}", what, library_message()));
   }
 
+  // Throws unless the netCDF variable `var` stores exactly `n` values. The Exodus library
+  // reads whole variables into the caller's buffer, sized from the counts it reports
+  // (dimensions of their own): in a corrupt file the two disagree, and the read would
+  // write past the buffer. Every bulk read is checked with this first.
+  void expect_values(const std::string& var, std::int64_t n, const std::string& what) const {
+    const std::int64_t have = stored_values(var);
+    if (have != n)
+      fail(fmt::format("{} is corrupt: its variable {} {} where the counts give {}", what, var,
+                       have < 0 ? std::string("is missing or malformed")
+                                : fmt::format("holds {} values", have),
+                       n));
+  }
+
 private:
+  // Values the netCDF variable `var` holds (the product of its dimensions, the record
+  // dimension at its current length), or -1 when the file has no such variable. The
+  // Exodus file id is the netCDF id.
+  std::int64_t stored_values(const std::string& var) const {
+    int varid = -1, ndims = 0;
+    if (nc_inq_varid(id_, var.c_str(), &varid) != NC_NOERR) return -1;
+    if (nc_inq_varndims(id_, varid, &ndims) != NC_NOERR || ndims < 0 || ndims > NC_MAX_VAR_DIMS)
+      return -1;
+    int dims[NC_MAX_VAR_DIMS];
+    if (nc_inq_vardimid(id_, varid, dims) != NC_NOERR) return -1;
+    std::int64_t total = 1;
+    for (int d = 0; d < ndims; ++d) {
+      std::size_t len = 0;
+      if (nc_inq_dimlen(id_, dims[d], &len) != NC_NOERR) return -1;
+      if (len != 0 &&
+          static_cast<std::uint64_t>(total) >
+              static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()) / len)
+        return -1;
+      total *= static_cast<std::int64_t>(len);
+    }
+    return total;
+  }
+
   // The Exodus library's own explanation of its last error, for the user.
   static std::string library_message() {
     const char* msg = nullptr;
@@ -176,6 +224,39 @@ std::string classic_netcdf_problem(const std::string& path) {
   return "";
 }
 
+// Returns what in the file would make the Exodus library write past its own buffers, or an
+// empty string. Opening the file reads global attributes into single numbers (more values
+// overflow them), and reading a block copies its element type into a buffer of
+// MAX_STR_LENGTH + 1 characters: both are checked through netCDF before the library sees
+// the file. A file netCDF cannot open is left to ex_open to report.
+std::string exodus_attribute_problem(const std::string& path) {
+  int ncid = -1;
+  if (nc_open(path.c_str(), NC_NOWRITE, &ncid) != NC_NOERR) return "";
+  std::string problem;
+  for (const char* att : {"api_version", "version", "floating_point_word_size", "file_size",
+                          "maximum_name_length", "int64_status", "last_written_time"}) {
+    std::size_t len = 0;
+    if (nc_inq_attlen(ncid, NC_GLOBAL, att, &len) == NC_NOERR && len != 1) {
+      problem = fmt::format("the global attribute {} has {} values instead of one", att, len);
+      break;
+    }
+  }
+  int nvars = 0;
+  if (problem.empty() && nc_inq_nvars(ncid, &nvars) == NC_NOERR) {
+    for (int v = 0; v < nvars && problem.empty(); ++v) {
+      std::size_t len = 0;
+      char name[NC_MAX_NAME + 1] = {};
+      if (nc_inq_varname(ncid, v, name) != NC_NOERR) continue;
+      if (std::string_view(name).substr(0, 7) != "connect") continue;
+      if (nc_inq_attlen(ncid, v, "elem_type", &len) == NC_NOERR && len > MAX_STR_LENGTH)
+        problem = fmt::format("the element type of {} has {} characters (at most {})", name, len,
+                              MAX_STR_LENGTH);
+    }
+  }
+  nc_close(ncid);
+  return problem;
+}
+
 // Names of the `count` entities of `type` in file order; an empty string where the file
 // gives none.
 std::vector<std::string> entity_names(const ExodusFile& f, ex_entity_type type, std::int64_t count,
@@ -197,10 +278,21 @@ std::vector<std::string> entity_names(const ExodusFile& f, ex_entity_type type, 
   return out;
 }
 
+// Ids of the `count` entities of `type` in file order; two entities with one id are an
+// error (the library would give both the first one's data).
 std::vector<std::int64_t> entity_ids(const ExodusFile& f, ex_entity_type type, std::int64_t count,
                                      const char* what) {
   std::vector<std::int64_t> ids(static_cast<std::size_t>(count));
-  if (count > 0) f.check(ex_get_ids(f.id(), type, ids.data()), what);
+  if (count == 0) return ids;
+  const char* var = type == EX_ELEM_BLOCK ? "eb_prop1"
+                    : type == EX_NODE_SET ? "ns_prop1"
+                                          : "ss_prop1";
+  f.expect_values(var, count, what);
+  f.check(ex_get_ids(f.id(), type, ids.data()), what);
+  std::vector<std::int64_t> sorted = ids;
+  std::sort(sorted.begin(), sorted.end());
+  if (const auto dup = std::adjacent_find(sorted.begin(), sorted.end()); dup != sorted.end())
+    f.fail(fmt::format("{}: two entities have id {}", what, *dup));
   return ids;
 }
 
@@ -242,6 +334,12 @@ Mesh read_all(const ExodusFile& f) {
   const std::int64_t nn = init.num_nodes;
   if (nn > 0) {
     std::vector<double> x(nn), y(nn), z(nn);
+    if (f.stored_coordinates_separately()) {
+      for (const char* var : {"coordx", "coordy", "coordz"})
+        f.expect_values(var, nn, "the node coordinates");
+    } else {
+      f.expect_values("coord", 3 * nn, "the node coordinates");
+    }
     f.check(ex_get_coord(f.id(), x.data(), y.data(), z.data()), "the node coordinates");
     mesh.nodes.resize(nn);
     for (std::int64_t i = 0; i < nn; ++i) {
@@ -260,8 +358,10 @@ Mesh read_all(const ExodusFile& f) {
     const std::int64_t bid = block_ids[b];
     const std::string name = block_names[b].empty() ? fmt::format("block_{}", bid) : block_names[b];
     const std::string label = fmt::format("element block '{}' (id {})", name, bid);
-    // Larger than MAX_STR_LENGTH + 1, which is all the library writes.
-    std::vector<char> type(256, '\0');
+    // The library copies the element type attribute into this buffer; its length was
+    // checked against MAX_STR_LENGTH before the file was opened (exodus_attribute_problem).
+    const std::string conn_var = fmt::format("connect{}", b + 1);
+    std::vector<char> type(MAX_STR_LENGTH + 2, '\0');
     std::int64_t count = 0, npe = 0, edges = 0, faces = 0, attrs = 0;
     f.check(
         ex_get_block(f.id(), EX_ELEM_BLOCK, bid, type.data(), &count, &npe, &edges, &faces, &attrs),
@@ -279,6 +379,7 @@ Mesh read_all(const ExodusFile& f) {
     fits(count * npe, "connectivity entries in " + label);
     ElementBlock eb{name, {}};
     if (count > 0) {
+      f.expect_values(conn_var, count * npe, "the connectivity of " + label);
       std::vector<std::int64_t> conn(static_cast<std::size_t>(count * npe));
       f.check(ex_get_conn(f.id(), EX_ELEM_BLOCK, bid, conn.data(), nullptr, nullptr),
               "the connectivity of " + label);
@@ -312,7 +413,10 @@ Mesh read_all(const ExodusFile& f) {
     if (count < 0) f.fail(label + " has a negative size");
     fits(count, "entries in " + label);
     std::vector<std::int64_t> ids(static_cast<std::size_t>(count));
-    if (count > 0) f.check(ex_get_set(f.id(), EX_NODE_SET, ns_ids[s], ids.data(), nullptr), label);
+    if (count > 0) {
+      f.expect_values(fmt::format("node_ns{}", s + 1), count, label);
+      f.check(ex_get_set(f.id(), EX_NODE_SET, ns_ids[s], ids.data(), nullptr), label);
+    }
     for (auto& n : ids) {
       if (n < 1 || n > nn)
         f.fail(fmt::format("{} contains node {}, but the file has nodes 1 to {}", label, n, nn));
@@ -336,8 +440,11 @@ Mesh read_all(const ExodusFile& f) {
     if (count < 0) f.fail(label + " has a negative size");
     fits(count, "entries in " + label);
     std::vector<std::int64_t> elems(static_cast<std::size_t>(count)), sides(elems.size());
-    if (count > 0)
+    if (count > 0) {
+      f.expect_values(fmt::format("elem_ss{}", s + 1), count, label);
+      f.expect_values(fmt::format("side_ss{}", s + 1), count, label);
       f.check(ex_get_set(f.id(), EX_SIDE_SET, ss_ids[s], elems.data(), sides.data()), label);
+    }
     std::vector<SideEntry> entries;
     entries.reserve(elems.size());
     for (std::size_t i = 0; i < elems.size(); ++i) {
@@ -357,9 +464,14 @@ Mesh read_all(const ExodusFile& f) {
 
 } // namespace
 
-Mesh read_exodus(const std::string& path) {
+namespace {
+
+// Reads the file in this process: the path for files whose format anvil validates itself.
+Mesh read_here(const std::string& path) {
   try {
     if (const auto problem = classic_netcdf_problem(path); !problem.empty())
+      throw InputError(SourceLocation{path, 0, ""}, "not a readable Exodus II file: " + problem);
+    if (const auto problem = exodus_attribute_problem(path); !problem.empty())
       throw InputError(SourceLocation{path, 0, ""}, "not a readable Exodus II file: " + problem);
     const ExodusFile f(path);
     // Names longer than the library's default of 32 characters would come back cut.
@@ -377,6 +489,210 @@ Mesh read_exodus(const std::string& path) {
     throw InputError(SourceLocation{path, 0, ""},
                      "the file declares more entities than fit in memory (corrupt header?)");
   }
+}
+
+// A byte stream for the child's answer: a Mesh or an error, length-prefixed fields.
+struct Writer {
+  std::string out;
+  template <class T>
+  void pod(const T& v) {
+    out.append(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  void str(const std::string& s) {
+    pod<std::uint64_t>(s.size());
+    out += s;
+  }
+  template <class T>
+  void vec(const std::vector<T>& v) {
+    pod<std::uint64_t>(v.size());
+    out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  }
+};
+
+struct Reader {
+  std::string_view in;
+  bool ok = true;
+  template <class T>
+  T pod() {
+    T v{};
+    if (in.size() < sizeof v) {
+      ok = false;
+      return v;
+    }
+    std::memcpy(&v, in.data(), sizeof v);
+    in.remove_prefix(sizeof v);
+    return v;
+  }
+  std::string str() {
+    const auto n = pod<std::uint64_t>();
+    if (!ok || n > in.size()) return ok = false, std::string();
+    std::string s(in.substr(0, n));
+    in.remove_prefix(n);
+    return s;
+  }
+  template <class T>
+  std::vector<T> vec() {
+    const auto n = pod<std::uint64_t>();
+    if (!ok || n > in.size() / sizeof(T)) return ok = false, std::vector<T>();
+    std::vector<T> v(n);
+    std::memcpy(v.data(), in.data(), n * sizeof(T));
+    in.remove_prefix(n * sizeof(T));
+    return v;
+  }
+};
+
+std::string encode(const Mesh& m) {
+  Writer w;
+  w.pod<char>('M');
+  w.vec(m.nodes);
+  w.pod<std::uint64_t>(m.blocks.size());
+  for (const auto& b : m.blocks) {
+    w.str(b.name);
+    w.vec(b.elements);
+  }
+  w.pod<std::uint64_t>(m.node_sets.size());
+  for (const auto& [name, ids] : m.node_sets) {
+    w.str(name);
+    w.vec(ids);
+  }
+  w.pod<std::uint64_t>(m.side_sets.size());
+  for (const auto& [name, sides] : m.side_sets) {
+    w.str(name);
+    w.vec(sides);
+  }
+  return w.out;
+}
+
+std::optional<Mesh> decode(std::string_view bytes) {
+  Reader r{bytes};
+  Mesh m;
+  m.nodes = r.vec<Vec3>();
+  for (auto n = r.pod<std::uint64_t>(); r.ok && n > 0; --n) {
+    ElementBlock b;
+    b.name = r.str();
+    b.elements = r.vec<Hex>();
+    m.blocks.push_back(std::move(b));
+  }
+  for (auto n = r.pod<std::uint64_t>(); r.ok && n > 0; --n) {
+    auto name = r.str();
+    m.node_sets[name] = r.vec<std::int64_t>();
+  }
+  for (auto n = r.pod<std::uint64_t>(); r.ok && n > 0; --n) {
+    auto name = r.str();
+    m.side_sets[name] = r.vec<SideEntry>();
+  }
+  if (!r.ok || !r.in.empty()) return std::nullopt;
+  return m;
+}
+
+// Reads the file in a child process and returns its mesh or rethrows its InputError. For
+// netCDF-4 (HDF5) files, which only the HDF5 library can check: it crashes on corrupt
+// files (fuzz/fuzz_exodus found several in seconds), and a crash in the child is an input
+// error here. The child uses no MPI and leaves by _exit.
+Mesh read_in_child(const std::string& path) {
+  int fds[2];
+  if (::pipe(fds) != 0) return read_here(path); // no pipe: no isolation, but a reading
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    return read_here(path);
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    // A crash here is the parent's input error: no backtrace from the handlers that MPI
+    // (or a sanitizer) installed in the parent.
+    for (int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL}) std::signal(sig, SIG_DFL);
+    std::string out;
+    try {
+      out = encode(read_here(path));
+    } catch (const InputError& e) {
+      // The location and the bare message (what() is "location: message").
+      const std::string prefix = e.where().str() + ": ";
+      std::string message = e.what();
+      if (message.rfind(prefix, 0) == 0) message.erase(0, prefix.size());
+      Writer w;
+      w.pod<char>('E');
+      w.str(e.where().file);
+      w.pod<std::int64_t>(e.where().line);
+      w.str(e.where().key);
+      w.str(message);
+      out = w.out;
+    } catch (...) {
+      Writer w;
+      w.pod<char>('E');
+      w.str(path);
+      w.pod<std::int64_t>(0);
+      w.str("");
+      w.str("the file cannot be read");
+      out = w.out;
+    }
+    for (std::size_t done = 0; done < out.size();) {
+      const auto n = ::write(fds[1], out.data() + done, out.size() - done);
+      if (n <= 0) break;
+      done += static_cast<std::size_t>(n);
+    }
+    ::_exit(0);
+  }
+  ::close(fds[1]);
+  std::string in;
+  char buf[65536];
+  for (;;) {
+    const auto n = ::read(fds[0], buf, sizeof buf);
+    if (n > 0) {
+      in.append(buf, static_cast<std::size_t>(n));
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    break;
+  }
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  const SourceLocation where{path, 0, ""};
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    throw InputError(
+        where, fmt::format("not a readable Exodus II file: the netCDF-4/HDF5 library "
+                           "failed on it ({}); the file is corrupt",
+                           WIFSIGNALED(status) ? strsignal(WTERMSIG(status)) : "abnormal exit"));
+  if (!in.empty() && in[0] == 'E') {
+    Reader r{std::string_view(in).substr(1)};
+    SourceLocation at;
+    at.file = r.str();
+    at.line = static_cast<int>(r.pod<std::int64_t>());
+    at.key = r.str();
+    const std::string message = r.str();
+    if (r.ok) throw InputError(at, message);
+    throw InputError(where, "not a readable Exodus II file (its reading ended early)");
+  }
+  std::optional<Mesh> m;
+  if (!in.empty() && in[0] == 'M') m = decode(std::string_view(in).substr(1));
+  if (!m) throw InputError(where, "not a readable Exodus II file (its reading ended early)");
+  return std::move(*m);
+}
+
+// Whether the file carries the HDF5 signature where the HDF5 library looks for it (at 0,
+// 512, 1024, 2048, ... bytes): a netCDF-4 file, read by the HDF5 library.
+bool is_hdf5(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  in.seekg(0, std::ios::end);
+  const auto size = static_cast<std::int64_t>(in.tellg());
+  static constexpr char signature[8] = {'\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
+  for (std::int64_t at = 0; at + 8 <= size; at = at == 0 ? 512 : 2 * at) {
+    char magic[8] = {};
+    in.seekg(at);
+    if (in.read(magic, 8) && std::memcmp(magic, signature, 8) == 0) return true;
+  }
+  return false;
+}
+
+} // namespace
+
+Mesh read_exodus(const std::string& path) {
+  return is_hdf5(path) ? read_in_child(path) : read_here(path);
 }
 
 } // namespace anvil

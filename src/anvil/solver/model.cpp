@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <new>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
+#include "anvil/io/keyword.hpp"
 #include "anvil/mesh/generators.hpp"
 #include "anvil/mesh/read_exodus.hpp"
 #include "anvil/mesh/read_gmsh.hpp"
@@ -25,6 +27,7 @@ MeshReader mesh_reader(const std::string& path) {
   if (ext == ".exo" || ext == ".e" || ext == ".g" || ext == ".gen" || ext == ".ex2")
     return &read_exodus;
   if (ext == ".msh") return &read_gmsh;
+  if (is_keyword_file(path)) return &read_keyword_mesh;
   return nullptr;
 }
 
@@ -38,16 +41,22 @@ Mesh part_mesh(const PartConfig& p) {
     case MeshConfig::Kind::can:
       return generate_can(p.mesh.can);
     case MeshConfig::Kind::file:
+    case MeshConfig::Kind::embedded:
       break;
     }
   } catch (const std::invalid_argument& e) {
     throw InputError(p.mesh.where, e.what());
+  } catch (const std::bad_alloc&) {
+    throw InputError(p.mesh.where, "the generated mesh does not fit in memory");
+  } catch (const std::length_error&) {
+    throw InputError(p.mesh.where, "the generated mesh does not fit in memory");
   }
   const auto reader = mesh_reader(p.mesh.file);
   if (!reader)
     throw InputError(p.mesh.where,
                      fmt::format("cannot read mesh file '{}': unknown format (expected "
-                                 ".exo, .e, .g, .gen or .ex2 for Exodus II, .msh for Gmsh)",
+                                 ".exo, .e, .g, .gen or .ex2 for Exodus II, .msh for Gmsh, "
+                                 ".k, .key or .dyn for an LS-DYNA keyword file)",
                                  p.mesh.file));
   try {
     return reader(p.mesh.file);
@@ -67,7 +76,33 @@ std::size_t part_index(const Config& c, const std::string& name) {
 
 Mesh build_mesh(const Config& config) {
   Mesh mesh;
+  // Parts of one embedded mesh (a keyword deck) share its nodes: the nodes and node sets
+  // are appended once, with the first such part, and each part takes its own block.
+  std::vector<std::pair<const Mesh*, std::int64_t>> embedded_offset;
   for (const auto& p : config.parts) {
+    if (p.mesh.kind == MeshConfig::Kind::embedded) {
+      const Mesh* src = p.mesh.embedded.get();
+      if (!src || p.mesh.embedded_block >= src->blocks.size())
+        throw InputError(p.mesh.where, "the part's embedded mesh is missing");
+      auto it = std::find_if(embedded_offset.begin(), embedded_offset.end(),
+                             [&](const auto& e) { return e.first == src; });
+      if (it == embedded_offset.end()) {
+        const std::int64_t shift = mesh.num_nodes();
+        mesh.nodes.insert(mesh.nodes.end(), src->nodes.begin(), src->nodes.end());
+        for (const auto& [name, ids] : src->node_sets) {
+          auto& dst = mesh.node_sets[name];
+          for (const auto id : ids) dst.push_back(id + shift);
+        }
+        embedded_offset.emplace_back(src, shift);
+        it = std::prev(embedded_offset.end());
+      }
+      ElementBlock b{p.name, src->blocks[p.mesh.embedded_block].elements};
+      for (auto& h : b.elements)
+        for (auto& n : h) n += it->second;
+      if (b.elements.empty()) throw InputError(p.mesh.where, "the part's mesh has no elements");
+      mesh.blocks.push_back(std::move(b));
+      continue;
+    }
     Mesh m = part_mesh(p);
     // A part is one block named after the part, whatever the source called it.
     if (m.blocks.size() != 1) {

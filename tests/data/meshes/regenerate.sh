@@ -9,3 +9,4 @@ tmp=$(mktemp -d)
 g++ -std=c++20 -O1 make_exodus.cpp -o "$tmp/make_exodus" -lexoIIv2c
 "$tmp/make_exodus" .
 rm -rf "$tmp"
+/usr/bin/python3 make_corrupt_exodus.py # needs python3-netcdf4

@@ -1,0 +1,1828 @@
+#include "anvil/io/keyword.hpp"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <limits>
+#include <map>
+#include <new>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <tuple>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+namespace anvil {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Nested *INCLUDEs deeper than this are surely a mistake (cycles are caught by name).
+constexpr int max_include_depth = 40;
+
+// Text from the deck for a message: short, and printable whatever the file holds.
+std::string shown(std::string_view s) {
+  std::string out;
+  for (char c : s.substr(0, 60)) {
+    const auto u = static_cast<unsigned char>(c);
+    out += (u >= 0x20 && u < 0x7f) ? std::string(1, c) : fmt::format("\\x{:02x}", u);
+  }
+  if (s.size() > 60) out += "...";
+  return out;
+}
+
+std::string_view trim(std::string_view s) {
+  auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; };
+  while (!s.empty() && blank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && blank(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+std::string upper(std::string_view s) {
+  std::string out(s);
+  for (auto& c : out)
+    if (c >= 'a' && c <= 'z') c = static_cast<char>(c - 'a' + 'A');
+  return out;
+}
+
+bool starts_with(std::string_view s, std::string_view prefix) {
+  return s.substr(0, prefix.size()) == prefix;
+}
+bool ends_with(std::string_view s, std::string_view suffix) {
+  return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
+}
+
+// ---- the deck as keyword blocks ---------------------------------------------------------
+
+// One data line of a keyword, and where it came from. The text lives in the Lexer's file
+// store, which outlives every Line.
+struct Line {
+  std::string_view text;
+  const std::string* file;
+  int line;
+  SourceLocation where(std::string key = "") const { return {*file, line, std::move(key)}; }
+};
+
+// One keyword (`*MAT_ELASTIC_TITLE`) with its data lines, comments removed, *INCLUDEs
+// already expanded around it.
+struct Block {
+  std::string name; // upper case, without the '*' and the format suffix
+  Line head;        // the keyword line itself
+  bool long_format = false;
+  bool i10 = false;
+  std::vector<Line> lines;
+  std::string key(std::string_view field) const { return fmt::format("*{}.{}", name, field); }
+};
+
+// Splits files into keyword blocks, following *INCLUDE and stopping at *END.
+class Lexer {
+public:
+  explicit Lexer(bool require_keyword) : require_keyword_(require_keyword) {}
+
+  // Lexes `text` (the main file); `name` names it in messages.
+  void lex_main(std::string_view text, const std::string& name, const fs::path& dir) {
+    files_.push_back(name);
+    std::vector<std::string> stack{name};
+    lex(text, &files_.back(), dir, stack, true);
+  }
+
+  std::vector<Block>& blocks() { return blocks_; }
+
+private:
+  void lex(std::string_view text, const std::string* file, const fs::path& dir,
+           std::vector<std::string>& stack, bool main_file) {
+    std::size_t pos = 0;
+    int line_no = 0;
+    std::optional<std::size_t> current; // index of the block taking data lines
+    bool in_include = false;
+    std::string pending_include; // a file name continued with " +"
+    int pending_line = 0;
+    bool seen_keyword = false;
+    // A format chosen on an included file's *KEYWORD card holds for that file only.
+    const bool outer_long = long_, outer_i10 = i10_;
+    struct Restore {
+      Lexer& l;
+      bool main, lng, i10;
+      ~Restore() {
+        if (!main) l.long_ = lng, l.i10_ = i10;
+      }
+    } restore{*this, main_file, outer_long, outer_i10};
+    while (pos < text.size()) {
+      const auto end = text.find('\n', pos);
+      const auto stop = end == std::string_view::npos ? text.size() : end;
+      std::string_view raw = text.substr(pos, stop - pos);
+      pos = stop + 1;
+      ++line_no;
+      if (!raw.empty() && raw.back() == '\r') raw.remove_suffix(1);
+      const std::string_view t = trim(raw);
+      if (!t.empty() && t.front() == '$') continue; // comment
+      const Line ln{raw, file, line_no};
+      if (!raw.empty() && raw.front() == '*') {
+        if (in_include && !pending_include.empty())
+          throw InputError({*file, pending_line, "*INCLUDE"},
+                           "the file name ends with ' +' but no continuation line follows");
+        in_include = false;
+        current.reset();
+        // `*NAME [options]`: the name runs to the first blank; '+', '-', '%' select the
+        // long, standard or I10 format for this keyword.
+        std::string_view rest = raw.substr(1);
+        const auto blank = rest.find_first_of(" \t");
+        std::string name = upper(trim(rest.substr(0, blank)));
+        const std::string options =
+            upper(blank == std::string_view::npos ? "" : trim(rest.substr(blank)));
+        bool long_format = long_, i10 = i10_;
+        auto suffix = [&](char c) {
+          if (c == '+') long_format = true;
+          if (c == '-') long_format = i10 = false;
+          if (c == '%') i10 = true;
+        };
+        while (!name.empty() && (name.back() == '+' || name.back() == '-' || name.back() == '%')) {
+          suffix(name.back());
+          name.pop_back();
+        }
+        if (options == "+" || options == "-" || options == "%") suffix(options[0]);
+        if (name.empty()) throw InputError(ln.where(), "a '*' line without a keyword name");
+        if (main_file && require_keyword_ && !seen_keyword && name != "KEYWORD")
+          throw InputError(
+              ln.where(),
+              fmt::format("an LS-DYNA keyword deck starts with *KEYWORD, found *{}", shown(name)));
+        seen_keyword = true;
+        if (name == "END") return; // the rest of this file is not read
+        if (name == "KEYWORD") {
+          keyword_options(options, ln);
+          continue;
+        }
+        if (name == "INCLUDE") {
+          in_include = true;
+          continue;
+        }
+        blocks_.push_back(Block{name, ln, long_format, i10, {}});
+        current = blocks_.size() - 1;
+        continue;
+      }
+      if (in_include) {
+        if (t.empty()) continue;
+        // A long file name continues on the next line after " +".
+        if (t.size() >= 2 && ends_with(t, " +")) {
+          if (pending_include.empty()) pending_line = line_no;
+          pending_include += std::string(trim(t.substr(0, t.size() - 2)));
+          continue;
+        }
+        std::string name = pending_include + std::string(t);
+        const int at = pending_include.empty() ? line_no : pending_line;
+        pending_include.clear();
+        include(name, Line{raw, file, at}, dir, stack);
+        continue;
+      }
+      if (!current) {
+        if (t.empty()) continue;
+        if (!seen_keyword && main_file && require_keyword_)
+          throw InputError(ln.where(), "an LS-DYNA keyword deck starts with *KEYWORD, found "
+                                       "data ('" +
+                                           shown(t) + "')");
+        throw InputError(ln.where(), fmt::format("data without a keyword: '{}'", shown(t)));
+      }
+      blocks_[*current].lines.push_back(ln);
+    }
+    if (in_include && !pending_include.empty())
+      throw InputError({*file, pending_line, "*INCLUDE"},
+                       "the file name ends with ' +' but no continuation line follows");
+    if (main_file && require_keyword_ && !seen_keyword)
+      throw InputError({*file, std::max(line_no, 1), ""},
+                       "no keywords: an LS-DYNA keyword deck starts with *KEYWORD");
+  }
+
+  // `*KEYWORD` options: LONG=Y (long format everywhere), LONG=S (standard), I10=Y; a
+  // memory size is LS-DYNA's business.
+  void keyword_options(const std::string& options, const Line& ln) {
+    std::istringstream in(options);
+    std::string tok;
+    while (in >> tok) {
+      if (tok == "LONG=Y")
+        long_ = true;
+      else if (tok == "LONG=S" || tok == "LONG=N")
+        long_ = false;
+      else if (tok == "I10=Y")
+        i10_ = true;
+      else if (tok == "I10=N")
+        i10_ = false;
+      else if (starts_with(tok, "LONG=") || starts_with(tok, "I10="))
+        throw InputError(ln.where("*KEYWORD"),
+                         fmt::format("unknown format option '{}' (expected LONG=Y, LONG=S or "
+                                     "I10=Y)",
+                                     shown(tok)));
+    }
+  }
+
+  void include(const std::string& name, const Line& ln, const fs::path& dir,
+               std::vector<std::string>& stack) {
+    fs::path p(name);
+    if (p.is_relative()) p = dir / p;
+    std::error_code ec;
+    const std::string label = p.string();
+    if (!fs::is_regular_file(p, ec))
+      throw InputError(ln.where("*INCLUDE"),
+                       fmt::format("cannot open the included file '{}'{}", shown(label),
+                                   fs::exists(p, ec) ? " (not a file)" : ""));
+    const fs::path canon = fs::weakly_canonical(p, ec);
+    const std::string id = ec ? label : canon.string();
+    if (std::find(stack.begin(), stack.end(), id) != stack.end()) {
+      std::string chain;
+      for (const auto& s : stack) chain += s + " -> ";
+      throw InputError(ln.where("*INCLUDE"),
+                       fmt::format("include cycle: {}{}", chain, shown(label)));
+    }
+    if (static_cast<int>(stack.size()) > max_include_depth)
+      throw InputError(ln.where("*INCLUDE"),
+                       fmt::format("*INCLUDE nested more than {} deep", max_include_depth));
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    if (!in && !in.eof())
+      throw InputError(ln.where("*INCLUDE"),
+                       fmt::format("cannot read the included file '{}'", shown(label)));
+    texts_.push_back(ss.str());
+    files_.push_back(label);
+    stack.push_back(id);
+    lex(texts_.back(), &files_.back(), p.parent_path(), stack, false);
+    stack.pop_back();
+  }
+
+  bool require_keyword_;
+  bool long_ = false, i10_ = false;
+  std::deque<std::string> files_; // names, stable addresses for Line::file
+  std::deque<std::string> texts_; // included files' contents, stable for Line::text
+  std::vector<Block> blocks_;
+};
+
+// ---- cards and fields -------------------------------------------------------------------
+
+// The fields of one card: fixed columns (widths adjusted for the long and I10 formats) or
+// comma-separated free format when the line holds a comma.
+class Card {
+public:
+  Card(const Block& kw, const Line& line, std::initializer_list<int> widths)
+      : kw_(kw), line_(line) {
+    const std::string_view text = line.text;
+    if (text.find(',') != std::string_view::npos) {
+      std::size_t start = 0;
+      while (count_ < max_fields) {
+        const auto comma = text.find(',', start);
+        fields_[count_++] = trim(text.substr(
+            start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+        if (comma == std::string_view::npos) break;
+        start = comma + 1;
+      }
+      return;
+    }
+    if (text.find('\t') != std::string_view::npos)
+      throw InputError(line.where(kw.key("card")),
+                       "a tab character in a fixed-format card: fields are counted in columns "
+                       "(use blanks, or commas for free format)");
+    std::size_t col = 0;
+    for (int w : widths) {
+      if (count_ == max_fields) break;
+      const std::size_t width = kw.long_format ? 20 : (kw.i10 && w < 10 ? 10 : w);
+      fields_[count_++] = col < text.size() ? trim(text.substr(col, width)) : std::string_view();
+      col += width;
+    }
+  }
+
+  bool blank(int i) const { return i >= count_ || fields_[i].empty(); }
+
+  std::int64_t integer(int i, std::string_view name, std::int64_t def = 0) const {
+    if (blank(i)) return def;
+    const std::string_view f = unparameter(i, name);
+    std::string_view s = f;
+    if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+    std::int64_t v = 0;
+    const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (ec != std::errc() || p != s.data() + s.size()) {
+      // "12." and "1.0e3" are integers written as reals; accept them when exact.
+      double d = 0;
+      if (parse_real(f, d) && d == std::floor(d) && std::abs(d) < 9e15)
+        return static_cast<std::int64_t>(d);
+      fail(name, fmt::format("{} must be an integer, found '{}'", name, shown(f)));
+    }
+    return v;
+  }
+
+  double real(int i, std::string_view name, double def = 0) const {
+    if (blank(i)) return def;
+    const std::string_view f = unparameter(i, name);
+    double v = 0;
+    if (!parse_real(f, v))
+      fail(name, fmt::format("{} must be a finite number, found '{}'", name, shown(f)));
+    return v;
+  }
+
+  // An id: a positive integer (blank or 0 gives `def`, which callers use for "none").
+  std::int64_t id(int i, std::string_view name) const {
+    const std::int64_t v = integer(i, name, 0);
+    if (v < 0) fail(name, fmt::format("{} must not be negative, found {}", name, v));
+    return v;
+  }
+
+  [[noreturn]] void fail(std::string_view field, const std::string& message) const {
+    throw InputError(line_.where(kw_.key(field)), message);
+  }
+  const Line& line() const { return line_; }
+
+private:
+  static constexpr int max_fields = 10;
+
+  std::string_view unparameter(int i, std::string_view name) const {
+    const std::string_view f = fields_[i];
+    if (f.front() == '&' || f.front() == '<')
+      fail(name, fmt::format("{} is a parameter reference ('{}'); anvil does not read "
+                             "*PARAMETER: write the value",
+                             name, shown(f)));
+    return f;
+  }
+
+  // Fortran-style reals: 1.5, 1.5e3, 1.5E+3, 1.5d3, and 1.5-3 (exponent without a letter).
+  static bool parse_real(std::string_view f, double& v) {
+    std::string s(f);
+    for (auto& c : s)
+      if (c == 'd' || c == 'D') c = 'e';
+    std::size_t start = !s.empty() && s[0] == '+' ? 1 : 0;
+    const char* b = s.data() + start;
+    const char* e = s.data() + s.size();
+    if (b == e) return false;
+    // from_chars also reads "inf", "nan" and "infinity": none of them is a number here.
+    if (!std::isdigit(static_cast<unsigned char>(*b)) && *b != '.' && *b != '-') return false;
+    auto [p, ec] = std::from_chars(b, e, v);
+    if (ec != std::errc()) return false;
+    if (p != e) {
+      // A mantissa followed by a signed exponent without its letter.
+      const std::string_view rest(p, static_cast<std::size_t>(e - p));
+      if (rest.size() < 2 || (rest[0] != '+' && rest[0] != '-') ||
+          s.find('e', start) != std::string::npos)
+        return false;
+      int ex = 0;
+      const char* q = rest.data() + (rest[0] == '+' ? 1 : 0);
+      const auto [p2, ec2] = std::from_chars(q, rest.data() + rest.size(), ex);
+      if (ec2 != std::errc() || p2 != rest.data() + rest.size()) return false;
+      std::string joined(b, p);
+      joined += 'e';
+      joined += std::string(rest);
+      const auto [p3, ec3] = std::from_chars(joined.data(), joined.data() + joined.size(), v);
+      if (ec3 != std::errc() || p3 != joined.data() + joined.size()) return false;
+    }
+    return std::isfinite(v);
+  }
+
+  const Block& kw_;
+  Line line_;
+  std::array<std::string_view, max_fields> fields_{};
+  int count_ = 0;
+};
+
+// A card of free text (title, heading): the whole line, trimmed.
+std::string text_card(const Line& l) {
+  return std::string(trim(l.text));
+}
+
+// Reads the lines of a block in order; cards past the end are blank (their defaults).
+class Cursor {
+public:
+  explicit Cursor(const Block& b) : b_(b) {
+    // Blank lines at the end of a block are layout, not cards with defaults.
+    end_ = b.lines.size();
+    while (end_ > 0 && trim(b.lines[end_ - 1].text).empty()) --end_;
+  }
+  bool done() const { return i_ >= end_; }
+  // The next line, or a blank one at the keyword's line when the block has run out.
+  Line next() {
+    if (i_ < end_) return b_.lines[i_++];
+    return Line{std::string_view(), b_.head.file, b_.head.line};
+  }
+  // The next non-blank line (list keywords skip blank lines).
+  std::optional<Line> next_record() {
+    while (i_ < end_) {
+      const Line& l = b_.lines[i_++];
+      if (!trim(l.text).empty()) return l;
+    }
+    return std::nullopt;
+  }
+
+private:
+  const Block& b_;
+  std::size_t i_ = 0, end_ = 0;
+};
+
+// ---- what the deck defines ----------------------------------------------------------------
+
+struct Where {
+  const std::string* file = nullptr;
+  int line = 0;
+  SourceLocation loc(std::string key = "") const {
+    return {file ? *file : std::string(), line, std::move(key)};
+  }
+  std::string str() const { return fmt::format("{}:{}", file ? *file : "", line); }
+};
+Where where_of(const Line& l) {
+  return {l.file, l.line};
+}
+
+struct RawElement {
+  std::int64_t eid, pid;
+  std::array<std::int64_t, 8> nodes; // node ids
+  Where at;
+};
+
+struct PartCard {
+  std::int64_t pid, secid, mid, eosid, hgid;
+  std::string heading;
+  Where at;
+};
+
+struct SectionCard {
+  std::int64_t elform;
+  std::string keyword;
+  Where at;
+};
+
+// A material as the deck gives it: anvil's model and parameters, or the LS-DYNA keyword
+// of a material anvil does not have (an error only if a solid part uses it).
+struct MaterialCard {
+  std::string keyword;
+  std::string model; // empty: unsupported
+  ParamValues params;
+  std::vector<std::string> notes; // warnings, given only if a part uses the material
+  Where at;
+};
+
+struct EosCard {
+  std::string keyword;
+  double c = 0; // *EOS_GRUNEISEN: bulk sound speed
+  Where at;
+};
+
+struct HourglassCard {
+  std::int64_t ihq;
+  double qm, q1, q2;
+  Where at;
+};
+
+struct IdSet {
+  std::vector<std::int64_t> ids;                             // listed ids
+  std::vector<std::pair<std::int64_t, std::int64_t>> ranges; // _GENERATE ranges
+  Where at;
+};
+
+struct Spc {
+  std::int64_t set = 0, node = 0; // one of them
+  std::array<bool, 3> fix{};
+  Where at;
+  std::string keyword;
+};
+
+struct VelocityGen {
+  int styp; // 1 part set, 2 part, 3 node set, 0: all parts (*INITIAL_VELOCITY with NSID 0)
+  std::int64_t id;
+  Vec3 velocity, angular, center;
+  Where at;
+  std::string keyword;
+};
+
+struct ContactCard {
+  std::int64_t ssid, sstyp;
+  double fs, fd, dc, vdc, bt, dt, sfs;
+  Where at;
+  std::string keyword;
+};
+
+struct WallCard {
+  std::int64_t nsid, nsidex, boxid;
+  double offset, birth, death;
+  Vec3 tail, head;
+  double fric, wvel;
+  Where at;
+};
+
+struct Unsupported {
+  int count = 0;
+  Where first;
+};
+
+// ---- the reader ---------------------------------------------------------------------------
+
+class KeywordReader {
+public:
+  explicit KeywordReader(bool mesh_only) : mesh_only_(mesh_only) {}
+
+  void read(std::vector<Block>& blocks) {
+    for (const Block& b : blocks) dispatch(b);
+  }
+
+  Mesh mesh() {
+    std::vector<std::int64_t> order;
+    for (const auto& p : parts_) order.push_back(p.pid);
+    std::set<std::int64_t> known(order.begin(), order.end());
+    for (const auto& e : elements_)
+      if (known.insert(e.pid).second) order.push_back(e.pid);
+    return build_mesh(order, false);
+  }
+
+  Config config(const std::string& deck_file);
+
+private:
+  // ---- dispatch -------------------------------------------------------------------------
+
+  void dispatch(const Block& b) {
+    const std::string& n = b.name;
+    if (n == "NODE") return node(b);
+    if (n == "ELEMENT_SOLID") return element_solid(b);
+    if (n == "PART") return part(b);
+    if (n == "SET_NODE" || n == "SET_NODE_LIST" || n == "SET_NODE_TITLE" ||
+        n == "SET_NODE_LIST_TITLE")
+      return id_set(b, node_sets_, false);
+    if (n == "SET_NODE_LIST_GENERATE" || n == "SET_NODE_LIST_GENERATE_TITLE")
+      return id_set(b, node_sets_, true);
+    if (mesh_only_) return;
+    if (n == "SET_PART" || n == "SET_PART_LIST" || n == "SET_PART_TITLE" ||
+        n == "SET_PART_LIST_TITLE")
+      return id_set(b, part_sets_, false);
+    if (n == "SET_PART_LIST_GENERATE" || n == "SET_PART_LIST_GENERATE_TITLE")
+      return id_set(b, part_sets_, true);
+    if (n == "SECTION_SOLID" || n == "SECTION_SOLID_TITLE") return section_solid(b);
+    if (starts_with(n, "SECTION_")) return other_with_id(b, other_sections_);
+    if (n == "MAT_ELASTIC" || n == "MAT_001" || n == "MAT_ELASTIC_TITLE" || n == "MAT_001_TITLE")
+      return mat_elastic(b);
+    if (n == "MAT_PLASTIC_KINEMATIC" || n == "MAT_003" || n == "MAT_PLASTIC_KINEMATIC_TITLE" ||
+        n == "MAT_003_TITLE")
+      return mat_plastic_kinematic(b);
+    if (n == "MAT_JOHNSON_COOK" || n == "MAT_015" || n == "MAT_JOHNSON_COOK_TITLE" ||
+        n == "MAT_015_TITLE")
+      return mat_johnson_cook(b);
+    if (starts_with(n, "MAT_")) return other_material(b);
+    if (starts_with(n, "EOS_")) return eos(b);
+    if (n == "HOURGLASS" || n == "HOURGLASS_TITLE") return hourglass(b);
+    if (n == "BOUNDARY_SPC_SET" || n == "BOUNDARY_SPC_SET_ID") return spc(b, true);
+    if (n == "BOUNDARY_SPC_NODE" || n == "BOUNDARY_SPC_NODE_ID") return spc(b, false);
+    if (n == "INITIAL_VELOCITY_GENERATION") return velocity_generation(b);
+    if (n == "INITIAL_VELOCITY") return initial_velocity(b);
+    if (n == "CONTACT_AUTOMATIC_SINGLE_SURFACE" || n == "CONTACT_AUTOMATIC_SINGLE_SURFACE_ID" ||
+        n == "CONTACT_AUTOMATIC_SINGLE_SURFACE_TITLE")
+      return contact(b);
+    if (n == "CONTROL_CONTACT") return control_contact(b);
+    if (n == "RIGIDWALL_PLANAR" || n == "RIGIDWALL_PLANAR_ID") return rigidwall(b);
+    if (n == "CONTROL_TERMINATION") return control_termination(b);
+    if (n == "CONTROL_TIMESTEP") return control_timestep(b);
+    if (n == "CONTROL_HOURGLASS") return control_hourglass(b);
+    if (n == "CONTROL_BULK_VISCOSITY") return control_bulk_viscosity(b);
+    if (n == "DATABASE_BINARY_D3PLOT") return d3plot(b);
+    if (n == "DATABASE_GLSTAT" || n == "DATABASE_NODOUT") return history_interval(b);
+    if (n == "DATABASE_HISTORY_NODE") return history_nodes(b);
+    if (n == "TITLE") {
+      Cursor c(b);
+      title_ = text_card(c.next());
+      return;
+    }
+    // Output and performance controls that change nothing anvil computes.
+    if (starts_with(n, "DATABASE_") || n == "CONTROL_ENERGY" || n == "CONTROL_OUTPUT" ||
+        n == "CONTROL_CPU" || n == "CONTROL_PARALLEL" || starts_with(n, "CONTROL_MPP_") ||
+        n == "COMMENT")
+      return;
+    auto& u = unsupported_[n];
+    if (u.count++ == 0) u.first = where_of(b.head);
+  }
+
+  // The title card of a _TITLE keyword (skipped), then the first card.
+  static void skip_title(const Block& b, Cursor& c) {
+    if (ends_with(b.name, "_TITLE")) c.next();
+  }
+
+  // ---- mesh -----------------------------------------------------------------------------
+
+  void node(const Block& b) {
+    Cursor c(b);
+    while (auto l = c.next_record()) {
+      const Card card(b, *l, {8, 16, 16, 16, 8, 8});
+      const std::int64_t nid = card.integer(0, "NID", 0);
+      if (nid <= 0) card.fail("NID", fmt::format("NID must be a positive node id, found {}", nid));
+      const Vec3 x{card.real(1, "X"), card.real(2, "Y"), card.real(3, "Z")};
+      const std::int64_t tc = card.integer(4, "TC", 0);
+      if (tc < 0 || tc > 7)
+        card.fail("TC", fmt::format("TC must be 0 to 7 (translational constraint), found {}", tc));
+      const auto [it, fresh] = node_index_.emplace(nid, static_cast<std::int64_t>(nodes_.size()));
+      if (!fresh)
+        card.fail("NID", fmt::format("node {} is defined twice (first at {})", nid,
+                                     node_at_[it->second].str()));
+      nodes_.push_back(x);
+      node_at_.push_back(where_of(*l));
+      node_ids_.push_back(nid);
+      if (tc != 0) node_tc_.emplace_back(nid, static_cast<int>(tc), where_of(*l));
+    }
+  }
+
+  void element_solid(const Block& b) {
+    Cursor c(b);
+    while (auto l = c.next_record()) {
+      const Card first(b, *l, {8, 8, 8, 8, 8, 8, 8, 8, 8, 8});
+      RawElement e{};
+      e.eid = first.integer(0, "EID", 0);
+      e.pid = first.integer(1, "PID", 0);
+      e.at = where_of(*l);
+      if (e.eid <= 0) first.fail("EID", fmt::format("EID must be a positive id, found {}", e.eid));
+      if (e.pid <= 0)
+        first.fail("PID", fmt::format("element {}: PID must be a positive part id, found {}", e.eid,
+                                      e.pid));
+      // The old one-line form (EID PID N1..N8), or EID PID then a card of N1..N10.
+      bool one_line = false;
+      for (int i = 2; i < 10; ++i) one_line = one_line || !first.blank(i);
+      std::optional<Card> second;
+      if (!one_line) {
+        const auto l2 = c.next_record();
+        if (!l2)
+          first.fail("N1",
+                     fmt::format("element {}: the card with its nodes N1-N8 is missing", e.eid));
+        second.emplace(b, *l2, std::initializer_list<int>{8, 8, 8, 8, 8, 8, 8, 8, 8, 8});
+      }
+      const Card& nc = one_line ? first : *second;
+      const int base = one_line ? 2 : 0;
+      int given = 0;
+      for (int a = 0; a < 8; ++a) {
+        const std::string name = fmt::format("N{}", a + 1);
+        e.nodes[a] = nc.integer(base + a, name, 0);
+        if (e.nodes[a] < 0)
+          nc.fail(name, fmt::format("element {}: {} must be a positive node id, found {}", e.eid,
+                                    name, e.nodes[a]));
+        if (e.nodes[a] > 0) ++given;
+      }
+      if (!one_line && (nc.integer(8, "N9", 0) != 0 || nc.integer(9, "N10", 0) != 0))
+        nc.fail("N9", fmt::format("element {} has more than 8 nodes; anvil reads 8-node "
+                                  "hexahedra only",
+                                  e.eid));
+      if (given < 8)
+        nc.fail(fmt::format("N{}", given + 1),
+                fmt::format("element {} has {} nodes; anvil reads 8-node hexahedra only (no "
+                            "tetrahedra or other solids)",
+                            e.eid, given));
+      for (int a = 0; a < 8; ++a)
+        for (int k = 0; k < a; ++k)
+          if (e.nodes[a] == e.nodes[k])
+            nc.fail(fmt::format("N{}", a + 1),
+                    fmt::format("element {} uses node {} twice (N{} and N{}): degenerate "
+                                "hexahedra (wedges and tetrahedra written as hexahedra) are "
+                                "not supported",
+                                e.eid, e.nodes[a], k + 1, a + 1));
+      const auto [it, fresh] = element_index_.emplace(e.eid, elements_.size());
+      if (!fresh)
+        first.fail("EID", fmt::format("element {} is defined twice (first at {})", e.eid,
+                                      elements_[it->second].at.str()));
+      elements_.push_back(e);
+    }
+  }
+
+  void part(const Block& b) {
+    Cursor c(b);
+    while (!c.done()) {
+      // Each part is a heading card (free text, possibly blank) and a card of ids.
+      const Line head = c.next();
+      if (c.done())
+        throw InputError(head.where(b.key("PID")),
+                         "the part card (PID SECID MID ...) after the heading is missing");
+      const Line l = c.next();
+      const Card card(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+      PartCard p{
+          card.integer(0, "PID", 0), card.id(1, "SECID"), card.id(2, "MID"), card.id(3, "EOSID"),
+          card.id(4, "HGID"),        text_card(head),     where_of(l)};
+      if (p.pid <= 0)
+        card.fail("PID", fmt::format("PID must be a positive part id, found {}", p.pid));
+      if (!mesh_only_) {
+        if (p.secid == 0) card.fail("SECID", fmt::format("part {} has no section (SECID)", p.pid));
+        if (p.mid == 0) card.fail("MID", fmt::format("part {} has no material (MID)", p.pid));
+      }
+      for (const auto& q : parts_)
+        if (q.pid == p.pid)
+          card.fail("PID",
+                    fmt::format("part {} is defined twice (first at {})", p.pid, q.at.str()));
+      parts_.push_back(std::move(p));
+    }
+  }
+
+  void id_set(const Block& b, std::map<std::int64_t, IdSet>& sets, bool generate) {
+    Cursor c(b);
+    skip_title(b, c);
+    const Line l = c.next();
+    const Card head(b, l, {10, 10, 10, 10, 10, 10});
+    const std::int64_t sid = head.integer(0, "SID", 0);
+    if (sid <= 0) head.fail("SID", fmt::format("SID must be a positive set id, found {}", sid));
+    IdSet s;
+    s.at = where_of(l);
+    while (auto r = c.next_record()) {
+      const Card card(b, *r, {10, 10, 10, 10, 10, 10, 10, 10});
+      if (generate) {
+        for (int k = 0; k < 8; k += 2) {
+          const auto lo = card.id(k, fmt::format("B{}BEG", k / 2 + 1));
+          const auto hi = card.id(k + 1, fmt::format("B{}END", k / 2 + 1));
+          if (lo == 0 && hi == 0) continue;
+          if (lo == 0 || hi < lo)
+            card.fail(fmt::format("B{}END", k / 2 + 1),
+                      fmt::format("the range {} to {} is empty or starts at 0", lo, hi));
+          s.ranges.emplace_back(lo, hi);
+        }
+      } else {
+        for (int k = 0; k < 8; ++k)
+          if (const auto id = card.id(k, fmt::format("ID{}", k + 1)); id != 0) s.ids.push_back(id);
+      }
+    }
+    const auto [it, fresh] = sets.emplace(sid, std::move(s));
+    if (!fresh)
+      head.fail("SID", fmt::format("set {} of this kind is defined twice (first at {})", sid,
+                                   it->second.at.str()));
+  }
+
+  // ---- sections, materials, equations of state, hourglass -------------------------------
+
+  void section_solid(const Block& b) {
+    Cursor c(b);
+    while (!c.done()) {
+      skip_title(b, c);
+      const Line l = c.next();
+      const Card card(b, l, {10, 10, 10});
+      const std::int64_t secid = card.integer(0, "SECID", 0);
+      if (secid <= 0)
+        card.fail("SECID", fmt::format("SECID must be a positive id, found {}", secid));
+      const std::int64_t elform = card.integer(1, "ELFORM", 1);
+      if (elform >= 101 && elform <= 105)
+        card.fail("ELFORM", fmt::format("ELFORM {} is a user element; anvil has its one-point "
+                                        "hexahedron (ELFORM 1) only",
+                                        elform));
+      add_section(card, secid, SectionCard{elform, b.name, where_of(l)});
+    }
+  }
+
+  void add_section(const Card& card, std::int64_t secid, SectionCard s) {
+    const auto [it, fresh] = sections_.emplace(secid, std::move(s));
+    if (!fresh)
+      card.fail("SECID", fmt::format("section {} is defined twice (first at {})", secid,
+                                     it->second.at.str()));
+  }
+
+  // A keyword anvil does not model whose first field is an id others may refer to
+  // (*SECTION_SHELL): remembered so that a reference to it gets a precise message.
+  void other_with_id(const Block& b, std::map<std::int64_t, SectionCard>& into) {
+    Cursor c(b);
+    skip_title(b, c);
+    if (c.done()) return unsupported(b);
+    const Line l = c.next();
+    const Card card(b, l, {10});
+    std::int64_t id = 0;
+    try {
+      id = card.integer(0, "ID", 0);
+    } catch (const InputError&) {
+      id = 0; // not even an id: listed as unsupported all the same
+    }
+    if (id > 0) into.emplace(id, SectionCard{0, b.name, where_of(l)});
+    unsupported(b);
+  }
+
+  void unsupported(const Block& b) {
+    auto& u = unsupported_[b.name];
+    if (u.count++ == 0) u.first = where_of(b.head);
+  }
+
+  // The MID of a material card; an error unless positive.
+  static std::int64_t material_id(const Card& card) {
+    const std::int64_t mid = card.integer(0, "MID", 0);
+    if (mid <= 0) card.fail("MID", fmt::format("MID must be a positive id, found {}", mid));
+    return mid;
+  }
+
+  void add_material(const Card& card, std::int64_t mid, MaterialCard m) {
+    const auto [it, fresh] = materials_.emplace(mid, std::move(m));
+    if (!fresh)
+      card.fail("MID", fmt::format("material {} is defined twice (first at {})", mid,
+                                   it->second.at.str()));
+  }
+
+  // Density, Young's modulus and Poisson's ratio with LS-DYNA's field names in messages.
+  static void elastic_fields(const Card& card, ParamValues& p, int ro, int e, int pr) {
+    p["density"] = card.real(ro, "RO");
+    p["youngs_modulus"] = card.real(e, "E");
+    p["poissons_ratio"] = card.real(pr, "PR");
+    if (!(p["density"] > 0)) card.fail("RO", "the density RO must be positive");
+    if (!(p["youngs_modulus"] > 0)) card.fail("E", "Young's modulus E must be positive");
+    if (!(p["poissons_ratio"] > -1 && p["poissons_ratio"] < 0.5))
+      card.fail("PR", fmt::format("Poisson's ratio PR = {} is impossible: must be in (-1, 0.5)",
+                                  p["poissons_ratio"]));
+  }
+
+  void mat_elastic(const Block& b) {
+    Cursor c(b);
+    skip_title(b, c);
+    const Line l = c.next();
+    const Card card(b, l, {10, 10, 10, 10, 10, 10, 10});
+    const std::int64_t mid = material_id(card);
+    MaterialCard m{b.name, "elastic", {}, {}, where_of(l)};
+    elastic_fields(card, m.params, 1, 2, 3);
+    add_material(card, mid, std::move(m));
+  }
+
+  void mat_plastic_kinematic(const Block& b) {
+    Cursor c(b);
+    skip_title(b, c);
+    const Line l = c.next();
+    const Card card(b, l, {10, 10, 10, 10, 10, 10, 10});
+    const std::int64_t mid = material_id(card);
+    MaterialCard m{b.name, "j2_plasticity", {}, {}, where_of(l)};
+    elastic_fields(card, m.params, 1, 2, 3);
+    const double E = m.params["youngs_modulus"];
+    const double sigy = card.real(4, "SIGY");
+    const double etan = card.real(5, "ETAN");
+    const double beta = card.real(6, "BETA");
+    if (!(sigy > 0)) card.fail("SIGY", "the yield stress SIGY must be positive");
+    if (!(etan >= 0 && etan < E))
+      card.fail("ETAN",
+                fmt::format("the tangent modulus ETAN = {} must be in [0, E = {})", etan, E));
+    if (!(beta >= 0 && beta <= 1)) card.fail("BETA", "BETA must be between 0 and 1");
+    m.params["yield_stress"] = sigy;
+    // Linear hardening in the uniaxial curve (slope ETAN) is plastic hardening modulus
+    // H = E ETAN / (E - ETAN) in terms of plastic strain.
+    m.params["hardening_modulus"] = etan * E / (E - etan);
+    if (beta < 1)
+      m.notes.push_back(fmt::format(
+          "{}: material {}: BETA = {} asks for {} hardening; anvil's j2_plasticity hardens "
+          "isotropically only and uses BETA = 1 (same yield curve in monotonic loading, "
+          "no Bauschinger effect)",
+          m.at.str(), mid, beta, beta == 0 ? "kinematic" : "mixed"));
+    const Line l2 = c.next();
+    const Card card2(b, l2, {10, 10, 10, 10});
+    if (card2.real(0, "SRC") != 0 || card2.real(1, "SRP") != 0)
+      m.notes.push_back(fmt::format("{}: material {}: the Cowper-Symonds strain-rate factors "
+                                    "SRC, SRP are ignored (rate-independent yield)",
+                                    where_of(l2).str(), mid));
+    if (card2.real(2, "FS") != 0)
+      m.notes.push_back(fmt::format("{}: material {}: the failure strain FS is ignored (anvil "
+                                    "does not erode elements)",
+                                    where_of(l2).str(), mid));
+    add_material(card, mid, std::move(m));
+  }
+
+  void mat_johnson_cook(const Block& b) {
+    Cursor c(b);
+    skip_title(b, c);
+    const Line l = c.next();
+    const Card c1(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+    const std::int64_t mid = material_id(c1);
+    MaterialCard m{b.name, "johnson_cook", {}, {}, where_of(l)};
+    const double ro = c1.real(1, "RO"), G = c1.real(2, "G"), E = c1.real(3, "E"),
+                 pr = c1.real(4, "PR");
+    if (!(ro > 0)) c1.fail("RO", "the density RO must be positive");
+    if (!(G > 0)) c1.fail("G", "the shear modulus G must be positive");
+    if (E < 0) c1.fail("E", "E must not be negative");
+    m.params["density"] = ro;
+    // anvil's model is hypoelastic with E and nu. LS-DYNA takes G for solids and the
+    // pressure from an EOS; with no EOS model here, the bulk modulus comes from PR (or E),
+    // else from the EOS's sound speed (resolved when the part's EOS is known).
+    if (pr != 0) {
+      if (!(pr > -1 && pr < 0.5))
+        c1.fail("PR", fmt::format("Poisson's ratio PR = {} must be in (-1, 0.5)", pr));
+      m.params["youngs_modulus"] = 2 * G * (1 + pr);
+      m.params["poissons_ratio"] = pr;
+    } else if (E > 0) {
+      const double nu = E / (2 * G) - 1;
+      if (!(nu > -1 && nu < 0.5))
+        c1.fail("E", fmt::format("E = {} and G = {} give Poisson's ratio {}, outside (-1, 0.5)", E,
+                                 G, nu));
+      m.params["youngs_modulus"] = E;
+      m.params["poissons_ratio"] = nu;
+    } else {
+      m.params["shear_modulus_only"] = G; // needs the EOS; see johnson_cook_bulk()
+    }
+    if (c1.real(6, "VP") != 0)
+      m.notes.push_back(fmt::format("{}: material {}: VP = 1 (viscoplastic rate form) is "
+                                    "replaced by anvil's scaled yield stress (VP = 0)",
+                                    m.at.str(), mid));
+    if (c1.real(7, "RATEOP") != 0)
+      m.notes.push_back(fmt::format("{}: material {}: RATEOP is ignored; anvil uses the "
+                                    "original form 1 + C ln(rate / EPSO)",
+                                    m.at.str(), mid));
+    const Line l2 = c.next();
+    const Card c2(b, l2, {10, 10, 10, 10, 10, 10, 10, 10});
+    const double A = c2.real(0, "A"), B = c2.real(1, "B"), n = c2.real(2, "N"), C = c2.real(3, "C"),
+                 M = c2.real(4, "M"), TM = c2.real(5, "TM"), TR = c2.real(6, "TR"),
+                 EPSO = c2.real(7, "EPSO");
+    if (!(A > 0)) c2.fail("A", "the yield stress A must be positive");
+    if (B < 0) c2.fail("B", "B must not be negative");
+    if (B > 0 && !(n > 0)) c2.fail("N", "the hardening exponent N must be positive");
+    if (C < 0) c2.fail("C", "C must not be negative");
+    if (!(M > 0))
+      c2.fail("M", "the thermal softening exponent M must be positive (anvil's johnson_cook "
+                   "always softens; give M and TM)");
+    if (!(TR > 0)) c2.fail("TR", "the room temperature TR must be positive (kelvin)");
+    if (!(TM > TR)) c2.fail("TM", "the melt temperature TM must exceed the room temperature TR");
+    if (!(EPSO > 0)) c2.fail("EPSO", "the reference strain rate EPSO must be positive");
+    m.params["A"] = A;
+    m.params["B"] = B;
+    m.params["n"] = B > 0 ? n : 1; // no hardening: the exponent does not matter
+    m.params["C"] = C;
+    m.params["m"] = M;
+    m.params["melt_temperature"] = TM;
+    m.params["room_temperature"] = TR;
+    m.params["reference_strain_rate"] = EPSO;
+    const Line l3 = c.next();
+    const Card c3(b, l3, {10, 10, 10, 10, 10, 10, 10, 10});
+    const double cp = c3.real(0, "CP");
+    if (!(cp > 0)) c3.fail("CP", "the specific heat CP must be positive");
+    m.params["specific_heat"] = cp;
+    bool failure = c3.real(1, "PC") != 0 || c3.real(4, "D1") != 0 || c3.real(5, "D2") != 0 ||
+                   c3.real(6, "D3") != 0 || c3.real(7, "D4") != 0;
+    const Line l4 = c.next();
+    const Card c4(b, l4, {10, 10, 10, 10, 10});
+    failure = failure || c4.real(0, "D5") != 0 || c4.real(2, "EROD") != 0;
+    if (failure)
+      m.notes.push_back(fmt::format("{}: material {}: spall (PC, SPALL) and damage (D1-D5, "
+                                    "EROD) are ignored: anvil does not fail elements",
+                                    m.at.str(), mid));
+    add_material(c1, mid, std::move(m));
+  }
+
+  void other_material(const Block& b) {
+    Cursor c(b);
+    skip_title(b, c);
+    if (!c.done()) {
+      const Line l = c.next();
+      const Card card(b, l, {10});
+      std::int64_t mid = 0;
+      try {
+        mid = card.integer(0, "MID", 0);
+      } catch (const InputError&) {
+        mid = 0;
+      }
+      if (mid > 0) materials_.emplace(mid, MaterialCard{b.name, "", {}, {}, where_of(l)});
+    }
+    unsupported(b);
+  }
+
+  void eos(const Block& b) {
+    Cursor c(b);
+    skip_title(b, c);
+    const Line l = c.next();
+    const Card card(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+    const std::int64_t id = card.integer(0, "EOSID", 0);
+    if (id <= 0) card.fail("EOSID", fmt::format("EOSID must be a positive id, found {}", id));
+    EosCard e{b.name, 0, where_of(l)};
+    if (starts_with(b.name, "EOS_GRUNEISEN")) e.c = card.real(1, "C");
+    const auto [it, fresh] = eos_.emplace(id, std::move(e));
+    if (!fresh)
+      card.fail("EOSID", fmt::format("equation of state {} is defined twice (first at {})", id,
+                                     it->second.at.str()));
+  }
+
+  void hourglass(const Block& b) {
+    Cursor c(b);
+    while (!c.done()) {
+      skip_title(b, c);
+      const Line l = c.next();
+      const Card card(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+      const std::int64_t id = card.integer(0, "HGID", 0);
+      if (id <= 0) card.fail("HGID", fmt::format("HGID must be a positive id, found {}", id));
+      HourglassCard h{card.integer(1, "IHQ", 0), card.real(2, "QM"), card.real(4, "Q1"),
+                      card.real(5, "Q2"), where_of(l)};
+      check_hourglass(card, h.ihq, "IHQ", h.qm, "QM");
+      if (h.q1 < 0) card.fail("Q1", "Q1 must not be negative");
+      if (h.q2 < 0) card.fail("Q2", "Q2 must not be negative");
+      const auto [it, fresh] = hourglass_.emplace(id, h);
+      if (!fresh)
+        card.fail("HGID", fmt::format("hourglass {} is defined twice (first at {})", id,
+                                      it->second.at.str()));
+    }
+  }
+
+  static void check_hourglass(const Card& card, std::int64_t ihq, const char* ihq_name, double qm,
+                              const char* qm_name) {
+    if (ihq < 0 || ihq > 10)
+      card.fail(ihq_name, fmt::format("{} = {} is not an LS-DYNA hourglass type", ihq_name, ihq));
+    if (!(qm >= 0 && qm <= 1)) card.fail(qm_name, fmt::format("{} must be in [0, 1]", qm_name));
+  }
+
+  // ---- loads, constraints, contact ------------------------------------------------------
+
+  void spc(const Block& b, bool set) {
+    Cursor c(b);
+    const bool with_id = ends_with(b.name, "_ID");
+    while (!c.done()) {
+      if (with_id) c.next(); // ID and HEADING
+      const Line l = c.next();
+      const Card card(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+      const char* what = set ? "NSID" : "NID";
+      Spc s;
+      (set ? s.set : s.node) = card.integer(0, what, 0);
+      if ((set ? s.set : s.node) <= 0)
+        card.fail(what, fmt::format("{} must be a positive id", what));
+      if (card.integer(1, "CID", 0) != 0)
+        card.fail("CID", "constraints in a local coordinate system (CID) are not supported");
+      static constexpr const char* dofs[6] = {"DOFX", "DOFY", "DOFZ", "DOFRX", "DOFRY", "DOFRZ"};
+      for (int i = 0; i < 6; ++i) {
+        const auto v = card.integer(2 + i, dofs[i], 0);
+        if (v != 0 && v != 1) card.fail(dofs[i], fmt::format("{} must be 0 or 1", dofs[i]));
+        // Rotations: a solid's nodes have none (LS-DYNA ignores them there too).
+        if (i < 3) s.fix[i] = v == 1;
+      }
+      s.at = where_of(l);
+      s.keyword = b.name;
+      spcs_.push_back(s);
+    }
+  }
+
+  void velocity_generation(const Block& b) {
+    Cursor c(b);
+    while (!c.done()) {
+      const Line l = c.next();
+      const Card c1(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+      VelocityGen v{};
+      v.id = c1.integer(0, "ID", 0);
+      const std::int64_t styp = c1.integer(1, "STYP", 0);
+      if (styp < 1 || styp > 3)
+        c1.fail("STYP", fmt::format("STYP must be 1 (part set), 2 (part) or 3 (node set), "
+                                    "found {}",
+                                    styp));
+      v.styp = static_cast<int>(styp);
+      if (v.id <= 0) c1.fail("ID", "ID must be a positive part or set id");
+      const double omega = c1.real(2, "OMEGA");
+      v.velocity = {c1.real(3, "VX"), c1.real(4, "VY"), c1.real(5, "VZ")};
+      if (c1.integer(7, "ICID", 0) != 0)
+        c1.fail("ICID", "velocities in a local coordinate system (ICID) are not supported");
+      const Line l2 = c.next();
+      const Card c2(b, l2, {10, 10, 10, 10, 10, 10, 10, 10});
+      v.center = {c2.real(0, "XC"), c2.real(1, "YC"), c2.real(2, "ZC")};
+      const Vec3 axis{c2.real(3, "NX"), c2.real(4, "NY"), c2.real(5, "NZ")};
+      if (omega != 0) {
+        const double len = norm(axis);
+        if (!(len > 0))
+          c2.fail("NX", "the rotation axis (NX, NY, NZ) must not be zero when OMEGA is given");
+        v.angular = axis * (omega / len);
+      }
+      if (c2.integer(6, "PHASE", 0) != 0)
+        warnings_.push_back(fmt::format("{}: PHASE = 1 (after dynamic relaxation): anvil has no "
+                                        "dynamic relaxation and applies the velocity at t = 0",
+                                        where_of(l2).str()));
+      v.at = where_of(l);
+      v.keyword = b.name;
+      velocities_.push_back(v);
+    }
+  }
+
+  void initial_velocity(const Block& b) {
+    Cursor c(b);
+    while (!c.done()) {
+      const Line l = c.next();
+      const Card c1(b, l, {10, 10, 10, 10, 10});
+      VelocityGen v{};
+      v.id = c1.id(0, "NSID");
+      v.styp = v.id == 0 ? 0 : 3;
+      if (c1.integer(1, "NSIDEX", 0) != 0)
+        c1.fail("NSIDEX", "an exempted node set is not supported");
+      if (c1.integer(2, "BOXID", 0) != 0) c1.fail("BOXID", "a box restriction is not supported");
+      if (c1.integer(4, "ICID", 0) != 0)
+        c1.fail("ICID", "velocities in a local coordinate system (ICID) are not supported");
+      const Line l2 = c.next();
+      const Card c2(b, l2, {10, 10, 10, 10, 10, 10});
+      v.velocity = {c2.real(0, "VX"), c2.real(1, "VY"), c2.real(2, "VZ")};
+      if (c2.real(3, "VXR") != 0 || c2.real(4, "VYR") != 0 || c2.real(5, "VZR") != 0)
+        warnings_.push_back(fmt::format("{}: the rotational velocities VXR, VYR, VZR are ignored "
+                                        "(solid nodes have no rotations; use "
+                                        "*INITIAL_VELOCITY_GENERATION for a spin)",
+                                        where_of(l2).str()));
+      v.at = where_of(l);
+      v.keyword = b.name;
+      velocities_.push_back(v);
+    }
+  }
+
+  void contact(const Block& b) {
+    Cursor c(b);
+    if (!ends_with(b.name, "SINGLE_SURFACE")) c.next(); // _ID / _TITLE: CID and HEADING
+    const Line l = c.next();
+    const Card c1(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+    ContactCard k{};
+    k.ssid = c1.id(0, "SSID");
+    k.sstyp = c1.integer(2, "SSTYP", 0);
+    if (k.ssid != 0 && k.sstyp != 2 && k.sstyp != 3)
+      c1.fail("SSTYP", fmt::format("SSTYP {} is not supported: give a part set (2), a part (3), "
+                                   "or SSID 0 for all parts",
+                                   k.sstyp));
+    if (c1.integer(4, "SBOXID", 0) != 0)
+      c1.fail("SBOXID", "a box restriction (SBOXID) is not supported");
+    const Line l2 = c.next();
+    const Card c2(b, l2, {10, 10, 10, 10, 10, 10, 10, 10});
+    k.fs = c2.real(0, "FS");
+    k.fd = c2.real(1, "FD");
+    k.dc = c2.real(2, "DC");
+    k.vdc = c2.real(4, "VDC");
+    k.bt = c2.real(6, "BT");
+    k.dt = c2.real(7, "DT", 0);
+    if (k.fs < 0) c2.fail("FS", "the friction coefficient FS must not be negative");
+    const Line l3 = c.next();
+    const Card c3(b, l3, {10, 10, 10, 10, 10, 10, 10, 10});
+    k.sfs = c3.real(0, "SFS", 1);
+    if (k.sfs == 0) k.sfs = 1; // LS-DYNA's default
+    if (k.sfs < 0) c3.fail("SFS", "the penalty scale SFS must be positive");
+    k.at = where_of(l);
+    k.keyword = b.name;
+    contacts_.push_back(k);
+  }
+
+  void control_contact(const Block& b) {
+    Cursor c(b);
+    const Line l = c.next();
+    const Card card(b, l, {10});
+    slsfac_ = card.real(0, "SLSFAC", 0);
+    if (slsfac_ < 0) card.fail("SLSFAC", "SLSFAC must not be negative");
+  }
+
+  void rigidwall(const Block& b) {
+    Cursor c(b);
+    if (ends_with(b.name, "_ID")) c.next(); // RWID and HEADING
+    const Line l = c.next();
+    const Card c1(b, l, {10, 10, 10, 10, 10, 10, 10});
+    WallCard w{};
+    w.nsid = c1.id(0, "NSID");
+    w.nsidex = c1.id(1, "NSIDEX");
+    w.boxid = c1.id(2, "BOXID");
+    w.offset = c1.real(3, "OFFSET");
+    w.birth = c1.real(4, "BIRTH");
+    w.death = c1.real(5, "DEATH", 0);
+    const Line l2 = c.next();
+    const Card c2(b, l2, {10, 10, 10, 10, 10, 10, 10, 10});
+    w.tail = {c2.real(0, "XT"), c2.real(1, "YT"), c2.real(2, "ZT")};
+    w.head = {c2.real(3, "XH"), c2.real(4, "YH"), c2.real(5, "ZH")};
+    w.fric = c2.real(6, "FRIC");
+    w.wvel = c2.real(7, "WVEL");
+    if (!(norm(w.head - w.tail) > 0))
+      c2.fail("XH", "the head (XH, YH, ZH) must differ from the tail (XT, YT, ZT): they give "
+                    "the wall's normal");
+    if (w.fric < 0) c2.fail("FRIC", "FRIC must not be negative");
+    w.at = where_of(l);
+    walls_.push_back(w);
+  }
+
+  // ---- controls and output ---------------------------------------------------------------
+
+  void control_termination(const Block& b) {
+    Cursor c(b);
+    const Line l = c.next();
+    const Card card(b, l, {10, 10, 10, 10, 10, 10});
+    endtim_ = card.real(0, "ENDTIM");
+    endcyc_ = card.integer(1, "ENDCYC", 0);
+    if (endtim_ < 0) card.fail("ENDTIM", "ENDTIM must not be negative");
+    if (endcyc_ < 0) card.fail("ENDCYC", "ENDCYC must not be negative");
+    termination_at_ = where_of(l);
+    have_termination_ = true;
+  }
+
+  void control_timestep(const Block& b) {
+    Cursor c(b);
+    const Line l = c.next();
+    const Card card(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+    const double tssfac = card.real(1, "TSSFAC", 0);
+    if (tssfac != 0) {
+      if (!(tssfac > 0 && tssfac <= 1))
+        card.fail("TSSFAC", "TSSFAC must be in (0, 1]: a fraction of the stable time step");
+      tssfac_ = tssfac;
+    }
+    if (card.real(4, "DT2MS") != 0)
+      warnings_.push_back(fmt::format("{}: DT2MS (mass scaling) is ignored: anvil takes the "
+                                      "stable time step of the unscaled mass",
+                                      where_of(l).str()));
+    if (card.integer(5, "LCTM", 0) != 0)
+      warnings_.push_back(
+          fmt::format("{}: LCTM (a time step limit curve) is ignored", where_of(l).str()));
+  }
+
+  void control_hourglass(const Block& b) {
+    Cursor c(b);
+    const Line l = c.next();
+    const Card card(b, l, {10, 10});
+    control_ihq_ = card.integer(0, "IHQ", 0);
+    control_qh_ = card.real(1, "QH");
+    check_hourglass(card, control_ihq_, "IHQ", control_qh_, "QH");
+  }
+
+  void control_bulk_viscosity(const Block& b) {
+    Cursor c(b);
+    const Line l = c.next();
+    const Card card(b, l, {10, 10, 10, 10});
+    control_q1_ = card.real(0, "Q1");
+    control_q2_ = card.real(1, "Q2");
+    if (control_q1_ < 0) card.fail("Q1", "Q1 must not be negative");
+    if (control_q2_ < 0) card.fail("Q2", "Q2 must not be negative");
+  }
+
+  void d3plot(const Block& b) {
+    Cursor c(b);
+    const Line l = c.next();
+    const Card card(b, l, {10, 10, 10, 10, 10});
+    const double dt = card.real(0, "DT");
+    if (dt < 0) card.fail("DT", "DT must not be negative");
+    d3plot_dt_ = dt;
+    d3plot_states_ = card.integer(3, "NPLTC", 0);
+    if (d3plot_states_ < 0) card.fail("NPLTC", "NPLTC must not be negative");
+  }
+
+  void history_interval(const Block& b) {
+    Cursor c(b);
+    const Line l = c.next();
+    const Card card(b, l, {10});
+    const double dt = card.real(0, "DT");
+    if (dt < 0) card.fail("DT", "DT must not be negative");
+    if (dt > 0) history_dt_ = history_dt_ > 0 ? std::min(history_dt_, dt) : dt;
+  }
+
+  void history_nodes(const Block& b) {
+    Cursor c(b);
+    while (auto l = c.next_record()) {
+      const Card card(b, *l, {10, 10, 10, 10, 10, 10, 10, 10});
+      for (int k = 0; k < 8; ++k)
+        if (const auto id = card.id(k, fmt::format("ID{}", k + 1)); id != 0)
+          history_nodes_.emplace_back(id, where_of(*l));
+    }
+  }
+
+  // ---- assembly ---------------------------------------------------------------------------
+
+  std::int64_t node_position(std::int64_t nid, const Where& at, const std::string& key,
+                             const std::string& what) const {
+    const auto it = node_index_.find(nid);
+    if (it == node_index_.end())
+      throw InputError(at.loc(key),
+                       fmt::format("{} refers to node {}, which no *NODE defines", what, nid));
+    return it->second;
+  }
+
+  // Node positions of a *SET_NODE_LIST (sorted, unique); every id must be a node.
+  std::vector<std::int64_t> resolve_node_set(std::int64_t sid, const IdSet& s) const {
+    std::vector<std::int64_t> out;
+    for (const auto id : s.ids)
+      out.push_back(node_position(id, s.at, "*SET_NODE_LIST", fmt::format("node set {}", sid)));
+    if (!s.ranges.empty())
+      for (std::size_t i = 0; i < node_ids_.size(); ++i)
+        for (const auto& [lo, hi] : s.ranges)
+          if (node_ids_[i] >= lo && node_ids_[i] <= hi) {
+            out.push_back(static_cast<std::int64_t>(i));
+            break;
+          }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+
+  // The mesh: every node in file order, one block per part in `pids` order, node sets.
+  Mesh build_mesh(const std::vector<std::int64_t>& pids, bool parts_must_exist) const {
+    Mesh m;
+    m.nodes = nodes_;
+    std::unordered_map<std::int64_t, std::size_t> block_of;
+    for (const auto pid : pids) {
+      block_of.emplace(pid, m.blocks.size());
+      m.blocks.push_back(ElementBlock{fmt::format("part{}", pid), {}});
+    }
+    for (const auto& e : elements_) {
+      const auto b = block_of.find(e.pid);
+      if (b == block_of.end()) {
+        if (parts_must_exist)
+          throw InputError(
+              e.at.loc("*ELEMENT_SOLID.PID"),
+              fmt::format("element {} belongs to part {}, which no *PART defines", e.eid, e.pid));
+        continue;
+      }
+      Hex h;
+      for (int a = 0; a < 8; ++a)
+        h[a] = node_position(e.nodes[a], e.at, fmt::format("*ELEMENT_SOLID.N{}", a + 1),
+                             fmt::format("element {}", e.eid));
+      m.blocks[b->second].elements.push_back(h);
+    }
+    for (const auto& [sid, s] : node_sets_)
+      m.node_sets[fmt::format("nodeset_{}", sid)] = resolve_node_set(sid, s);
+    return m;
+  }
+
+  std::string part_name(std::int64_t pid) const { return fmt::format("part{}", pid); }
+
+  // The parts of a part set, those anvil keeps (parts with solid elements).
+  std::vector<std::string> part_set(std::int64_t sid, const Where& at, const std::string& key,
+                                    const std::set<std::int64_t>& kept) const {
+    const auto it = part_sets_.find(sid);
+    if (it == part_sets_.end())
+      throw InputError(at.loc(key),
+                       fmt::format("part set {} is not defined (*SET_PART_LIST)", sid));
+    std::vector<std::int64_t> pids = it->second.ids;
+    for (const auto& p : parts_)
+      for (const auto& [lo, hi] : it->second.ranges)
+        if (p.pid >= lo && p.pid <= hi) pids.push_back(p.pid);
+    std::vector<std::string> out;
+    for (const auto pid : pids) {
+      if (std::none_of(parts_.begin(), parts_.end(),
+                       [&](const PartCard& p) { return p.pid == pid; }))
+        throw InputError(
+            it->second.at.loc("*SET_PART_LIST"),
+            fmt::format("part set {} lists part {}, which no *PART defines", sid, pid));
+      if (kept.count(pid) && std::find(out.begin(), out.end(), part_name(pid)) == out.end())
+        out.push_back(part_name(pid));
+    }
+    return out;
+  }
+
+  HourglassControl hourglass_of(std::int64_t ihq, double qm) const {
+    HourglassControl h;
+    h.model = ihq >= 4 ? HourglassControl::Model::stiffness : HourglassControl::Model::viscous;
+    h.coefficient = qm > 0 ? qm : 0.1; // LS-DYNA's default QM
+    return h;
+  }
+
+  bool mesh_only_;
+  std::string title_;
+  std::vector<Vec3> nodes_;
+  std::vector<Where> node_at_;
+  std::vector<std::int64_t> node_ids_;
+  std::unordered_map<std::int64_t, std::int64_t> node_index_;
+  std::vector<std::tuple<std::int64_t, int, Where>> node_tc_; // *NODE TC constraints
+  std::vector<RawElement> elements_;
+  std::unordered_map<std::int64_t, std::size_t> element_index_;
+  std::vector<PartCard> parts_;
+  std::map<std::int64_t, SectionCard> sections_, other_sections_;
+  std::map<std::int64_t, MaterialCard> materials_;
+  std::map<std::int64_t, EosCard> eos_;
+  std::map<std::int64_t, HourglassCard> hourglass_;
+  std::map<std::int64_t, IdSet> node_sets_, part_sets_;
+  std::vector<Spc> spcs_;
+  std::vector<VelocityGen> velocities_;
+  std::vector<ContactCard> contacts_;
+  std::vector<WallCard> walls_;
+  double slsfac_ = 0;
+  bool have_termination_ = false;
+  Where termination_at_;
+  double endtim_ = 0;
+  std::int64_t endcyc_ = 0;
+  double tssfac_ = 0.9;
+  std::int64_t control_ihq_ = 0;
+  double control_qh_ = 0, control_q1_ = 0, control_q2_ = 0;
+  double d3plot_dt_ = 0, history_dt_ = 0;
+  std::int64_t d3plot_states_ = 0;
+  std::vector<std::pair<std::int64_t, Where>> history_nodes_;
+  std::vector<std::string> warnings_;
+  std::map<std::string, Unsupported> unsupported_;
+};
+
+// Fills in the defaults of the model's optional parameters and checks every value against
+// the registry's range (the keyword checks above name LS-DYNA's fields; this is the net
+// under them, in anvil's names).
+void complete_material(MaterialConfig& m) {
+  const MaterialModel* info = find_material_model(m.model);
+  if (!info) throw InputError(m.where, fmt::format("no material model '{}'", m.model));
+  for (const auto& p : info->params) {
+    const std::string name(p.name);
+    auto it = m.params.find(name);
+    if (it == m.params.end()) {
+      if (p.required)
+        throw InputError(m.where, fmt::format("{} is missing for anvil's {}", name, m.model));
+      m.params[name] = p.default_value;
+      continue;
+    }
+    const double x = it->second;
+    const bool low_ok = p.min_exclusive ? x > p.min : x >= p.min;
+    const bool high_ok = p.max_exclusive ? x < p.max : x <= p.max;
+    if (!low_ok || !high_ok)
+      throw InputError(m.where,
+                       fmt::format("{} = {} is outside the range of anvil's {}", name, x, m.model));
+  }
+}
+
+Config KeywordReader::config(const std::string& deck_file) {
+  Config c;
+  c.deck_file = deck_file;
+  c.title = title_;
+  std::vector<std::string> warnings = std::move(warnings_);
+
+  // Termination.
+  if (!have_termination_ || (endtim_ == 0 && endcyc_ == 0))
+    throw InputError(
+        {deck_file, have_termination_ ? termination_at_.line : 0, "*CONTROL_TERMINATION"},
+        "no end: give *CONTROL_TERMINATION with ENDTIM (or ENDCYC)");
+  if (endtim_ > 0) c.end_time = endtim_;
+  if (endcyc_ > 0) c.end_cycles = endcyc_;
+  c.time_step_scale = tssfac_;
+
+  // Parts with solid elements; the others (shells, beams, ...) are left out.
+  std::map<std::int64_t, std::size_t> solids;
+  for (const auto& e : elements_) ++solids[e.pid];
+  std::set<std::int64_t> kept;
+  std::vector<std::int64_t> order;
+  for (const auto& p : parts_) {
+    if (!solids.count(p.pid)) {
+      warnings.push_back(fmt::format("{}: part {}{} has no *ELEMENT_SOLID elements and is left "
+                                     "out (anvil models solid hexahedra only)",
+                                     p.at.str(), p.pid,
+                                     p.heading.empty() ? "" : " (" + shown(p.heading) + ")"));
+      continue;
+    }
+    kept.insert(p.pid);
+    order.push_back(p.pid);
+  }
+  if (order.empty())
+    throw InputError({deck_file, 0, "*PART"},
+                     "no part has solid elements: anvil needs *PART and *ELEMENT_SOLID cards");
+  Mesh mesh = build_mesh(order, true); // shared by the parts once complete (below)
+
+  // Materials, in order of first use; hourglass and bulk viscosity per part.
+  std::map<std::int64_t, std::string> material_names;
+  const std::string part_key = "*PART";
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const PartCard& p = *std::find_if(parts_.begin(), parts_.end(),
+                                      [&](const PartCard& q) { return q.pid == order[i]; });
+    PartConfig pc;
+    pc.name = part_name(p.pid);
+    pc.where = p.at.loc(part_key);
+    pc.mesh.kind = MeshConfig::Kind::embedded;
+    pc.mesh.embedded_block = i;
+    pc.mesh.where = pc.where;
+
+    // Section.
+    const auto sec = sections_.find(p.secid);
+    if (sec == sections_.end()) {
+      const auto other = other_sections_.find(p.secid);
+      throw InputError(
+          p.at.loc("*PART.SECID"),
+          other != other_sections_.end()
+              ? fmt::format("part {} has solid elements but its section {} is a *{} "
+                            "(at {}), not a *SECTION_SOLID",
+                            p.pid, p.secid, other->second.keyword, other->second.at.str())
+              : fmt::format("part {}: section {} is not defined (*SECTION_SOLID)", p.pid, p.secid));
+    }
+    if (sec->second.elform != 1 && sec->second.elform != 0)
+      warnings.push_back(fmt::format("{}: section {} asks for ELFORM {}; anvil uses its one-point "
+                                     "hexahedron with hourglass control (ELFORM 1) for part {}",
+                                     sec->second.at.str(), p.secid, sec->second.elform, p.pid));
+
+    // Material.
+    const auto mat = materials_.find(p.mid);
+    if (mat == materials_.end())
+      throw InputError(p.at.loc("*PART.MID"),
+                       fmt::format("part {}: material {} is not defined", p.pid, p.mid));
+    MaterialCard& mc = mat->second;
+    if (mc.model.empty())
+      throw InputError(p.at.loc("*PART.MID"),
+                       fmt::format("part {}: material {} is a *{} (at {}), which anvil does not "
+                                   "have (supported: *MAT_ELASTIC, *MAT_PLASTIC_KINEMATIC, "
+                                   "*MAT_JOHNSON_COOK)",
+                                   p.pid, p.mid, mc.keyword, mc.at.str()));
+    const std::string mname = fmt::format("mat{}", p.mid);
+    // Equation of state: anvil's models carry their own linear elastic pressure.
+    if (p.eosid != 0) {
+      const auto e = eos_.find(p.eosid);
+      if (e == eos_.end())
+        throw InputError(
+            p.at.loc("*PART.EOSID"),
+            fmt::format("part {}: equation of state {} is not defined", p.pid, p.eosid));
+      if (mc.params.count("shear_modulus_only")) {
+        // *MAT_JOHNSON_COOK with G only: the EOS's bulk sound speed gives K = rho C^2.
+        const double G = mc.params["shear_modulus_only"], rho = mc.params["density"];
+        const double K = rho * e->second.c * e->second.c;
+        const double nu = (3 * K - 2 * G) / (2 * (3 * K + G));
+        if (!(K > 0) || !(nu > -1 && nu < 0.5))
+          throw InputError(p.at.loc("*PART.EOSID"),
+                           fmt::format("part {}: material {} gives only G; anvil needs PR (or E) "
+                                       "on the material card, or an *EOS_GRUNEISEN with a "
+                                       "sound speed C, for its bulk modulus",
+                                       p.pid, p.mid));
+        mc.params.erase("shear_modulus_only");
+        mc.params["youngs_modulus"] = 2 * G * (1 + nu);
+        mc.params["poissons_ratio"] = nu;
+        warnings.push_back(fmt::format(
+            "{}: part {}: *{} {} is not supported; anvil uses a linear elastic pressure with "
+            "the bulk modulus rho C^2 = {:.6g} Pa from its sound speed C (S1-S3, GAMA0 and "
+            "the energy term are ignored)",
+            p.at.str(), p.pid, e->second.keyword, p.eosid, K));
+      } else {
+        warnings.push_back(fmt::format(
+            "{}: part {}: *{} {} is not supported; anvil computes the pressure of material {} "
+            "from its linear elastic bulk modulus (E, PR) instead",
+            p.at.str(), p.pid, e->second.keyword, p.eosid, p.mid));
+      }
+    }
+    if (mc.params.count("shear_modulus_only"))
+      throw InputError(mc.at.loc(fmt::format("*{}.PR", mc.keyword)),
+                       fmt::format("material {} gives only the shear modulus G; anvil needs PR "
+                                   "(or E) for its bulk modulus (no equation of state is given)",
+                                   p.mid));
+    if (material_names.emplace(p.mid, mname).second) {
+      MaterialConfig m{mname, mc.model, mc.params, {}, {}, mc.at.loc("*" + mc.keyword)};
+      complete_material(m);
+      const double rho = m.params["density"];
+      if (rho < 10 || rho > 1e5)
+        warnings.push_back(
+            fmt::format("{}: material {}: density {} looks like it is not in kg/m^3: "
+                        "anvil reads keyword decks in SI units (m, kg, s, Pa) "
+                        "and converts nothing",
+                        mc.at.str(), p.mid, rho));
+      for (const auto& n : mc.notes) warnings.push_back(n);
+      c.materials.push_back(std::move(m));
+    }
+    pc.material = mname;
+
+    // Hourglass and bulk viscosity: the part's *HOURGLASS, else the *CONTROL_ cards, else
+    // LS-DYNA's defaults (which are anvil's: viscous 0.1, Q1 1.5, Q2 0.06).
+    std::int64_t ihq = control_ihq_;
+    double qm = control_qh_, q1 = control_q1_, q2 = control_q2_;
+    if (p.hgid != 0) {
+      const auto h = hourglass_.find(p.hgid);
+      if (h == hourglass_.end())
+        throw InputError(
+            p.at.loc("*PART.HGID"),
+            fmt::format("part {}: hourglass {} is not defined (*HOURGLASS)", p.pid, p.hgid));
+      ihq = h->second.ihq;
+      qm = h->second.qm;
+      if (h->second.q1 > 0) q1 = h->second.q1;
+      if (h->second.q2 > 0) q2 = h->second.q2;
+    }
+    if (ihq >= 6)
+      warnings.push_back(fmt::format("{}: part {}: hourglass type IHQ {} is replaced by anvil's "
+                                     "Flanagan-Belytschko stiffness form (IHQ 4) with the same "
+                                     "coefficient",
+                                     p.at.str(), p.pid, ihq));
+    pc.hourglass = hourglass_of(ihq, qm);
+    if (q1 > 0) pc.bulk_viscosity.quadratic = q1;
+    if (q2 > 0) pc.bulk_viscosity.linear = q2;
+    c.parts.push_back(std::move(pc));
+  }
+
+  auto node_set_name = [&](std::int64_t sid, const Where& at, const std::string& key) {
+    if (!node_sets_.count(sid))
+      throw InputError(at.loc(key),
+                       fmt::format("node set {} is not defined (*SET_NODE_LIST)", sid));
+    return fmt::format("nodeset_{}", sid);
+  };
+  auto part_ref = [&](std::int64_t pid, const Where& at, const std::string& key) {
+    if (std::none_of(parts_.begin(), parts_.end(), [&](const PartCard& p) { return p.pid == pid; }))
+      throw InputError(at.loc(key), fmt::format("part {} is not defined (*PART)", pid));
+    return kept.count(pid) > 0;
+  };
+
+  // Initial velocities, in deck order (later ones override earlier ones on shared nodes,
+  // as in the YAML deck).
+  for (const auto& v : velocities_) {
+    const std::string key = "*" + v.keyword;
+    std::vector<Selection> targets;
+    if (v.styp == 3) {
+      Selection s;
+      s.name = node_set_name(v.id, v.at, key + (v.keyword == "INITIAL_VELOCITY" ? ".NSID" : ".ID"));
+      s.where = v.at.loc(key);
+      targets.push_back(s);
+    } else {
+      std::vector<std::string> names;
+      if (v.styp == 2) {
+        if (part_ref(v.id, v.at, key + ".ID")) names.push_back(part_name(v.id));
+      } else if (v.styp == 1) {
+        names = part_set(v.id, v.at, key + ".ID", kept);
+      } else {
+        for (const auto pid : order) names.push_back(part_name(pid));
+      }
+      for (const auto& n : names) {
+        Selection s;
+        s.part = n;
+        s.where = v.at.loc(key);
+        targets.push_back(s);
+      }
+    }
+    for (const auto& s : targets) {
+      InitialCondition ic;
+      ic.nodes = s;
+      ic.velocity = v.velocity;
+      ic.angular_velocity = v.angular;
+      ic.center = v.center;
+      ic.where = v.at.loc(key);
+      c.initial_conditions.push_back(ic);
+    }
+  }
+
+  // Constraints: *BOUNDARY_SPC_SET by set; single nodes (*BOUNDARY_SPC_NODE, *NODE TC)
+  // grouped by the components they fix, one set each, so that a deck with thousands of
+  // them makes seven conditions, not thousands.
+  std::map<int, std::pair<std::vector<std::int64_t>, Where>> single; // mask -> nodes
+  for (const auto& s : spcs_) {
+    if (!s.fix[0] && !s.fix[1] && !s.fix[2]) continue; // rotations only
+    if (s.set != 0) {
+      BoundaryCondition bc;
+      bc.nodes.name = node_set_name(s.set, s.at, "*" + s.keyword + ".NSID");
+      bc.nodes.where = s.at.loc("*" + s.keyword);
+      bc.fix = s.fix;
+      bc.where = bc.nodes.where;
+      c.boundary_conditions.push_back(bc);
+    } else {
+      const auto pos = node_position(s.node, s.at, "*" + s.keyword + ".NID", "the constraint");
+      const int mask = (s.fix[0] ? 1 : 0) | (s.fix[1] ? 2 : 0) | (s.fix[2] ? 4 : 0);
+      auto& [ids, at] = single[mask];
+      if (ids.empty()) at = s.at;
+      ids.push_back(pos);
+    }
+  }
+  for (const auto& [nid, tc, at] : node_tc_) {
+    // TC: 1 x, 2 y, 3 z, 4 x and y, 5 y and z, 6 z and x, 7 all.
+    static constexpr int masks[8] = {0, 1, 2, 4, 3, 6, 5, 7};
+    auto& [ids, first] = single[masks[tc]];
+    if (ids.empty()) first = at;
+    ids.push_back(node_index_.at(nid));
+  }
+  for (auto& [mask, entry] : single) {
+    auto& [ids, at] = entry;
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    const std::string name =
+        fmt::format("spc_{}{}{}", mask & 1 ? "x" : "", mask & 2 ? "y" : "", mask & 4 ? "z" : "");
+    mesh.node_sets[name] = ids;
+    BoundaryCondition bc;
+    bc.nodes.name = name;
+    bc.nodes.where = at.loc("*BOUNDARY_SPC_NODE");
+    bc.fix = {(mask & 1) != 0, (mask & 2) != 0, (mask & 4) != 0};
+    bc.where = bc.nodes.where;
+    c.boundary_conditions.push_back(bc);
+  }
+
+  const auto shared = std::make_shared<const Mesh>(std::move(mesh));
+  for (auto& pc : c.parts) pc.mesh.embedded = shared;
+
+  // Contact: single-surface contact is anvil's general contact among the listed parts.
+  if (contacts_.size() > 1)
+    throw InputError(contacts_[1].at.loc("*" + contacts_[1].keyword),
+                     fmt::format("anvil supports one contact definition; the first is at {}",
+                                 contacts_[0].at.str()));
+  for (const auto& k : contacts_) {
+    ContactConfig cc;
+    cc.where = k.at.loc("*" + k.keyword);
+    if (k.ssid != 0) {
+      if (k.sstyp == 3) {
+        if (part_ref(k.ssid, k.at, "*" + k.keyword + ".SSID"))
+          cc.parts.push_back(part_name(k.ssid));
+      } else {
+        cc.parts = part_set(k.ssid, k.at, "*" + k.keyword + ".SSID", kept);
+      }
+      if (cc.parts.empty())
+        throw InputError(cc.where, "the contact's parts have no solid elements");
+    }
+    cc.friction = k.fs;
+    // LS-DYNA's penalty stiffness for solid segments is SLSFAC * SFS * K A^2 / V, anvil's
+    // penalty_scale * K A^2 / V.
+    cc.penalty_scale = (slsfac_ > 0 ? slsfac_ : 0.1) * k.sfs;
+    if (k.dc > 0 && k.fd != k.fs)
+      warnings.push_back(fmt::format("{}: contact friction: anvil uses the static coefficient "
+                                     "FS = {} throughout (FD and DC are ignored)",
+                                     k.at.str(), k.fs));
+    if (k.vdc != 0)
+      warnings.push_back(fmt::format("{}: contact viscous damping VDC is ignored", k.at.str()));
+    if (k.bt != 0 || (k.dt != 0 && k.dt < 1e19))
+      warnings.push_back(fmt::format("{}: contact birth and death times (BT, DT) are ignored: "
+                                     "the contact is active throughout",
+                                     k.at.str()));
+    c.contact.push_back(cc);
+  }
+
+  // Rigid walls: a plane through the tail with the normal towards the head.
+  for (const auto& w : walls_) {
+    RigidWallConfig rw;
+    rw.where = w.at.loc("*RIGIDWALL_PLANAR");
+    rw.point = w.tail;
+    const Vec3 n = w.head - w.tail;
+    rw.normal = n * (1 / norm(n));
+    rw.friction = w.fric;
+    if (w.nsid != 0 || w.nsidex != 0 || w.boxid != 0)
+      warnings.push_back(fmt::format("{}: rigid wall: NSID, NSIDEX and BOXID are ignored: "
+                                     "anvil's walls act on every node",
+                                     w.at.str()));
+    if (w.fric >= 1)
+      warnings.push_back(fmt::format("{}: rigid wall: FRIC = {} (no sliding) is taken as a "
+                                     "Coulomb coefficient of {}",
+                                     w.at.str(), w.fric, w.fric));
+    if (w.offset != 0 || w.birth != 0 || (w.death != 0 && w.death < 1e19) || w.wvel != 0)
+      warnings.push_back(fmt::format("{}: rigid wall: OFFSET, BIRTH, DEATH and WVEL are "
+                                     "ignored",
+                                     w.at.str()));
+    c.rigid_walls.push_back(rw);
+  }
+
+  // Output intervals.
+  if (d3plot_states_ > 0 && endtim_ > 0)
+    c.fields_every = endtim_ / static_cast<double>(d3plot_states_);
+  else
+    c.fields_every = d3plot_dt_;
+  c.history_every = history_dt_;
+
+  // Probes: *DATABASE_HISTORY_NODE, at the node's position (anvil probes the nearest node,
+  // the lowest id among coincident ones).
+  std::set<std::int64_t> probed;
+  std::map<std::array<double, 3>, std::int64_t> first_at; // position -> first node there
+  if (!history_nodes_.empty())
+    for (std::size_t j = 0; j < nodes_.size(); ++j)
+      first_at.emplace(std::array<double, 3>{nodes_[j].x, nodes_[j].y, nodes_[j].z},
+                       static_cast<std::int64_t>(j));
+  for (const auto& [nid, at] : history_nodes_) {
+    const auto pos = node_position(nid, at, "*DATABASE_HISTORY_NODE", "the history node list");
+    if (!probed.insert(nid).second) continue;
+    const Vec3 x = nodes_[pos];
+    const std::int64_t j = first_at.at({x.x, x.y, x.z});
+    if (j != pos)
+      warnings.push_back(fmt::format("{}: history node {} lies on node {} (same coordinates); "
+                                     "the probe follows node {}",
+                                     at.str(), nid, node_ids_[j], node_ids_[j]));
+    c.probes.push_back(
+        ProbeConfig{fmt::format("node{}", nid), x, at.loc("*DATABASE_HISTORY_NODE")});
+  }
+
+  // One warning lists every keyword anvil ignored.
+  if (!unsupported_.empty()) {
+    std::string list;
+    for (const auto& [name, u] : unsupported_)
+      list += fmt::format("{}*{} ({}x, first at {})", list.empty() ? "" : ", ", name, u.count,
+                          u.first.str());
+    warnings.push_back(fmt::format("{}: {} keyword{} not supported by anvil and ignored: {}",
+                                   deck_file, unsupported_.size(),
+                                   unsupported_.size() == 1 ? " is" : "s are", list));
+  }
+  c.warnings = std::move(warnings);
+  return c;
+}
+
+// Runs `f`, turning allocation failures on absurd input into an InputError.
+template <class F>
+auto guarded(const std::string& name, F&& f) {
+  try {
+    return f();
+  } catch (const std::bad_alloc&) {
+    throw InputError(SourceLocation{name, 0, ""}, "the deck does not fit in memory");
+  } catch (const std::length_error&) {
+    throw InputError(SourceLocation{name, 0, ""}, "the deck does not fit in memory");
+  } catch (const fs::filesystem_error& e) {
+    throw InputError(SourceLocation{name, 0, ""}, e.what());
+  }
+}
+
+std::string slurp(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec))
+    throw InputError({path, 0, ""}, fs::exists(path, ec) ? "not a file" : "cannot open the deck");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError({path, 0, ""}, "cannot open the deck");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string dir_of(const std::string& path) {
+  const auto d = fs::path(path).parent_path();
+  return d.empty() ? "." : d.string();
+}
+
+} // namespace
+
+bool is_keyword_file(const std::string& path) {
+  const std::string ext = upper(fs::path(path).extension().string());
+  return ext == ".K" || ext == ".KEY" || ext == ".DYN";
+}
+
+Config parse_keyword_deck(std::string_view text, const std::string& name,
+                          const std::string& base_dir) {
+  return guarded(name, [&] {
+    Lexer lex(true);
+    lex.lex_main(text, name, base_dir);
+    KeywordReader r(false);
+    r.read(lex.blocks());
+    return r.config(name);
+  });
+}
+
+Config read_keyword_deck(const std::string& path) {
+  const std::string text = guarded(path, [&] { return slurp(path); });
+  return parse_keyword_deck(text, path, dir_of(path));
+}
+
+Mesh parse_keyword_mesh(std::string_view text, const std::string& name,
+                        const std::string& base_dir) {
+  return guarded(name, [&] {
+    Lexer lex(false);
+    lex.lex_main(text, name, base_dir);
+    KeywordReader r(true);
+    r.read(lex.blocks());
+    return r.mesh();
+  });
+}
+
+Mesh read_keyword_mesh(const std::string& path) {
+  const std::string text = guarded(path, [&] { return slurp(path); });
+  return parse_keyword_mesh(text, path, dir_of(path));
+}
+
+} // namespace anvil

@@ -1,0 +1,543 @@
+// The LS-DYNA keyword reader: valid decks in every card format become the Config the
+// YAML reader would give; every kind of bad input is an InputError naming the file, the
+// line and the keyword's field; unsupported keywords end in one warning.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "anvil/io/keyword.hpp"
+#include "anvil/solver/model.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using namespace anvil;
+namespace fs = std::filesystem;
+
+// Two hexahedra stacked along z (12 nodes), part 1, a node set of the bottom face.
+const std::string mesh_cards = R"(*NODE
+$#   nid               x               y               z      tc      rc
+       1             0.0             0.0             0.0
+       2             1.0             0.0             0.0
+       3             1.0             1.0             0.0
+       4             0.0             1.0             0.0
+       5             0.0             0.0             1.0
+       6             1.0             0.0             1.0
+       7             1.0             1.0             1.0
+       8             0.0             1.0             1.0
+       9             0.0             0.0             2.0
+      10             1.0             0.0             2.0
+      11             1.0             1.0             2.0
+      12             0.0             1.0             2.0
+*ELEMENT_SOLID
+       1       1       1       2       3       4       5       6       7       8
+       2       1       5       6       7       8       9      10      11      12
+*SET_NODE_LIST
+         7
+         1         2         3         4
+)";
+
+const std::string good = R"(*KEYWORD
+*TITLE
+two bricks
+*CONTROL_TERMINATION
+   1.0E-04
+*CONTROL_TIMESTEP
+       0.0       0.8
+*PART
+steel
+         1         1         1
+*SECTION_SOLID
+         1         1
+*MAT_ELASTIC
+         1    7850.0   2.0E+11       0.3
+)" + mesh_cards + R"(*BOUNDARY_SPC_SET
+         7         0         1         1         1
+*INITIAL_VELOCITY_GENERATION
+         1         2       0.0       0.0       0.0     -10.0
+       0.0       0.0       0.0       0.0       0.0       0.0
+*DATABASE_BINARY_D3PLOT
+   1.0E-05
+*DATABASE_GLSTAT
+   1.0E-06
+*DATABASE_NODOUT
+   5.0E-07
+*DATABASE_HISTORY_NODE
+        12
+*END
+)";
+
+Config kw(const std::string& text, const std::string& name = "model.k") {
+  return parse_keyword_deck(text, name, ".");
+}
+
+// Replaces the first occurrence of `from` (which must exist) in `text`.
+std::string with(std::string text, const std::string& from, const std::string& to) {
+  const auto pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  if (pos != std::string::npos) text.replace(pos, from.size(), to);
+  return text;
+}
+
+// Expects an InputError whose message holds every fragment.
+void expect_error(const std::string& text, const std::vector<std::string>& fragments) {
+  try {
+    kw(text);
+    ADD_FAILURE() << "no error for fragments starting " << fragments.front();
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    for (const auto& f : fragments)
+      EXPECT_NE(msg.find(f), std::string::npos) << msg << "\n  lacks: " << f;
+  }
+}
+
+TEST(Keyword, ReadsADeck) {
+  const Config c = kw(good);
+  EXPECT_EQ(c.title, "two bricks");
+  EXPECT_EQ(c.end_time, 1e-4);
+  EXPECT_EQ(c.time_step_scale, 0.8);
+  EXPECT_EQ(c.fields_every, 1e-5);
+  EXPECT_EQ(c.history_every, 5e-7); // the smaller of GLSTAT and NODOUT
+  ASSERT_EQ(c.materials.size(), 1u);
+  EXPECT_EQ(c.materials[0].name, "mat1");
+  EXPECT_EQ(c.materials[0].model, "elastic");
+  EXPECT_EQ(c.materials[0].params.at("youngs_modulus"), 2e11);
+  ASSERT_EQ(c.parts.size(), 1u);
+  EXPECT_EQ(c.parts[0].name, "part1");
+  EXPECT_EQ(c.parts[0].material, "mat1");
+  EXPECT_EQ(c.parts[0].mesh.kind, MeshConfig::Kind::embedded);
+  EXPECT_EQ(c.parts[0].hourglass.model, HourglassControl::Model::viscous);
+  EXPECT_EQ(c.parts[0].hourglass.coefficient, 0.1);
+  ASSERT_EQ(c.boundary_conditions.size(), 1u);
+  EXPECT_EQ(c.boundary_conditions[0].nodes.name, "nodeset_7");
+  EXPECT_TRUE(c.boundary_conditions[0].fix[0] && c.boundary_conditions[0].fix[2]);
+  ASSERT_EQ(c.initial_conditions.size(), 1u);
+  EXPECT_EQ(c.initial_conditions[0].nodes.part, "part1");
+  EXPECT_EQ(c.initial_conditions[0].velocity, (Vec3{0, 0, -10}));
+  ASSERT_EQ(c.probes.size(), 1u);
+  EXPECT_EQ(c.probes[0].name, "node12");
+  EXPECT_EQ(c.probes[0].at, (Vec3{0, 1, 2}));
+  EXPECT_TRUE(c.warnings.empty());
+
+  const Mesh m = build_mesh(c);
+  EXPECT_EQ(m.num_nodes(), 12);
+  EXPECT_EQ(m.num_elements(), 2);
+  EXPECT_EQ(m.node_sets.at("nodeset_7"), (std::vector<std::int64_t>{0, 1, 2, 3}));
+  EXPECT_EQ(resolve_selection(m, c, c.boundary_conditions[0].nodes).size(), 4u);
+  for (const auto& h : m.blocks[0].elements) {
+    std::array<Vec3, 8> x;
+    for (int a = 0; a < 8; ++a) x[a] = m.nodes[h[a]];
+    EXPECT_NEAR(hex_volume(x), 1.0, 1e-12); // LS-DYNA's node order is anvil's
+  }
+}
+
+// The same deck in free format, long format, I10 format and the two-card element form.
+TEST(Keyword, CardFormatsReadTheSame) {
+  const Config ref = kw(good);
+  const Mesh mref = build_mesh(ref);
+  std::vector<std::string> variants;
+  // Free format (comma-separated) everywhere it matters.
+  variants.push_back(
+      with(with(with(good, "         1    7850.0   2.0E+11       0.3", "1,7850.0,2.0E+11,0.3"),
+                "       2             1.0             0.0             0.0", "2, 1.0, 0.0, 0.0"),
+           "       1       1       1       2       3       4       5       6       "
+           "7       8",
+           "1,1,1,2,3,4,5,6,7,8"));
+  // Two-card elements (EID PID, then N1..N10).
+  variants.push_back(
+      with(good,
+           "       1       1       1       2       3       4       5       6       "
+           "7       8",
+           "       1       1\n       1       2       3       4       5       6       "
+           "7       8       0       0"));
+  // Long format for the nodes ("+" suffix): 20-character fields.
+  {
+    std::string nodes = "*NODE +\n";
+    const Mesh m = mref;
+    for (std::size_t n = 0; n < m.nodes.size(); ++n)
+      nodes += fmt::format("{:>20}{:>20.12e}{:>20.12e}{:>20.12e}\n", n + 1, m.nodes[n].x,
+                           m.nodes[n].y, m.nodes[n].z);
+    std::string text = good;
+    const auto a = text.find("*NODE\n"), b = text.find("*ELEMENT_SOLID");
+    text.replace(a, b - a, nodes);
+    variants.push_back(text);
+  }
+  // Long format everywhere from *KEYWORD LONG=Y: every field 20 characters.
+  {
+    std::string text =
+        "*KEYWORD LONG=Y\n*CONTROL_TERMINATION\n" + fmt::format("{:>20}\n", "1.0E-04") +
+        "*PART\nsteel\n" + fmt::format("{:>20}{:>20}{:>20}\n", 1, 1, 1) + "*SECTION_SOLID\n" +
+        fmt::format("{:>20}{:>20}\n", 1, 1) + "*MAT_ELASTIC\n" +
+        fmt::format("{:>20}{:>20}{:>20}{:>20}\n", 1, "7850.0", "2.0E+11", "0.3") + "*NODE\n";
+    for (std::size_t n = 0; n < mref.nodes.size(); ++n)
+      text += fmt::format("{:>20}{:>20}{:>20}{:>20}\n", n + 1, mref.nodes[n].x, mref.nodes[n].y,
+                          mref.nodes[n].z);
+    text += "*ELEMENT_SOLID\n";
+    for (std::size_t e = 0; e < 2; ++e) {
+      text += fmt::format("{:>20}{:>20}", e + 1, 1);
+      for (auto n : mref.blocks[0].elements[e]) text += fmt::format("{:>20}", n + 1);
+      text += "\n";
+    }
+    variants.push_back(text);
+  }
+  // I10: 8-character fields become 10 wide.
+  {
+    std::string text = with(good, "*KEYWORD\n", "*KEYWORD I10=Y\n");
+    const auto a = text.find("*NODE\n"), b = text.find("*SET_NODE_LIST");
+    std::string cards = "*NODE\n";
+    for (std::size_t n = 0; n < mref.nodes.size(); ++n)
+      cards += fmt::format("{:>10}{:>16}{:>16}{:>16}\n", n + 1, mref.nodes[n].x, mref.nodes[n].y,
+                           mref.nodes[n].z);
+    cards += "*ELEMENT_SOLID\n";
+    for (std::size_t e = 0; e < 2; ++e) {
+      cards += fmt::format("{:>10}{:>10}", e + 1, 1);
+      for (auto n : mref.blocks[0].elements[e]) cards += fmt::format("{:>10}", n + 1);
+      cards += "\n";
+    }
+    text.replace(a, b - a, cards);
+    variants.push_back(text);
+  }
+  for (std::size_t v = 0; v < variants.size(); ++v) {
+    SCOPED_TRACE(fmt::format("variant {}", v));
+    const Config c = kw(variants[v]);
+    const Mesh m = build_mesh(c);
+    EXPECT_EQ(m.nodes, mref.nodes);
+    EXPECT_EQ(m.blocks[0].elements, mref.blocks[0].elements);
+    EXPECT_EQ(c.materials[0].params, ref.materials[0].params);
+    EXPECT_EQ(c.end_time, ref.end_time);
+  }
+}
+
+TEST(Keyword, NumbersInFortranStyle) {
+  for (const char* e : {"2.0E+11", "2.0e11", "2.0D+11", "2.0d11", "2.0+11", "+2.0E11", "2E11"}) {
+    SCOPED_TRACE(e);
+    const Config c = kw(with(good, "   2.0E+11", fmt::format("{:>10}", e)));
+    EXPECT_EQ(c.materials[0].params.at("youngs_modulus"), 2e11);
+  }
+}
+
+TEST(Keyword, PlasticKinematicIsJ2Plasticity) {
+  const std::string mat = R"(*MAT_PLASTIC_KINEMATIC
+         1    8930.0  117.0E+9      0.35    0.4E+999914602.9       1.0
+)";
+  Config c = kw(with(good, "*MAT_ELASTIC\n         1    7850.0   2.0E+11       0.3\n", mat));
+  ASSERT_EQ(c.materials[0].model, "j2_plasticity");
+  EXPECT_EQ(c.materials[0].params.at("yield_stress"), 0.4e9);
+  // E Etan / (E - Etan): 0.1 GPa within the 10 digits of ETAN.
+  EXPECT_LT(test::relative_error(c.materials[0].params.at("hardening_modulus"), 0.1e9), 1e-10);
+  EXPECT_TRUE(c.warnings.empty());
+  // BETA = 0 (LS-DYNA's default, kinematic hardening): a warning says what anvil does.
+  c = kw(with(good, "*MAT_ELASTIC\n         1    7850.0   2.0E+11       0.3\n",
+              "*MAT_003\n1,8930.0,117.0E+9,0.35,0.4E+9,1.0E+8\n"));
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("kinematic"), std::string::npos) << c.warnings[0];
+  EXPECT_NE(c.warnings[0].find("isotropic"), std::string::npos) << c.warnings[0];
+  expect_error(with(good, "*MAT_ELASTIC\n         1    7850.0   2.0E+11       0.3\n",
+                    "*MAT_003\n1,8930.0,117.0E+9,0.35,0.4E+9,200.0E+9,1.0\n"),
+               {"model.k:", "*MAT_003.ETAN", "tangent modulus"});
+}
+
+TEST(Keyword, JohnsonCookAndItsEquationOfState) {
+  const std::string jc = R"(*MAT_JOHNSON_COOK
+$      mid        ro         g         e        pr
+         1    7830.0   77.0E+9  200.0E+9      0.29
+$        a         b         n         c         m        tm        tr      epso
+   792.0E6   510.0E6      0.26     0.014      1.03    1793.0     293.0       1.0
+$       cp        pc     spall        it        d1
+     477.0
+)";
+  Config c = kw(with(good, "*MAT_ELASTIC\n         1    7850.0   2.0E+11       0.3\n", jc));
+  ASSERT_EQ(c.materials[0].model, "johnson_cook");
+  const auto& p = c.materials[0].params;
+  EXPECT_EQ(p.at("A"), 792e6);
+  EXPECT_EQ(p.at("n"), 0.26);
+  EXPECT_EQ(p.at("melt_temperature"), 1793.0);
+  EXPECT_EQ(p.at("specific_heat"), 477.0);
+  EXPECT_EQ(p.at("poissons_ratio"), 0.29);
+  EXPECT_DOUBLE_EQ(p.at("youngs_modulus"), 2 * 77e9 * 1.29); // from G and PR
+  EXPECT_EQ(p.at("taylor_quinney"), 0.9);
+  // G only, with a Gruneisen EOS: the bulk modulus rho C^2, and a warning about the EOS.
+  std::string g_only = with(jc, "   77.0E+9  200.0E+9      0.29", "   77.0E+9");
+  g_only += "*EOS_GRUNEISEN\n         1    4570.0      1.49       0.0       0.0      1.93\n";
+  c = kw(with(with(good, "*MAT_ELASTIC\n         1    7850.0   2.0E+11       0.3\n", g_only),
+              "         1         1         1\n", "         1         1         1         1\n"));
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("EOS_GRUNEISEN"), std::string::npos) << c.warnings[0];
+  const double K = 7830.0 * 4570.0 * 4570.0, G = 77e9;
+  EXPECT_NEAR(c.materials[0].params.at("poissons_ratio"), (3 * K - 2 * G) / (2 * (3 * K + G)),
+              1e-12);
+  // G only and no EOS: nothing gives the bulk modulus.
+  expect_error(with(good, "*MAT_ELASTIC\n         1    7850.0   2.0E+11       0.3\n", g_only),
+               {"*MAT_JOHNSON_COOK.PR", "only the shear modulus"});
+}
+
+TEST(Keyword, HourglassAndBulkViscosity) {
+  Config c = kw(
+      with(with(good, "         1         1         1\n",
+                "         1         1         1         0         5\n"),
+           "*END", "*HOURGLASS\n         5         4      0.03      0.0      1.2      0.1\n*END"));
+  EXPECT_EQ(c.parts[0].hourglass.model, HourglassControl::Model::stiffness);
+  EXPECT_EQ(c.parts[0].hourglass.coefficient, 0.03);
+  EXPECT_EQ(c.parts[0].bulk_viscosity.quadratic, 1.2);
+  EXPECT_EQ(c.parts[0].bulk_viscosity.linear, 0.1);
+  c = kw(with(good, "*END",
+              "*CONTROL_HOURGLASS\n         2      0.07\n*CONTROL_BULK_VISCOSITY\n"
+              "       1.0      0.05\n*END"));
+  EXPECT_EQ(c.parts[0].hourglass.model, HourglassControl::Model::viscous);
+  EXPECT_EQ(c.parts[0].hourglass.coefficient, 0.07);
+  EXPECT_EQ(c.parts[0].bulk_viscosity.quadratic, 1.0);
+  EXPECT_EQ(c.parts[0].bulk_viscosity.linear, 0.05);
+}
+
+TEST(Keyword, ConstraintsVelocitiesContactWalls) {
+  const std::string extra = R"(*BOUNDARY_SPC_NODE
+        12         0         1         0         0
+        11         0         1         0         0
+*INITIAL_VELOCITY_GENERATION
+         3         1     100.0       1.0       0.0       0.0
+       0.5       0.5       0.0       0.0       0.0       2.0
+*SET_PART_LIST
+         3
+         1
+*CONTACT_AUTOMATIC_SINGLE_SURFACE
+         0
+      0.25
+       2.0
+*CONTROL_CONTACT
+      0.05
+*RIGIDWALL_PLANAR
+         0
+       0.0       0.0      -0.1       0.0       0.0       1.0       0.3
+*END)";
+  const Config c =
+      kw(with(with(good, "*END", extra), "       9             0.0             0.0             2.0",
+              "       9             0.0             0.0             2.0       3"));
+  // SPC_NODE x on nodes 11, 12; *NODE TC = 3 (z) on node 9: one set per component mask.
+  ASSERT_EQ(c.boundary_conditions.size(), 3u);
+  const Mesh m = build_mesh(c);
+  EXPECT_EQ(m.node_sets.at("spc_x"), (std::vector<std::int64_t>{10, 11}));
+  EXPECT_EQ(m.node_sets.at("spc_z"), (std::vector<std::int64_t>{8}));
+  ASSERT_EQ(c.initial_conditions.size(), 2u);
+  EXPECT_EQ(c.initial_conditions[1].angular_velocity, (Vec3{0, 0, 100.0})); // axis normalised
+  EXPECT_EQ(c.initial_conditions[1].center, (Vec3{0.5, 0.5, 0}));
+  EXPECT_EQ(c.initial_conditions[1].velocity, (Vec3{1, 0, 0}));
+  ASSERT_EQ(c.contact.size(), 1u);
+  EXPECT_TRUE(c.contact[0].parts.empty()); // SSID 0: all parts
+  EXPECT_EQ(c.contact[0].friction, 0.25);
+  EXPECT_DOUBLE_EQ(c.contact[0].penalty_scale, 0.05 * 2.0); // SLSFAC * SFS
+  ASSERT_EQ(c.rigid_walls.size(), 1u);
+  EXPECT_EQ(c.rigid_walls[0].point, (Vec3{0, 0, -0.1}));
+  EXPECT_EQ(c.rigid_walls[0].normal, (Vec3{0, 0, 1}));
+  EXPECT_EQ(c.rigid_walls[0].friction, 0.3);
+}
+
+TEST(Keyword, UnsupportedKeywordsMakeOneWarning) {
+  const Config c = kw(with(good, "*END", R"(*LOAD_NODE_SET
+         7         3         1
+*DEFINE_CURVE
+         1
+       0.0       0.0
+*LOAD_NODE_SET
+         7         1         1
+*PART
+shell part
+         2         2         2
+*SECTION_SHELL
+         2
+*MAT_RIGID
+         2    7850.0   2.0E+11       0.3
+*END)"));
+  std::vector<std::string> about_keywords;
+  for (const auto& w : c.warnings)
+    if (w.find("not supported by anvil and ignored") != std::string::npos)
+      about_keywords.push_back(w);
+  ASSERT_EQ(about_keywords.size(), 1u);
+  const std::string& w = about_keywords[0];
+  EXPECT_NE(w.find("*LOAD_NODE_SET (2x, first at model.k:"), std::string::npos) << w;
+  EXPECT_NE(w.find("*DEFINE_CURVE (1x"), std::string::npos) << w;
+  EXPECT_NE(w.find("*MAT_RIGID (1x"), std::string::npos) << w;
+  EXPECT_NE(w.find("*SECTION_SHELL (1x"), std::string::npos) << w;
+  // The part without solid elements is left out, with a warning of its own.
+  EXPECT_EQ(c.parts.size(), 1u);
+  EXPECT_EQ(c.warnings.size(), 2u);
+}
+
+TEST(Keyword, Includes) {
+  const auto dir = fs::temp_directory_path() / fmt::format("anvil_keyword_include_{}", ::getpid());
+  fs::create_directories(dir / "sub");
+  std::ofstream(dir / "sub" / "mesh.k") << mesh_cards;
+  std::string main = good;
+  const auto a = main.find("*NODE\n"), b = main.find("*BOUNDARY_SPC_SET");
+  main.replace(a, b - a, "*INCLUDE\nsub/mesh.k\n");
+  std::ofstream(dir / "main.k") << main;
+  const Config c = read_keyword_deck((dir / "main.k").string());
+  EXPECT_EQ(build_mesh(c).num_elements(), 2);
+  // A long name continued with " +".
+  std::ofstream(dir / "cont.k") << with(main, "sub/mesh.k\n", "sub/ +\nmesh.k\n");
+  EXPECT_EQ(build_mesh(read_keyword_deck((dir / "cont.k").string())).num_nodes(), 12);
+  // A cycle and a missing file are errors at the *INCLUDE line.
+  std::ofstream(dir / "sub" / "loop.k") << "*INCLUDE\nloop.k\n";
+  std::ofstream(dir / "cycle.k") << with(main, "sub/mesh.k\n", "sub/loop.k\n");
+  for (const auto& [file, fragment] : std::vector<std::pair<std::string, std::string>>{
+           {"cycle.k", "include cycle"}, {"missing.k", "cannot open the included file"}}) {
+    if (file == "missing.k") std::ofstream(dir / file) << with(main, "sub/mesh.k\n", "nowhere.k\n");
+    try {
+      read_keyword_deck((dir / file).string());
+      ADD_FAILURE() << file;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("*INCLUDE"), std::string::npos) << e.what();
+    }
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Keyword, ErrorsNameFileLineAndField) {
+  expect_error("*NODE\n", {"model.k:1", "starts with *KEYWORD"});
+  expect_error(with(good, "    7850.0", "    78x0.0"), {"model.k:14: *MAT_ELASTIC.RO", "78x0.0"});
+  expect_error(with(good, "    7850.0", "   -7850.0"), {"model.k:14: *MAT_ELASTIC.RO", "positive"});
+  expect_error(with(good, "       0.3\n", "       0.5\n"), {"*MAT_ELASTIC.PR"});
+  expect_error(with(good, "      12             0.0", "      11             0.0"),
+               {"model.k:28: *NODE.NID", "node 11 is defined twice (first at model.k:27)"});
+  expect_error(with(good, "      11      12\n", "      11      13\n"),
+               {"*ELEMENT_SOLID.N8", "element 2", "node 13"});
+  expect_error(with(good, "      11      12\n", "      11      11\n"),
+               {"model.k:31: *ELEMENT_SOLID.N8", "degenerate"});
+  expect_error(with(good, "      11      12\n", "      11\n"), {"has 7 nodes"});
+  expect_error(with(good, "       2       1       5", "       2       9       5"),
+               {"model.k:31: *ELEMENT_SOLID.PID", "part 9"});
+  expect_error(with(good, "   1.0E-04\n", "\n"), {"*CONTROL_TERMINATION", "ENDTIM"});
+  expect_error(with(good, "         7         0         1", "         8         0         1"),
+               {"model.k:36: *BOUNDARY_SPC_SET.NSID", "node set 8 is not defined"});
+  expect_error(with(good, "         7         0         1", "         7         5         1"),
+               {"*BOUNDARY_SPC_SET.CID"});
+  expect_error(with(good, "*MAT_ELASTIC\n", "*MAT_RIGID\n"),
+               {"*PART.MID", "*MAT_RIGID", "anvil does not have"});
+  expect_error(with(good, "    7850.0", "     &dens"), {"*MAT_ELASTIC.RO", "parameter"});
+  expect_error(with(good, "       1             0.0", "       1\t0.0"), {"*NODE", "tab"});
+  expect_error(with(good, "*SECTION_SOLID\n         1", "*SECTION_SOLID\n         2"),
+               {"*PART.SECID", "section 1 is not defined"});
+  // ELFORM other than 1: a warning that anvil's one-point hexahedron is used.
+  EXPECT_NE(
+      kw(with(good, "*SECTION_SOLID\n         1         1", "*SECTION_SOLID\n         1         2"))
+          .warnings.at(0)
+          .find("ELFORM 2"),
+      std::string::npos);
+  expect_error(with(good, "*INITIAL_VELOCITY_GENERATION\n         1         2",
+                    "*INITIAL_VELOCITY_GENERATION\n         1         7"),
+               {"*INITIAL_VELOCITY_GENERATION.STYP"});
+  expect_error(with(good, "*TITLE", "two bricks\n*TITLE"), {"model.k:2", "data without a keyword"});
+}
+
+// Fuzz-style: deterministic damage to the valid deck (bytes, digits, truncation, lines
+// deleted or repeated). Every variant parses or throws InputError naming the deck.
+TEST(Keyword, MutatedDecksParseOrThrowInputError) {
+  std::mt19937 rng(2024);
+  int parsed = 0, rejected = 0;
+  for (int v = 0; v < 600; ++v) {
+    std::string s = good;
+    switch (v % 5) {
+    case 0:
+      for (int k = 0, n = 1 + static_cast<int>(rng() % 6); k < n; ++k)
+        s[rng() % s.size()] = static_cast<char>(rng());
+      break;
+    case 1:
+      for (int k = 0; k < 3; ++k) {
+        const auto p = rng() % s.size();
+        if (std::isdigit(static_cast<unsigned char>(s[p]))) s[p] = "0123456789-.,"[rng() % 13];
+      }
+      break;
+    case 2:
+      s.resize(rng() % s.size());
+      break;
+    case 3:
+    case 4: {
+      const auto p = s.find('\n', rng() % s.size());
+      if (p == std::string::npos) break;
+      const auto q = s.find('\n', p + 1);
+      if (q == std::string::npos) break;
+      if (v % 5 == 3)
+        s.erase(p, q - p);
+      else
+        s.insert(p, s.substr(p, q - p));
+      break;
+    }
+    }
+    try {
+      const Config c = kw(s, "fuzz.k");
+      const Mesh m = build_mesh(c);
+      for (const auto& b : m.blocks)
+        for (const auto& h : b.elements)
+          for (auto n : h) ASSERT_TRUE(n >= 0 && n < m.num_nodes());
+      ++parsed;
+    } catch (const InputError& e) {
+      ASSERT_NE(std::string(e.what()).find("fuzz.k"), std::string::npos) << e.what();
+      ++rejected;
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "variant " << v << ": not an InputError: " << e.what();
+    }
+  }
+  EXPECT_GT(parsed, 50);
+  EXPECT_GT(rejected, 100);
+}
+
+// Through the command line: `anvil check` reads .k decks, prints the warnings, exits 2 on
+// bad ones; a YAML deck can take a keyword file as a part's mesh.
+struct CliRun {
+  int status;
+  std::string output;
+};
+CliRun anvil(const std::string& args) {
+  FILE* p = ::popen(fmt::format("'{}' {} 2>&1", test::anvil_binary(), args).c_str(), "r");
+  if (!p) return {-1, ""};
+  std::string out;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  const int raw = ::pclose(p);
+  return {WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw), out};
+}
+
+TEST(KeywordCli, CheckAndRun) {
+  const auto dir = fs::temp_directory_path() / fmt::format("anvil_keyword_cli_{}", ::getpid());
+  fs::create_directories(dir);
+  std::ofstream(dir / "good.k") << with(good, "*END", "*LOAD_NODE_SET\n7\n*END");
+  CliRun r = anvil(fmt::format("check '{}'", (dir / "good.k").string()));
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("elements    2\n"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("anvil: warning:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("*LOAD_NODE_SET (1x"), std::string::npos) << r.output;
+  r = anvil(fmt::format("run '{}' -q -o '{}'", (dir / "good.k").string(), (dir / "out").string()));
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "out" / "summary.json"));
+  std::ofstream(dir / "bad.key") << with(good, "    7850.0", "    78x0.0");
+  r = anvil(fmt::format("check '{}'", (dir / "bad.key").string()));
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("bad.key:14: *MAT_ELASTIC.RO"), std::string::npos) << r.output;
+  // A keyword file as the mesh of a YAML part: its sets become PART.nodeset_<SID>.
+  std::ofstream(dir / "mesh.k") << mesh_cards;
+  std::ofstream(dir / "deck.yaml") << R"(termination: {cycles: 2}
+materials:
+  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+parts:
+  block:
+    mesh: {file: mesh.k}
+    material: steel
+boundary_conditions:
+  - {set: block.nodeset_7, fix: all}
+)";
+  r = anvil(fmt::format("check '{}'", (dir / "deck.yaml").string()));
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("nodes       12\n"), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
+} // namespace
