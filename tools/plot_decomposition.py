@@ -301,11 +301,13 @@ def style_3d_axes(ax, lo, hi, lu, elev, azim, zoom=1.1, label_size=9, tick_size=
     ax.tick_params(labelsize=tick_size, pad=1)
 
 
-def add_faces(ax, quads, rgba, edges=True, linewidth=0.15):
-    """Add (m, 4, 3) quadrilaterals with RGBA colours to a 3-D axes (edges dark, thin)."""
+def add_faces(ax, quads, rgba, edges=True, linewidth=0.15, edgecolors=None):
+    """Add (m, 4, 3) quadrilaterals with RGBA colours to a 3-D axes.  Edges are thin and
+    dark by default; `edgecolors` (one or one per face) overrides their colour."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    edgecolors = (0.1, 0.1, 0.1, 0.35) if edges else "none"
+    if edgecolors is None:
+        edgecolors = (0.1, 0.1, 0.1, 0.35) if edges else "none"
     coll = Poly3DCollection(quads, facecolors=rgba, edgecolors=edgecolors, linewidths=linewidth)
     ax.add_collection3d(coll)
     return coll
