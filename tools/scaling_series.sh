@@ -5,7 +5,8 @@
 # OUTROOT/P<P>/ (summary.json, history.csv, results.pvd, plus run.log with anvil's output
 # and time.txt with the elapsed/user/system seconds of the whole mpirun).  OUTROOT/machine.json
 # records the machine (nproc, CPU model, load average), the anvil build and the options;
-# OUTROOT/runs.tsv has one line per run.  Runs with more ranks than cores are allowed
+# OUTROOT/runs.tsv has one line per run.  The machine may be shared: the load average before
+# each run is recorded, and --repeat N keeps the fastest of N runs of each rank count.  Runs with more ranks than cores are allowed
 # (--oversubscribe) but their timings are not scaling data: the ranks time-share the cores.
 # tools/plot_figure2.py and tools/plot_parallel_evidence.py read OUTROOT.
 #
@@ -30,6 +31,8 @@ options:
   --anvil PATH           anvil executable (default: build/apps/anvil next to tools/)
   --mpirun CMD           MPI launcher (default: mpirun)
   --mpi-args "ARGS"      extra launcher arguments (default: "--bind-to none")
+  --repeat N             run each rank count N times and keep the fastest (least
+                         grind time) in P<P>/, the others in P<P>/rep<k>/ (default 1)
   --timeout SEC          kill a run after SEC seconds (default: none)
   --no-fields            delete OUTROOT/P<P>/fields and results.pvd after each run
   -h, --help             this text
@@ -53,6 +56,7 @@ cycles=300
 epr=""
 full=0
 timeout_s=""
+repeat=1
 keep_fields=1
 outroot=""
 
@@ -69,6 +73,7 @@ while [ $# -gt 0 ]; do
     --anvil) [ $# -ge 2 ] || die "$1 needs a value"; anvil=$2; shift 2 ;;
     --mpirun) [ $# -ge 2 ] || die "$1 needs a value"; mpirun_cmd=$2; shift 2 ;;
     --mpi-args) [ $# -ge 2 ] || die "$1 needs a value"; mpi_args=$2; shift 2 ;;
+    --repeat) [ $# -ge 2 ] || die "$1 needs a value"; repeat=$2; shift 2 ;;
     --timeout) [ $# -ge 2 ] || die "$1 needs a value"; timeout_s=$2; shift 2 ;;
     --no-fields) keep_fields=0; shift ;;
     -h|--help) usage; exit 0 ;;
@@ -80,6 +85,7 @@ done
 [ -n "$outroot" ] || { usage >&2; die "OUTROOT is required"; }
 is_uint "$cycles" || die "--cycles expects a non-negative integer, got '$cycles'"
 [ -z "$epr" ] || is_uint "$epr" || die "--elements-per-rank expects an integer, got '$epr'"
+is_uint "$repeat" && [ "$repeat" -ge 1 ] || die "--repeat expects N >= 1, got '$repeat'"
 [ -z "$timeout_s" ] || is_uint "$timeout_s" || die "--timeout expects seconds, got '$timeout_s'"
 [ -x "$anvil" ] || die "$anvil: no executable (build it: cmake --build build -j2 --target anvil)"
 command -v "$mpirun_cmd" >/dev/null || die "$mpirun_cmd: launcher not found"
@@ -129,7 +135,8 @@ cat >"$outroot/machine.json" <<EOF
   "mpi_args": "$(json_str "--oversubscribe $mpi_args")",
   "ranks": $ranks_json,
   "cycles": $([ "$full" = 1 ] && echo null || echo "$cycles"),
-  "elements_per_rank": ${epr:-1875}
+  "elements_per_rank": ${epr:-1875},
+  "repeat": $repeat
 }
 EOF
 
@@ -141,48 +148,78 @@ if [ ${#over[@]} -gt 0 ]; then
   echo "      measure time-sharing, not parallel scaling. Only P <= $cores is scaling data."
 fi
 
-printf 'ranks\telements\tcycles\tstatus\telapsed_s\tuser_s\tsys_s\tgrind_us\tloadavg_before\toversubscribed\n' \
+printf 'ranks\trep\telements\tcycles\tstatus\telapsed_s\tuser_s\tsys_s\tgrind_us\tloadavg_before\toversubscribed\n' \
   >"$outroot/runs.tsv"
-failed=0
-for p in "${ranks[@]}"; do
-  dir="$outroot/P$p"
-  rm -rf "$dir"
+
+# run_one P DIR REP: one mpirun into DIR; appends to runs.tsv; sets run_ok and run_grind.
+run_one() {
+  local p=$1 dir=$2 rep=$3
   mkdir -p "$dir"
-  args=(bench can-crush -o "$dir")
+  local args=(bench can-crush -o "$dir")
   [ "$full" = 1 ] || args+=(--cycles "$cycles")
   [ -z "$epr" ] || args+=(--elements-per-rank "$epr")
-  launcher=("$mpirun_cmd" -np "$p" --oversubscribe)
+  local launcher=("$mpirun_cmd" -np "$p" --oversubscribe)
   # shellcheck disable=SC2206  # the extra launcher arguments are meant to split on spaces
   launcher+=($mpi_args)
-  [ -z "$timeout_s" ] || launcher=(timeout --signal=TERM --kill-after=30 "$timeout_s" "${launcher[@]}")
-  tag=""
+  [ -z "$timeout_s" ] ||
+    launcher=(timeout --signal=TERM --kill-after=30 "$timeout_s" "${launcher[@]}")
+  local tag="" load_before status st
   [ "$p" -gt "$cores" ] && tag=" (oversubscribed: $p ranks on $cores cores)"
   load_before=$(loadavg)
-  printf 'P = %-4s ... ' "$p"
+  if [ "$repeat" -gt 1 ]; then printf 'P = %-4s #%-2s ... ' "$p" "$rep"; else printf 'P = %-4s ... ' "$p"; fi
   echo "${launcher[*]} $anvil ${args[*]}" >"$dir/command.txt"
   /usr/bin/time -f '%e %U %S' -o "$dir/time.txt" "${launcher[@]}" "$anvil" "${args[@]}" \
     >"$dir/run.log" 2>&1
   status=$?
   # the last line of time.txt (a failed command adds a line before it)
-  elapsed=NA user=NA sys=NA
+  local elapsed=NA user=NA sys=NA elements=NA ncyc=NA
+  run_grind=NA
   [ -s "$dir/time.txt" ] && read -r elapsed user sys < <(tail -n 1 "$dir/time.txt")
-  elements=NA grind=NA ncyc=NA
   if [ "$status" = 0 ] && [ -s "$dir/summary.json" ]; then
     elements=$(sed -n 's/^  "elements": \([0-9]*\),*$/\1/p' "$dir/summary.json")
     ncyc=$(sed -n 's/^  "cycles": \([0-9]*\),*$/\1/p' "$dir/summary.json")
-    grind=$(sed -n 's/^  "grind_us": \([-0-9.eE+]*\),*$/\1/p' "$dir/summary.json")
-    echo "ok   ${elements:-?} elements, ${ncyc:-?} cycles, ${elapsed}s, grind ${grind:-?} us$tag"
+    run_grind=$(sed -n 's/^  "grind_us": \([-0-9.eE+]*\),*$/\1/p' "$dir/summary.json")
+    printf 'ok   %s elements, %s cycles, %ss, grind %.4g us, load %s%s\n' "${elements:-?}" \
+      "${ncyc:-?}" "$elapsed" "${run_grind:-0}" "${load_before%% *}" "$tag"
     st=ok
+    run_ok=1
   else
     st="failed($status)"
     [ "$status" = 124 ] && st="timeout"
-    failed=$((failed + 1))
     echo "FAILED (exit $status, see $dir/run.log)$tag"
+    run_ok=0
   fi
   if [ "$keep_fields" = 0 ]; then rm -rf "$dir/fields" "$dir/results.pvd"; fi
-  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$p" "${elements:-NA}" "${ncyc:-NA}" "$st" \
-    "${elapsed:-NA}" "${user:-NA}" "${sys:-NA}" "${grind:-NA}" "$load_before" \
+  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$p" "$rep" "${elements:-NA}" \
+    "${ncyc:-NA}" "$st" "$elapsed" "$user" "$sys" "${run_grind:-NA}" "$load_before" \
     "$([ "$p" -gt "$cores" ] && echo yes || echo no)" >>"$outroot/runs.tsv"
+}
+
+failed=0
+for p in "${ranks[@]}"; do
+  dir="$outroot/P$p"
+  rm -rf "$dir"
+  if [ "$repeat" = 1 ]; then
+    run_one "$p" "$dir" 1
+    [ "$run_ok" = 1 ] || failed=$((failed + 1))
+    continue
+  fi
+  # best of N: every repetition in P<P>/rep<k>/, the fastest (least grind) copied to P<P>/
+  best="" best_grind=""
+  for rep in $(seq 1 "$repeat"); do
+    run_one "$p" "$dir/rep$rep" "$rep"
+    if [ "$run_ok" = 1 ]; then
+      if [ -z "$best" ] || awk -v a="$run_grind" -v b="$best_grind" 'BEGIN{exit !(a < b)}'; then
+        best="$dir/rep$rep" best_grind=$run_grind
+      fi
+    else
+      failed=$((failed + 1))
+    fi
+  done
+  if [ -n "$best" ]; then
+    find "$best" -mindepth 1 -maxdepth 1 -exec cp -r {} "$dir"/ \;
+    echo "best of $repeat: $(basename "$best") (grind $best_grind us)" >"$dir/best_of.txt"
+  fi
 done
 
 echo "wrote $outroot/runs.tsv and $outroot/machine.json"
