@@ -180,6 +180,7 @@ def plot_phases(series, args, title):
           for n in names}
     total = sum(ms.values())
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.8))
+    phase_handles = []
     for ax, scale in ((ax1, np.ones_like(total)), (ax2, 100.0 / np.maximum(total, 1e-300))):
         bottom = np.zeros(len(runs))
         for n in names:
@@ -187,6 +188,8 @@ def plot_phases(series, args, title):
             h = ms[n] * scale
             bars = ax.bar(x, h, 0.65, bottom=bottom, color=colour, edgecolor="white", lw=0.5,
                           label=label)
+            if ax is ax1:
+                phase_handles.append(bars)
             for b, s in zip(bars, runs):
                 if s["_oversubscribed"]:
                     b.set_hatch("///")
@@ -198,18 +201,23 @@ def plot_phases(series, args, title):
                                    if any(s["_oversubscribed"] for s in runs) else ""))
         ax.grid(True, axis="y", alpha=0.3)
         ax.set_axisbelow(True)
-    for xi, t in zip(x, total):
+    wall = np.array([float(s["wall_seconds"]) / max(int(s["cycles"]), 1) * 1e3 for s in runs])
+    wall_handle = ax1.hlines(wall, x - 0.42, x + 0.42, color="black", lw=1.5,
+               label="wall time per cycle\n(the phase maxima may sum to more)")
+    for xi, t in zip(x, wall):
         ax1.text(xi, t, f"{t:.3g}", ha="center", va="bottom", fontsize=8)
-    ax1.set_ylabel("wall time per cycle [ms]")
-    ax1.set_title("time per cycle by phase (max over ranks)", fontsize=10)
-    ax1.set_ylim(0, float(total.max()) * 1.12)
-    ax2.set_ylabel("share of wall time [%]")
+    ax1.set_ylabel("time per cycle [ms]")
+    ax1.set_title("time per cycle by phase (each phase: max over ranks)", fontsize=10)
+    ax1.set_ylim(0, float(max(total.max(), wall.max())) * 1.12)
+    ax2.set_ylabel("share [%]")
     ax2.set_ylim(0, 100)
-    ax2.set_title("share of the wall time", fontsize=10)
-    handles, hl = ax1.get_legend_handles_labels()
-    fig.legend(handles[::-1], hl[::-1], loc="center right", fontsize=8, frameon=False)
+    ax2.set_title("shares of the summed phase times", fontsize=10)
+    # phases top to bottom as stacked, then the wall-time marker
+    fig.legend(phase_handles[::-1] + [wall_handle],
+               [PHASE_STYLE[n][0] for n in names[::-1]] + [wall_handle.get_label()],
+               loc="center right", fontsize=8, frameon=False)
     fig.suptitle(title, fontsize=11)
-    fig.tight_layout(rect=(0, 0, 0.8, 1))
+    fig.tight_layout(rect=(0, 0, 0.77, 1))
     return fig
 
 

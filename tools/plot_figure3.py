@@ -67,6 +67,7 @@ def parse_args(argv=None):
     p.add_argument("--cut", metavar="AXIS=VALUE",
                    help="cutaway: keep only cells whose centroid has AXIS <= VALUE [m]")
     p.add_argument("--no-edges", action="store_true", help="do not draw element edges")
+    p.add_argument("--axes", action="store_true", help="draw the x, y, z axes in each panel")
     p.add_argument("--title", help="title (default: from summary.json)")
     p.add_argument("--dpi", type=int, default=110, help="PNG resolution (default 110)")
     p.add_argument("-o", "--output", help="PNG to write (default OUTDIR/figure3.png)")
@@ -189,10 +190,12 @@ def main(argv=None):
         # the anti-aliasing seams between faces (which would let the background through).
         edge_rgba = rgba.copy()
         if not args.no_edges:
-            edge_rgba[:, :3] *= 0.6
-        add_faces(ax, surf.quads[front] * lf, rgba, linewidth=0.25, edgecolors=edge_rgba)
-        style_3d_axes(ax, lo, hi, lu, args.elev, args.azim, zoom=1.0, label_size=8,
-                      tick_size=7)
+            edge_rgba[:, :3] *= 0.7
+        add_faces(ax, surf.quads[front] * lf, rgba, linewidth=0.5, edgecolors=edge_rgba)
+        style_3d_axes(ax, lo, hi, lu, args.elev, args.azim, zoom=1.0 if args.axes else 1.12,
+                      label_size=8, tick_size=7)
+        if not args.axes:
+            ax.set_axis_off()
         counts = per_rank_counts(grid, field, n_ranks)
         spread = (f"elements per rank {counts.min():,}-{counts.max():,}, max/mean "
                   f"{counts.max() / max(counts.mean(), 1e-300):.2f}")
@@ -209,7 +212,7 @@ def main(argv=None):
         head += f": {summary.get('ranks', n_ranks)} ranks, {summary.get('elements', 0):,} elements"
     fig.suptitle(head + "\nFE decomposition (a) and contact RCB decomposition (b-f); "
                  "same colour = same rank", fontsize=12)
-    fig.subplots_adjust(left=0.01, right=0.99, top=0.9, bottom=0.06, wspace=0.02, hspace=0.1)
+    fig.subplots_adjust(left=0.0, right=1.0, top=0.9, bottom=0.05, wspace=0.0, hspace=0.1)
     out = args.output or os.path.join(
         args.outdir if os.path.isdir(args.outdir) else ".", "figure3.png")
     save_figure(fig, out, dpi=args.dpi)
