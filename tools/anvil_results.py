@@ -192,7 +192,8 @@ class Series:
     """The runs of one or more scaling_series.sh output roots.
 
     runs: summary.json dicts sorted by rank count, each with "_dir" (its directory) and
-    "_oversubscribed" (ranks > nproc) added; machine: OUTROOT/machine.json of the first root
+    "_oversubscribed" (ranks > nproc) and "_cpu_seconds" (user + system seconds of all
+    ranks from time.txt, or None) added; machine: OUTROOT/machine.json of the first root
     that has one ({} if none); nproc: cores of that machine (None when unknown)."""
 
     runs: list
@@ -210,6 +211,18 @@ def read_machine(root):
             return json.load(f)
     except (OSError, ValueError) as e:
         raise ResultsError(f"{path}: cannot read ({e})") from None
+
+
+def read_cpu_seconds(run_dir):
+    """User + system CPU seconds of the whole mpirun (all ranks, setup included) from
+    RUN_DIR/time.txt as scaling_series.sh writes it ('elapsed user sys' on the last line),
+    or None when absent or unreadable."""
+    try:
+        with open(os.path.join(run_dir, "time.txt"), encoding="utf-8") as f:
+            last = f.read().strip().splitlines()[-1].split()
+        return float(last[1]) + float(last[2])
+    except (OSError, IndexError, ValueError):
+        return None
 
 
 def read_series(roots, nproc=None):
@@ -249,6 +262,7 @@ def read_series(roots, nproc=None):
                 continue
             seen[p] = d
             s["_dir"] = d
+            s["_cpu_seconds"] = read_cpu_seconds(d)
             runs.append(s)
     if not runs:
         raise ResultsError(f"{', '.join(roots)}: no P<n>/summary.json found")
