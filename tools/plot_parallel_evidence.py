@@ -9,7 +9,9 @@ with many cycles and P = 16..64 with a few) and draws, against P on a log2 axis:
     imbalance (nodes searched + faces held per rank, a count that does not depend on the
     machine; last cycle and worst cycle);
 (b) bytes sent per rank per cycle by the contact transfers (max over ranks;
-    contact.bytes_sent_per_rank_per_cycle_max), in kB;
+    contact.bytes_sent_per_rank_per_cycle_max), in kB, labelled with the elements
+    through the can wall when the run directory holds deck.yaml (a thicker split
+    leaves fewer exterior nodes and faces per rank);
 (c) wall time per cycle times min(P, cores) / P: on an oversubscribed machine the ranks
     time-share the cores, so this is roughly the time one rank's work takes per cycle,
     which stays flat when the work per rank and the per-rank overheads do not grow with P.
@@ -23,6 +25,7 @@ with many cycles and P = 16..64 with a few) and draws, against P on a log2 axis:
 
 import argparse
 import os
+import re
 
 import numpy as np
 
@@ -68,9 +71,22 @@ def values(series):
             rebalances=c.get("rebalances", None),
             ms_cycle=float(s["wall_seconds"]) / cyc * 1e3,
             ms_rank=float(s["wall_seconds"]) / cyc * 1e3 * share,
+            layers=wall_layers(s["_dir"]),
             over=s["_oversubscribed"],
         ))
     return out
+
+
+def wall_layers(run_dir):
+    """Elements through the can wall from RUN_DIR/deck.yaml (the first mesh's third
+    division), or None when the deck is absent or has no such line."""
+    try:
+        with open(os.path.join(run_dir, "deck.yaml"), encoding="utf-8") as f:
+            m = re.search(r"generate:\s*can\b.*?divisions:\s*\[\s*\d+\s*,\s*\d+\s*,\s*(\d+)",
+                          f.read())
+    except OSError:
+        return None
+    return int(m.group(1)) if m else None
 
 
 def log2_axis(ax, ranks):
@@ -119,8 +135,11 @@ def plot(series, rows, title):
     series_plot(ax, ranks, [r["bytes"] / 1e3 for r in rows], over,
                 dict(color="tab:purple", marker="o"), "max over ranks")
     for r in rows:
-        ax.annotate(f"{r['bytes'] / 1e3:,.0f}", (r["ranks"], r["bytes"] / 1e3),
-                    textcoords="offset points", xytext=(4, 6), fontsize=7.5)
+        text = f"{r['bytes'] / 1e3:,.0f}"
+        if r["layers"]:
+            text += f"\n{r['layers']} layer" + ("s" if r["layers"] > 1 else "")
+        ax.annotate(text, (r["ranks"], r["bytes"] / 1e3), textcoords="offset points",
+                    xytext=(4, 6), fontsize=7.5)
     ax.set_ylim(0, np.nanmax([r["bytes"] for r in rows]) / 1e3 * 1.2)
     ax.set_ylabel("kB sent per rank per cycle")
     ax.set_title("(b) contact transfer volume (FE <-> contact, incl. to self)", fontsize=10)
@@ -148,13 +167,13 @@ def plot(series, rows, title):
 
 def table(rows):
     """Markdown table of the plotted numbers."""
-    head = ["P", "elements", "cycles", "imb fe (time)", "imb contact (time)",
+    head = ["P", "elements", "wall layers", "cycles", "imb fe (time)", "imb contact (time)",
             "contact load imb last", "contact load imb max", "kB/rank/cycle", "rebalances",
             "ms/cycle", "ms/cycle x min(P,cores)/P", "oversub."]
     lines = ["| " + " | ".join(head) + " |", "|" + "---:|" * len(head)]
     for r in rows:
         lines.append("| " + " | ".join([
-            str(r["ranks"]), f"{r['elements']:,}", str(r["cycles"]), f"{r['imb_fe']:.2f}",
+            str(r["ranks"]), f"{r['elements']:,}", str(r["layers"] or "?"), str(r["cycles"]), f"{r['imb_fe']:.2f}",
             f"{r['imb_contact']:.2f}", f"{r['load_last']:.3f}", f"{r['load_max']:.3f}",
             f"{r['bytes'] / 1e3:,.1f}", str(r["rebalances"]), f"{r['ms_cycle']:.1f}",
             f"{r['ms_rank']:.2f}", "yes" if r["over"] else "no"]) + " |")

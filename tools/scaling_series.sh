@@ -2,8 +2,9 @@
 # Run the paper's scaled can crush (DESIGN.md section 5) at P = 1, 2, 4, 8, ... ranks.
 #
 # Each run is `mpirun -np P --oversubscribe anvil bench can-crush --cycles C` into
-# OUTROOT/P<P>/ (summary.json, history.csv, results.pvd, plus run.log with anvil's output
-# and time.txt with the elapsed/user/system seconds of the whole mpirun).  OUTROOT/machine.json
+# OUTROOT/P<P>/ (summary.json, history.csv, results.pvd, plus run.log with anvil's output,
+# time.txt with the elapsed/user/system seconds of the whole mpirun and deck.yaml, the
+# deck for that rank count).  OUTROOT/machine.json
 # records the machine (nproc, CPU model, load average), the anvil build and the options;
 # OUTROOT/runs.tsv has one line per run.  The machine may be shared: the load average before
 # each run is recorded, and --repeat N keeps the fastest of N runs of each rank count.  Runs with more ranks than cores are allowed
@@ -171,6 +172,9 @@ run_one() {
   load_before=$(loadavg)
   if [ "$repeat" -gt 1 ]; then printf 'P = %-4s #%-2s ... ' "$p" "$rep"; else printf 'P = %-4s ... ' "$p"; fi
   echo "${launcher[*]} $anvil ${args[*]}" >"$dir/command.txt"
+  # the deck of this rank count, for the record (mesh divisions)
+  "${launcher[@]}" "$anvil" bench can-crush --print-deck \
+    ${epr:+--elements-per-rank "$epr"} >"$dir/deck.yaml" 2>/dev/null || rm -f "$dir/deck.yaml"
   /usr/bin/time -f '%e %U %S' -o "$dir/time.txt" "${launcher[@]}" "$anvil" "${args[@]}" \
     >"$dir/run.log" 2>&1
   status=$?
