@@ -10,12 +10,15 @@ Public interface:
     length_unit(extent) -> (factor, label)
     run_main(main)                       call main(); turn errors into exit status 2
     save_figure(fig, path)               write a PNG, creating the directory
+    read_series(roots) -> Series         the runs of tools/scaling_series.sh, by rank count
 """
 
+import glob
 import json
 import os
+import re
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -175,3 +178,114 @@ def run_main(main, prog):
         print(f"{prog}: error: {e}", file=sys.stderr)
         sys.exit(2)
     sys.exit(status or 0)
+
+
+# --------------------------------------------------------------------------- scaling series
+
+# Phases of summary.json's timers shown separately in the breakdowns, in stacking order;
+# the rest of the wall time (predict, update, output, sph and untimed work) is "other".
+SERIES_PHASES = ["fe", "halo", "contact_search", "contact_force", "transfer", "rebalance"]
+
+
+@dataclass
+class Series:
+    """The runs of one or more scaling_series.sh output roots.
+
+    runs: summary.json dicts sorted by rank count, each with "_dir" (its directory) and
+    "_oversubscribed" (ranks > nproc) and "_cpu_seconds" (user + system seconds of all
+    ranks from time.txt, or None) added; machine: OUTROOT/machine.json of the first root
+    that has one ({} if none); nproc: cores of that machine (None when unknown)."""
+
+    runs: list
+    machine: dict = field(default_factory=dict)
+    nproc: int = None
+
+
+def read_machine(root):
+    """ROOT/machine.json as written by scaling_series.sh, or {} when absent."""
+    path = os.path.join(root, "machine.json")
+    if not os.path.exists(path):
+        return {}
+    try:
+        with open(path, encoding="utf-8") as f:
+            return json.load(f)
+    except (OSError, ValueError) as e:
+        raise ResultsError(f"{path}: cannot read ({e})") from None
+
+
+def read_cpu_seconds(run_dir):
+    """User + system CPU seconds of the whole mpirun (all ranks, setup included) from
+    RUN_DIR/time.txt as scaling_series.sh writes it ('elapsed user sys' on the last line),
+    or None when absent or unreadable."""
+    try:
+        with open(os.path.join(run_dir, "time.txt"), encoding="utf-8") as f:
+            last = f.read().strip().splitlines()[-1].split()
+        return float(last[1]) + float(last[2])
+    except (OSError, IndexError, ValueError):
+        return None
+
+
+def read_series(roots, nproc=None):
+    """Collect ROOT/P<n>/summary.json of every root (a root may also be one run directory).
+
+    Runs with the same rank count: the first root wins and a warning names the other.
+    `nproc` overrides the core count of machine.json.  Runs whose summary says failed are
+    skipped with a warning.  Raises ResultsError when no run is found."""
+    runs, machine, seen = [], {}, {}
+    for root in roots:
+        if not os.path.isdir(root):
+            raise ResultsError(f"{root}: no such directory")
+        if not machine:
+            machine = read_machine(root)
+        if os.path.exists(os.path.join(root, "summary.json")):
+            dirs = [root]
+        else:
+            dirs = [d for d in glob.glob(os.path.join(root, "P*")) if re.fullmatch(
+                r"P\d+", os.path.basename(d)) and os.path.isdir(d)]
+        for d in sorted(dirs, key=lambda d: int(re.sub(r"\D", "", os.path.basename(d)) or 0)):
+            s = read_summary(d)
+            if s is None:
+                print(f"warning: {d}: no summary.json (run failed or still running?)",
+                      file=sys.stderr)
+                continue
+            path = os.path.join(d, "summary.json")
+            for key in ("ranks", "elements", "cycles", "wall_seconds", "grind_us", "timers"):
+                if key not in s:
+                    raise ResultsError(f"{path}: no {key!r}")
+            if s.get("status", "completed") != "completed":
+                print(f"warning: {path}: status {s.get('status')!r}, skipped", file=sys.stderr)
+                continue
+            p = int(s["ranks"])
+            if p in seen:
+                print(f"warning: {path}: P = {p} already read from {seen[p]}, ignored",
+                      file=sys.stderr)
+                continue
+            seen[p] = d
+            s["_dir"] = d
+            s["_cpu_seconds"] = read_cpu_seconds(d)
+            runs.append(s)
+    if not runs:
+        raise ResultsError(f"{', '.join(roots)}: no P<n>/summary.json found")
+    runs.sort(key=lambda s: s["ranks"])
+    if nproc is None:
+        nproc = machine.get("nproc")
+    for s in runs:
+        s["_oversubscribed"] = bool(nproc) and s["ranks"] > nproc
+    return Series(runs, machine, nproc)
+
+
+def phase_seconds(summary):
+    """{phase: seconds} for SERIES_PHASES plus "other" = wall_seconds minus their sum
+    (clipped at 0: the timers are maxima over ranks, so their sum may exceed the wall)."""
+    t = summary["timers"]
+    out = {p: float(t.get(p, 0.0)) for p in SERIES_PHASES}
+    out["other"] = max(0.0, float(summary["wall_seconds"]) - sum(out.values()))
+    return out
+
+
+def scaled_efficiency(runs):
+    """E(P) = grind(P0) * P0 / (P * grind(P)) per run, P0 the smallest rank count (1 for
+    the paper's definition grind(1) / (P grind(P)))."""
+    base = runs[0]
+    g0, p0 = float(base["grind_us"]), int(base["ranks"])
+    return [g0 * p0 / (int(s["ranks"]) * float(s["grind_us"])) for s in runs]

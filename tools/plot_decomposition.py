@@ -18,6 +18,7 @@ fields with a colorbar.
 import argparse
 import os
 import sys
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -280,33 +281,49 @@ def padded_limits(pts, min_ratio=0.45):
     return mid - 0.5 * want, mid + 0.5 * want
 
 
+def style_3d_axes(ax, lo, hi, lu, elev, azim, zoom=1.1, label_size=9, tick_size=8):
+    """Limits lo..hi (3,) in length unit `lu`, equal scale on all axes, orthographic view
+    from elev/azim [deg], transparent panes, light grid and labelled axes."""
+    from matplotlib.ticker import MaxNLocator
+
+    ax.set_proj_type("ortho")
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_zlim(lo[2], hi[2])
+    ax.set_box_aspect((hi - lo) / (hi - lo).max(), zoom=zoom)
+    ax.view_init(elev=elev, azim=azim)
+    for axis, name in ((ax.xaxis, "x"), (ax.yaxis, "y"), (ax.zaxis, "z")):
+        axis.pane.set_alpha(0.0)
+        axis._axinfo["grid"].update(color=(0.5, 0.5, 0.5, 0.25), linewidth=0.5)
+        axis.set_label_text(f"{name} [{lu}]")
+        axis.label.set_size(label_size)
+        axis.set_major_locator(MaxNLocator(5))
+    ax.tick_params(labelsize=tick_size, pad=1)
+
+
+def add_faces(ax, quads, rgba, edges=True, linewidth=0.15, edgecolors=None):
+    """Add (m, 4, 3) quadrilaterals with RGBA colours to a 3-D axes.  Edges are thin and
+    dark by default; `edgecolors` (one or one per face) overrides their colour."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    if edgecolors is None:
+        edgecolors = (0.1, 0.1, 0.1, 0.35) if edges else "none"
+    coll = Poly3DCollection(quads, facecolors=rgba, edgecolors=edgecolors, linewidths=linewidth)
+    ax.add_collection3d(coll)
+    return coll
+
+
 def draw(quads, rgba, legend, counts, args, title, lu):
     """Build the figure from quads (m,4,3) already in length unit `lu`, their RGBA colours,
     the legend description of face_colors and per-category element counts."""
     plt = use_agg()
     from matplotlib.patches import Patch
-    from matplotlib.ticker import MaxNLocator
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     fig = plt.figure(figsize=tuple(args.size))
     ax = fig.add_subplot(projection="3d", computed_zorder=False)
-    ax.set_proj_type("ortho")
-    edges = "none" if args.no_edges else (0.1, 0.1, 0.1, 0.35)
-    coll = Poly3DCollection(quads, facecolors=rgba, edgecolors=edges, linewidths=0.15)
-    ax.add_collection3d(coll)
+    add_faces(ax, quads, rgba, edges=not args.no_edges)
     lo, hi = padded_limits(quads.reshape(-1, 3) if len(quads) else np.zeros((1, 3)))
-    ax.set_xlim(lo[0], hi[0])
-    ax.set_ylim(lo[1], hi[1])
-    ax.set_zlim(lo[2], hi[2])
-    ax.set_box_aspect((hi - lo) / (hi - lo).max(), zoom=1.1)
-    ax.view_init(elev=args.elev, azim=args.azim)
-    for axis, name in ((ax.xaxis, "x"), (ax.yaxis, "y"), (ax.zaxis, "z")):
-        axis.pane.set_alpha(0.0)
-        axis._axinfo["grid"].update(color=(0.5, 0.5, 0.5, 0.25), linewidth=0.5)
-        axis.set_label_text(f"{name} [{lu}]")
-        axis.label.set_size(9)
-        axis.set_major_locator(MaxNLocator(5))
-    ax.tick_params(labelsize=8, pad=1)
+    style_3d_axes(ax, lo, hi, lu, args.elev, args.azim)
     fig.subplots_adjust(top=0.9 if args.elev >= 0 else 0.82)  # tick labels on top from below
     fig.suptitle(title, fontsize=11, y=0.96)
 
@@ -349,39 +366,69 @@ def build_title(args, summary, entry):
     return f"{head}\n{name}{when} ({shape})"
 
 
+@dataclass
+class Surface:
+    """The exterior faces of a field output, ready to draw.
+
+    quads (m, 4, 3) corner coordinates [m] in outward order; normals (m, 3) unit outward;
+    values (m,) the field on each face (SI units); is_int: an integer field; counts
+    {value: number of hexahedra} for an integer cell field ({} otherwise); points: all
+    point coordinates used [m] (deformed or undeformed as asked)."""
+
+    quads: np.ndarray
+    normals: np.ndarray
+    values: np.ndarray
+    is_int: bool
+    counts: dict
+    points: np.ndarray
+
+
+def exterior_surface(grid, field, undeformed=False, cut=None, where="input"):
+    """Exterior faces of `grid`'s hexahedra coloured by `field` (see face_values).
+
+    undeformed: subtract the displacement point field; cut: (axis index, value) keeps only
+    cells whose centroid has coordinate <= value.  `where` names the input in errors."""
+    conn, hex_cells = grid.hex_connectivity()
+    if len(conn) == 0:
+        raise ResultsError(f"{where}: no hexahedral cells to draw")
+    points = grid.points
+    if undeformed:
+        if "displacement" not in grid.point_data:
+            raise ResultsError(f"{where}: no displacement field for --undeformed")
+        points = points - grid.point_data["displacement"]
+    if cut is not None:
+        keep = points[conn].mean(axis=1)[:, cut[0]] <= cut[1]
+        if not keep.any():
+            raise ResultsError(f"{where}: --cut removes every cell")
+        conn, hex_cells = conn[keep], hex_cells[keep]
+    faces, owner = exterior_faces(conn, node_keys(grid))
+    vals, is_int = face_values(grid, field, hex_cells, faces, owner, where)
+    quads = points[faces]
+    counts = category_counts(grid, field, hex_cells) if is_int else {}
+    return Surface(quads, face_normals(quads), vals, is_int, counts, points)
+
+
+def front_faces(surface, elev, azim):
+    """Boolean mask of the faces turned towards a viewer at elev/azim (orthographic)."""
+    return surface.normals @ view_vector(elev, azim) > -1e-9
+
+
 def main(argv=None):
     """Entry point: read one field output, draw, write the PNG and print its path."""
     args = parse_args(argv)
     entry, grid = load_output(args.outdir, step=args.step, time=args.time)
-    conn, hex_cells = grid.hex_connectivity()
-    if len(conn) == 0:
-        raise ResultsError(f"{entry.path}: no hexahedral cells to draw")
-    points = grid.points
-    if args.undeformed:
-        if "displacement" not in grid.point_data:
-            raise ResultsError(f"{entry.path}: no displacement field for --undeformed")
-        points = points - grid.point_data["displacement"]
+    surf = exterior_surface(grid, args.field, args.undeformed, args.cut, entry.path)
+    front = front_faces(surf, args.elev, args.azim)  # orthographic view: back faces hidden
+    rgba, legend = face_colors(surf.values, surf.is_int, args)
 
-    if args.cut is not None:
-        keep = points[conn].mean(axis=1)[:, args.cut[0]] <= args.cut[1]
-        if not keep.any():
-            raise ResultsError(f"{entry.path}: --cut removes every cell")
-        conn, hex_cells = conn[keep], hex_cells[keep]
-    faces, owner = exterior_faces(conn, node_keys(grid))
-    vals, is_int = face_values(grid, args.field, hex_cells, faces, owner, entry.path)
-    quads = points[faces]
-    normals = face_normals(quads)
-    view = view_vector(args.elev, args.azim)
-    front = normals @ view > -1e-9  # orthographic view: back faces are hidden
-    rgba, legend = face_colors(vals, is_int, args)
-
-    extent = (points.max(axis=0) - points.min(axis=0)).max()
+    extent = (surf.points.max(axis=0) - surf.points.min(axis=0)).max()
     lf, lu = length_unit(extent)
     summary = read_summary(args.outdir) if os.path.isdir(args.outdir) else None
     title = build_title(args, summary, entry)
-    counts = category_counts(grid, args.field, hex_cells) if legend[0] == "categories" else {}
-    fig = draw(quads[front] * lf, shade(rgba[front], normals[front], light_vector(args.elev, args.azim),
-               0.6 if legend[0] == "categories" else 0.3), legend, counts,
+    counts = surf.counts if legend[0] == "categories" else {}
+    fig = draw(surf.quads[front] * lf,
+               shade(rgba[front], surf.normals[front], light_vector(args.elev, args.azim),
+                     0.6 if legend[0] == "categories" else 0.3), legend, counts,
                args, title, lu)
     out = args.output or os.path.join(
         args.outdir if os.path.isdir(args.outdir) else ".", f"{args.field}.png")

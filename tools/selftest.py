@@ -164,6 +164,7 @@ def rank_piece(pts, conn, cells, rank, t):
                       ("pressure", 1, (-stress[:, 2] / 3).tolist(), False),
                       ("plastic_strain", 1, (0.01 * cells * t / 1e-5).tolist(), False),
                       ("fe_rank", 1, [rank] * len(cells), True),
+                      ("contact_rank", 1, [rank if t == 0 else 1 - rank] * len(cells), True),
                       ("element_id", 1, (cells + 1).tolist(), True),
                       ("part", 1, [0] * len(cells), True)],
     }
@@ -336,6 +337,67 @@ def check_png(path):
     assert os.path.getsize(path) > 5000, f"{path} is suspiciously small"
 
 
+def write_series(root, ranks=(1, 2, 4, 8), nproc=2):
+    """A synthetic scaling_series.sh output root: machine.json and P<n>/summary.json with
+    the keys plot_figure2.py and plot_parallel_evidence.py read; P = 8 lacks its summary
+    (a failed run) and P = 4's repeats sit in rep<k>/ as with --repeat."""
+    os.makedirs(root)
+    with open(os.path.join(root, "machine.json"), "w") as f:
+        json.dump({"nproc": nproc, "cpu_model": "Synthetic CPU", "ranks": list(ranks),
+                   "cycles": 100}, f)
+    for p in ranks:
+        d = os.path.join(root, f"P{p}")
+        os.makedirs(os.path.join(d, "rep1"))
+        if p == ranks[-1]:
+            continue
+        wall = 1.0 + 0.2 * np.log2(p)
+        phases = {"fe": 0.4 * wall, "halo": 0.02 * p, "contact_search": 0.2 * wall,
+                  "contact_force": 0.05, "transfer": 0.1 * p, "rebalance": 0.01,
+                  "predict": 0.01, "update": 0.01, "output": 0.02, "sph": 0.0}
+        summary = {"ranks": p, "elements": 1864 * p, "cycles": 100, "status": "completed",
+                   "wall_seconds": wall, "grind_us": wall / 100 / (1864 * p) * 1e6,
+                   "timers": phases, "imbalance": {"fe": 1 + 0.01 * p, "contact": 1 + 0.05 * p},
+                   "contact": {"rebalances": p, "load_imbalance_last": 1.02,
+                               "load_imbalance_max": 1.1, "pairs_last_cycle": 10 * p,
+                               "bytes_sent_per_rank_per_cycle_max": 1.5e6 + 1e4 * p}}
+        for where in (d, os.path.join(d, "rep1")):
+            with open(os.path.join(where, "summary.json"), "w") as f:
+                json.dump(summary, f)
+
+
+def check_series_tools(tmp):
+    """plot_figure2.py and plot_parallel_evidence.py on a synthetic series (P = 4 over the
+    2 cores of machine.json, P = 8 missing), their tables, and exit status 2 on bad input."""
+    root = os.path.join(tmp, "series")
+    write_series(root)
+    r = run_tool(["plot_figure2.py", root, "-o", f"{tmp}/fig2_scaling.png", "--table"], 0)
+    check_png(os.path.join(tmp, "fig2_scaling.png"))
+    check_png(os.path.join(tmp, "fig2_phases.png"))
+    rows = [line for line in r.stdout.splitlines() if line.startswith("| ")]
+    assert len(rows) == 4, r.stdout  # header + P = 1, 2, 4
+    assert rows[3].split("|")[1].strip() == "4" and rows[3].rstrip(" |").endswith("yes"), rows
+    assert "no summary.json" in r.stderr, r.stderr  # P = 8
+    # E(2) = grind(1) / (2 grind(2)) = (1 / 1864) / (2 * 1.2 / (2 * 1864)) = 1 / 1.2
+    assert rows[2].split("|")[6].strip() == f"{1 / 1.2:.2f}", rows[2]
+    r = run_tool(["plot_parallel_evidence.py", root, "-o", f"{tmp}/evidence.png", "--table"], 0)
+    check_png(os.path.join(tmp, "evidence.png"))
+    assert r.stdout.count("\n| ") == 4, r.stdout
+    for bad in (["plot_figure2.py", os.path.join(tmp, "no_such_dir")],
+                ["plot_figure2.py", os.path.join(tmp, "run", "fields")],
+                ["plot_parallel_evidence.py", os.path.join(tmp, "no_such_dir")]):
+        run_tool(bad, 2)
+
+
+def check_figure3(outdir, tmp):
+    """plot_figure3.py on the synthetic run (both outputs; a time that is missing fails)."""
+    run_tool(["plot_figure3.py", outdir, "--times", "0", "1e-5", "1e-5", "-o",
+              f"{tmp}/fig3.png"], 0)
+    check_png(os.path.join(tmp, "fig3.png"))
+    run_tool(["plot_figure3.py", outdir, "--t0", outdir, "--times", "0", "0", "1e-5",
+              "--cut", "y=1e-3", "-o", f"{tmp}/fig3b.png"], 0)
+    run_tool(["plot_figure3.py", outdir, "-o", f"{tmp}/fig3c.png"], 2)  # no 1.6 ms output
+
+
 def check_tools(outdir, tmp):
     """Every plot script writes a PNG, and fails with status 2 on bad input."""
     plots = [
@@ -379,6 +441,9 @@ def main():
         c.run("exterior faces across pieces", check_exterior, outdir, facts)
         c.run("reader: malformed input errors", check_malformed, outdir, tmp)
         c.run("plot tools: PNGs and exit status 2", check_tools, outdir, tmp)
+        c.run("plot_figure2 / plot_parallel_evidence on a synthetic series",
+              check_series_tools, tmp)
+        c.run("plot_figure3 on the synthetic run", check_figure3, outdir, tmp)
     finally:
         if args.keep:
             print(f"kept {tmp}")
