@@ -4,8 +4,7 @@
 // updates) for a particle model of two sets with plasticity and artificial stress make no
 // C++ allocation. Particles that leave their box would legitimately grow the arrays that
 // receive them, so the motion is slow. Tolerance: zero allocations.
-// (The whole step is not measured: Simulation::fe_forces makes 3 allocations per cycle
-// of its own, the initializer-list vectors of its corner exchange and gather.)
+// (test_cycle_allocations measures the whole step of an FE model in contact.)
 #include <gtest/gtest.h>
 
 #include <cstdlib>

@@ -50,8 +50,9 @@ struct KernelRig {
     const CornerView cv{{corner[0].data(), corner[1].data(), corner[2].data()}};
     result = HexResult{};
     hex_forces(block, nv, dt_prev, cv, work, result);
-    gather_corners(fe, {corner[0].data(), corner[1].data(), corner[2].data()},
-                   {f[0].data(), f[1].data(), f[2].data()});
+    gather_corners(
+        fe, std::array<const double*, 3>{corner[0].data(), corner[1].data(), corner[2].data()},
+        std::array{f[0].data(), f[1].data(), f[2].data()});
   }
 };
 

@@ -149,10 +149,10 @@ CornerExchange::CornerExchange(const FeDecomposition& d, const Comm& comm) : d_(
   recv_.resize(d.remote_slots * 3);
 }
 
-void CornerExchange::exchange(const std::vector<double*>& arrays) {
+void CornerExchange::exchange(std::span<double* const> arrays) {
   if (d_.neighbors.empty()) return;
   const std::size_t k = arrays.size();
-  Requests req;
+  Requests& req = requests_;
   for (const auto& nb : d_.neighbors) {
     double* r = recv_.data() + (nb.recv_base - d_.local_slots) * k;
     comm_.irecv(std::span<double>(r, nb.recv_count * k), nb.rank, 11, req);
@@ -177,10 +177,10 @@ NodeExchange::NodeExchange(const FeDecomposition& d, const Comm& comm) : d_(d), 
   recv_.resize(3 * n);
 }
 
-void NodeExchange::from_owners(const std::vector<double*>& arrays) {
+void NodeExchange::from_owners(std::span<double* const> arrays) {
   if (d_.neighbors.empty()) return;
   const std::size_t k = arrays.size();
-  Requests req;
+  Requests& req = requests_;
   // Per neighbour: we send the shared nodes we own, receive those it owns, both in
   // ascending gid, so the two sides agree on the layout without telling each other.
   std::size_t off = 0;
@@ -210,8 +210,8 @@ void NodeExchange::from_owners(const std::vector<double*>& arrays) {
   }
 }
 
-void gather_corners(const FeDecomposition& d, const std::vector<const double*>& corner,
-                    const std::vector<double*>& out) {
+void gather_corners(const FeDecomposition& d, std::span<const double* const> corner,
+                    std::span<double* const> out) {
   const std::size_t nn = d.node_gid.size();
   const int* ptr = d.gather_ptr.data();
   const std::int64_t* slot = d.gather_slot.data();

@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "anvil/mesh/mesh.hpp"
@@ -62,12 +63,13 @@ class CornerExchange {
 public:
   CornerExchange(const FeDecomposition& d, const Comm& comm);
   // Fills the remote slots of `components` arrays of total_slots() values each.
-  void exchange(const std::vector<double*>& arrays);
+  void exchange(std::span<double* const> arrays);
 
 private:
   const FeDecomposition& d_;
   const Comm& comm_;
   std::vector<double> send_, recv_;
+  Requests requests_; // reused: the exchange allocates nothing
 };
 
 // Copies nodal values from each shared node's owner to the other ranks that hold it
@@ -76,17 +78,18 @@ class NodeExchange {
 public:
   NodeExchange(const FeDecomposition& d, const Comm& comm);
   // `arrays` hold one value per local node; non-owned shared entries are overwritten.
-  void from_owners(const std::vector<double*>& arrays);
+  void from_owners(std::span<double* const> arrays);
 
 private:
   const FeDecomposition& d_;
   const Comm& comm_;
   std::vector<double> send_, recv_;
+  Requests requests_; // reused: the exchange allocates nothing
 };
 
 // Sums the corner slots of every local node (the gather): out[i][n] = sum over the
 // node's slots in order of corner[i][slot]. Pure arithmetic, no communication.
-void gather_corners(const FeDecomposition& d, const std::vector<const double*>& corner,
-                    const std::vector<double*>& out);
+void gather_corners(const FeDecomposition& d, std::span<const double* const> corner,
+                    std::span<double* const> out);
 
 } // namespace anvil

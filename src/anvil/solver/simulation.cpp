@@ -80,8 +80,9 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
         corner_mass[lb.corner_base + static_cast<std::size_t>(a) * lb.stride + e] = hb.mass[e] / 8;
     blocks_.push_back(std::move(hb));
   }
-  corner_exchange_->exchange({corner_mass.data()});
-  gather_corners(fe_, {corner_mass.data()}, {nodes_.mass.data()});
+  corner_exchange_->exchange(std::array{corner_mass.data()});
+  gather_corners(fe_, std::array<const double*, 1>{corner_mass.data()},
+                 std::array{nodes_.mass.data()});
   std::fill(corner_mass.begin(), corner_mass.end(), 0.0);
 
   part_mass_.assign(config_.parts.size(), 0.0);
@@ -292,12 +293,14 @@ void Simulation::fe_forces() {
   {
     ScopedPhase t(timers_, Phase::halo);
     corner_exchange_->exchange(
-        {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()});
+        std::array{corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()});
   }
   {
     ScopedPhase t(timers_, Phase::fe);
-    gather_corners(fe_, {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()},
-                   {nodes_.f[0].data(), nodes_.f[1].data(), nodes_.f[2].data()});
+    gather_corners(fe_,
+                   std::array<const double*, 3>{corner_force_[0].data(), corner_force_[1].data(),
+                                                corner_force_[2].data()},
+                   std::array{nodes_.f[0].data(), nodes_.f[1].data(), nodes_.f[2].data()});
   }
 }
 
