@@ -227,7 +227,7 @@ void parse_eos(MaterialConfig& m, const Node& n) {
   for (const auto& [key, v] : n.entries()) {
     if (key == "model") continue;
     const auto spec = std::find_if(info->params.begin(), info->params.end(),
-                                   [&](const ParamSpec& p) { return p.name == key; });
+                                   [&key = key](const ParamSpec& p) { return p.name == key; });
     if (spec == info->params.end()) {
       std::string list;
       for (const auto& p : info->params) list += (list.empty() ? "" : ", ") + std::string(p.name);
@@ -596,7 +596,7 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
     for (const auto& [pname, pn] : top.child("particles").entries()) {
       if (pname.find('.') != std::string::npos) pn.fail("particle set names may not contain '.'");
       if (std::any_of(c.parts.begin(), c.parts.end(),
-                      [&](const PartConfig& p) { return p.name == pname; }))
+                      [&pname = pname](const PartConfig& p) { return p.name == pname; }))
         pn.fail(fmt::format("'{}' is already the name of a part", pname));
       ParticleSetConfig p = parse_particle_set(pname, pn);
       if (!c.material(p.material))
