@@ -258,19 +258,21 @@ void Simulation::step() {
 }
 
 void Simulation::fe_forces() {
+  HexResult r;
   {
     ScopedPhase t(timers_, Phase::fe);
     const NodalView view{{nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()},
                          {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()}};
     const CornerView corners{
         {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()}};
-    HexResult r;
     for (auto& b : blocks_)
       if (b.size() > 0) hex_forces(b, view, clock_.dt_prev, corners, workspace_, r);
-    dt_stable_ = r.dt_stable;
-    dt_element_ = r.stable_gid;
     eroded_ += r.eroded;
-
+  }
+  {
+    // The reductions are timed with the exchange, not with the element work: a rank that
+    // waits here for a slower one would otherwise hide the imbalance of `fe`.
+    ScopedPhase t(timers_, Phase::halo);
     // One reduction per cycle carries the stable step and the failure flags.
     const double none = std::numeric_limits<double>::infinity();
     double red[4] = {r.dt_stable, r.inverted_gid >= 0 ? static_cast<double>(r.inverted_gid) : none,
@@ -289,9 +291,6 @@ void Simulation::fe_forces() {
     dt_element_ = static_cast<std::int64_t>(
         comm_.min(r.dt_stable == red[0] ? static_cast<double>(r.stable_gid) : none));
     dt_stable_ = red[0];
-  }
-  {
-    ScopedPhase t(timers_, Phase::halo);
     corner_exchange_->exchange(
         std::array{corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()});
   }
