@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
 
   auto* dec =
       app.add_subcommand("decompose", "under mpirun: the decompositions at t = 0, as VTU and JSON");
-  dec->add_option("deck", deck, "the YAML deck")->required();
+  dec->add_option("deck", deck, "the deck: YAML, or LS-DYNA keyword (.k, .key, .dyn)")->required();
   dec->add_option("-o,--output", outdir, "output directory")->required();
   auto* bench = app.add_subcommand("bench", "benchmarks");
   bench->require_subcommand(1);
@@ -118,6 +118,7 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   can->add_option("-o,--output", bench_out, "output directory")->capture_default_str();
   can->add_flag("--print-deck", write_deck, "print the deck for this rank count and exit");
+  can->add_flag("-q,--quiet", quiet, "no progress line");
 
   try {
     app.parse(argc, argv);

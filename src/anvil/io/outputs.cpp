@@ -170,7 +170,10 @@ Outputs::Outputs(const Simulation& sim, OutputOptions options)
   ok = sim_.comm().min(ok);
   sim_.comm().broadcast(err, 0);
   if (!ok) throw InputError(err);
-  tty_ = sim_.comm().rank() == 0 && ::isatty(STDOUT_FILENO);
+  // Under mpirun, OpenMPI gives rank 0 a pseudo-terminal whatever mpirun's own output is
+  // (a log file too): there, periodic lines are the safe choice.
+  tty_ = sim_.comm().rank() == 0 && ::isatty(STDOUT_FILENO) &&
+         std::getenv("OMPI_COMM_WORLD_SIZE") == nullptr;
 }
 
 Outputs::~Outputs() {
