@@ -1,9 +1,11 @@
 #include "anvil/io/checkpoint.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "anvil/core/error.hpp"
@@ -14,7 +16,11 @@ namespace anvil {
 
 namespace {
 
-constexpr char magic[8] = {'A', 'N', 'V', 'I', 'L', 'C', 'K', '1'};
+// The format's version is the magic's last character. Version 2 added the particle
+// sections after the element sections and the header keys model_particles and
+// particle_pvd; version 1 files (no particles) still load.
+constexpr char magic[8] = {'A', 'N', 'V', 'I', 'L', 'C', 'K', '2'};
+constexpr std::size_t magic_version = 7;
 
 // Sends this rank's records to rank 0, which keeps them in ascending global id.
 template <int Width>
@@ -129,6 +135,28 @@ Checkpoint capture(const Simulation& sim, const OutputState& outputs) {
   std::vector<std::int64_t> unused;
   gather_sorted<Checkpoint::element_values>(comm, gid, data, face, c.element_gid, c.element_data,
                                             unused);
+  if (const sph::SphPhase* sph = sim.sph()) {
+    c.model_particles = sph->global_count();
+    gid.clear();
+    data.clear();
+    face.clear();
+    const sph::Particles& pt = sph->particles();
+    for (std::size_t i = 0; i < pt.size(); ++i) {
+      gid.push_back(pt.gid[i]);
+      for (int k = 0; k < 3; ++k) data.push_back(pt.x[k][i]);
+      for (int k = 0; k < 3; ++k) data.push_back(pt.v[k][i]);
+      data.push_back(pt.rho[i]);
+      data.push_back(pt.h[i]);
+      for (int k = 0; k < 6; ++k) data.push_back(pt.stress[k][i]);
+      data.push_back(pt.energy[i]);
+      data.push_back(pt.plastic_strain[i]);
+      data.push_back(pt.temperature[i]);
+      data.push_back(pt.wave_speed[i]);
+      face.push_back(pt.last_face[i]);
+    }
+    gather_sorted<Checkpoint::particle_values>(comm, gid, data, face, c.particle_gid,
+                                               c.particle_data, c.particle_face);
+  }
   return c;
 }
 
@@ -144,11 +172,13 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
   h["contact_energy"] = c.contact_energy;
   h["model_nodes"] = c.model_nodes;
   h["model_elements"] = c.model_elements;
+  h["model_particles"] = c.model_particles;
   h["next_fields"] = c.outputs.next_fields;
   h["next_history"] = c.outputs.next_history;
   h["next_checkpoint"] = c.outputs.next_checkpoint;
   h["field_count"] = c.outputs.field_count;
   h["pvd"] = c.outputs.pvd;
+  h["particle_pvd"] = c.outputs.particle_pvd;
   // Doubles as raw bits in the binary part: the header's decimal text is for people.
   const double exact[8] = {c.time,
                            c.dt,
@@ -168,6 +198,9 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
   put(s, c.node_face);
   put(s, c.element_gid);
   put(s, c.element_data);
+  put(s, c.particle_gid);
+  put(s, c.particle_data);
+  put(s, c.particle_face);
   write_file_atomic(path, s);
 }
 
@@ -177,10 +210,15 @@ Checkpoint read_checkpoint(const std::string& path) {
   std::stringstream ss;
   ss << in.rdbuf();
   const std::string s = ss.str();
-  if (s.size() < sizeof magic || std::memcmp(s.data(), magic, sizeof magic) != 0)
+  if (s.size() < sizeof magic || std::memcmp(s.data(), magic, magic_version) != 0)
     throw InputError("'" + path + "' is not an anvil checkpoint");
+  const char version = s[magic_version];
+  if (version != '1' && version != '2')
+    throw InputError(fmt::format("checkpoint '{}' has format version {}; this anvil reads 1 and 2",
+                                 path, version));
   std::size_t pos = sizeof magic;
   Checkpoint c;
+  c.file = path;
   std::vector<char> header;
   std::vector<double> exact, next_checkpoint;
   get(s, pos, header, path);
@@ -191,6 +229,11 @@ Checkpoint read_checkpoint(const std::string& path) {
   get(s, pos, c.node_face, path);
   get(s, pos, c.element_gid, path);
   get(s, pos, c.element_data, path);
+  if (version >= '2') {
+    get(s, pos, c.particle_gid, path);
+    get(s, pos, c.particle_data, path);
+    get(s, pos, c.particle_face, path);
+  }
   try {
     const auto h = nlohmann::json::parse(std::string(header.begin(), header.end()));
     c.deck = h.at("deck").get<std::string>();
@@ -199,13 +242,21 @@ Checkpoint read_checkpoint(const std::string& path) {
     c.model_elements = h.at("model_elements").get<std::int64_t>();
     c.outputs.field_count = h.at("field_count").get<int>();
     c.outputs.pvd = h.at("pvd").get<std::vector<std::pair<double, std::string>>>();
+    // Optional: absent from version 1 files.
+    c.model_particles = h.value("model_particles", std::int64_t{0});
+    if (h.contains("particle_pvd"))
+      c.outputs.particle_pvd =
+          h.at("particle_pvd").get<std::vector<std::pair<double, std::string>>>();
   } catch (const std::exception& e) {
     throw InputError("checkpoint '" + path + "' has a damaged header: " + e.what());
   }
   if (exact.size() != 8 || next_checkpoint.size() != 1 ||
       c.node_data.size() != c.node_gid.size() * Checkpoint::node_values ||
       c.node_face.size() != c.node_gid.size() ||
-      c.element_data.size() != c.element_gid.size() * Checkpoint::element_values)
+      c.element_data.size() != c.element_gid.size() * Checkpoint::element_values ||
+      c.particle_data.size() != c.particle_gid.size() * Checkpoint::particle_values ||
+      c.particle_face.size() != c.particle_gid.size() ||
+      c.model_particles != static_cast<std::int64_t>(c.particle_gid.size()))
     throw InputError("checkpoint '" + path + "' is inconsistent");
   c.time = exact[0];
   c.dt = exact[1];

@@ -1,8 +1,8 @@
-// Checkpoints: the complete state of a run, independent of the number of ranks (nodes and
-// elements keyed by global id), written atomically (temporary file, fsync, rename; the
-// previous checkpoint stays until the new one is complete). `anvil run DECK --restart
-// CHECKPOINT` continues from one, on the same or another number of ranks, and reproduces
-// the uninterrupted run bit for bit.
+// Checkpoints: the complete state of a run, independent of the number of ranks (nodes,
+// elements and SPH particles keyed by global id), written atomically (temporary file,
+// fsync, rename; the previous checkpoint stays until the new one is complete). `anvil run
+// DECK --restart CHECKPOINT` continues from one, on the same or another number of ranks,
+// and reproduces the uninterrupted run bit for bit.
 #pragma once
 
 #include <cstdint>
@@ -18,14 +18,20 @@ class Simulation;
 struct OutputState {
   double next_fields = 0, next_history = 0, next_checkpoint = 0;
   int field_count = 0;
-  std::vector<std::pair<double, std::string>> pvd;
+  std::vector<std::pair<double, std::string>> pvd;          // results.pvd (rank 0)
+  std::vector<std::pair<double, std::string>> particle_pvd; // particles.pvd (rank 0)
 };
 
 struct Checkpoint {
   static constexpr int node_values = 7;     // x, y, z, vx, vy, vz, contact allowance
   static constexpr int element_values = 22; // stress (6), plastic strain, temperature,
                                             // internal and hourglass energy, Q (12)
-  std::string deck;                         // the deck the run came from (for messages)
+  // Per particle: x (3), v (3), density, smoothing length, stress (6), specific energy,
+  // plastic strain, temperature, wave speed. What the deck fixes (set, mass, reference
+  // position, constraints) is not stored: the restarted run rebuilds it from the deck.
+  static constexpr int particle_values = 18;
+  std::string deck; // the deck the run came from (for messages)
+  std::string file; // the file it was read from (for messages; empty when captured)
   double time = 0, dt = 0, dt_prev = 0, dt_initial = 0;
   std::int64_t cycle = 0;
   double external_work = 0, contact_energy = 0; // global diagnostics
@@ -35,7 +41,11 @@ struct Checkpoint {
   std::vector<std::int64_t> node_face;              // contact history: last face per node
   std::vector<std::int64_t> element_gid;            // ascending
   std::vector<double> element_data;                 // element_values per element
+  std::vector<std::int64_t> particle_gid;           // ascending (empty without particles)
+  std::vector<double> particle_data;                // particle_values per particle
+  std::vector<std::int64_t> particle_face;          // contact history: last face per particle
   std::int64_t model_nodes = 0, model_elements = 0; // sizes of the model, for validation
+  std::int64_t model_particles = 0;
 };
 
 // Gathers the state of `sim` on rank 0 (collective); other ranks get an empty checkpoint.
@@ -44,7 +54,9 @@ Checkpoint capture(const Simulation& sim, const OutputState& outputs);
 // Writes `c` to `path` atomically (rank 0's job).
 void write_checkpoint(const std::string& path, const Checkpoint& c);
 
-// Reads a checkpoint; InputError (with the file name) when it is missing or damaged.
+// Reads a checkpoint (this format, or the first one, which had no particles: it reads as
+// a model without particles); InputError (with the file name) when it is missing or
+// damaged.
 Checkpoint read_checkpoint(const std::string& path);
 
 } // namespace anvil

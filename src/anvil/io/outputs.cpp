@@ -218,6 +218,7 @@ void Outputs::resume(const OutputState& state) {
   next_history_ = state.next_history;
   field_count_ = state.field_count;
   pvd_ = state.pvd;
+  particle_pvd_ = state.particle_pvd;
   last_field_cycle_ = sim_.clock().cycle; // the fields at the checkpoint were written then
   // A restart may run on another number of ranks, so the Exodus files of the first run
   // cannot be extended: the continuation goes to results-sCYCLE.exo[.P.R], starting with
@@ -253,11 +254,13 @@ void Outputs::resume(const OutputState& state) {
   write_file_atomic(path, text);
   history_ = std::fopen(path.c_str(), "a");
   if (!history_) throw InputError("cannot write " + path);
+  // Drop what a killed run may have listed past its checkpoint (as for the history).
   if (!pvd_.empty()) write_pvd(opt_.directory + "/results.pvd", pvd_);
+  if (!particle_pvd_.empty()) write_pvd(opt_.directory + "/particles.pvd", particle_pvd_);
 }
 
 OutputState Outputs::state() const {
-  return {next_fields_, next_history_, 0.0, field_count_, pvd_};
+  return {next_fields_, next_history_, 0.0, field_count_, pvd_, particle_pvd_};
 }
 
 void Outputs::write_history_row(const Sample& s) {

@@ -523,11 +523,17 @@ double Simulation::balance_error(const Sample& s) const {
 }
 
 void Simulation::restore(const Checkpoint& c) {
+  const std::string from = c.file.empty() ? "the checkpoint of '" + c.deck + "'"
+                                          : "checkpoint '" + c.file + "' (of '" + c.deck + "')";
+  const std::int64_t particles = sph_ ? sph_->global_count() : 0;
   if (c.model_nodes != global_nodes_ || c.model_elements != global_elements_)
-    throw InputError(
-        fmt::format("the checkpoint of '{}' ({} nodes, {} elements) does not match this model "
-                    "({} nodes, {} elements)",
-                    c.deck, c.model_nodes, c.model_elements, global_nodes_, global_elements_));
+    throw InputError(fmt::format("{} ({} nodes, {} elements) does not match this model "
+                                 "({} nodes, {} elements)",
+                                 from, c.model_nodes, c.model_elements, global_nodes_,
+                                 global_elements_));
+  if (c.model_particles != particles)
+    throw InputError(fmt::format("{} holds {} particles, this model has {}", from,
+                                 c.model_particles, particles));
   clock_.time = c.time;
   clock_.cycle = c.cycle;
   clock_.dt = c.dt;
@@ -542,9 +548,7 @@ void Simulation::restore(const Checkpoint& c) {
   };
   for (std::size_t n = 0; n < nodes_.size(); ++n) {
     const std::int64_t k = find(c.node_gid, fe_.node_gid[n]);
-    if (k < 0)
-      throw InputError("the checkpoint of '" + c.deck + "' lacks node " +
-                       std::to_string(fe_.node_gid[n] + 1));
+    if (k < 0) throw InputError(from + " lacks node " + std::to_string(fe_.node_gid[n] + 1));
     const double* d = &c.node_data[static_cast<std::size_t>(k) * Checkpoint::node_values];
     for (int i = 0; i < 3; ++i) {
       nodes_.x[i][n] = d[i];
@@ -555,9 +559,7 @@ void Simulation::restore(const Checkpoint& c) {
   for (auto& b : blocks_)
     for (int e = 0; e < b.size(); ++e) {
       const std::int64_t k = find(c.element_gid, b.gid[e]);
-      if (k < 0)
-        throw InputError("the checkpoint of '" + c.deck + "' lacks element " +
-                         std::to_string(b.gid[e] + 1));
+      if (k < 0) throw InputError(from + " lacks element " + std::to_string(b.gid[e] + 1));
       const double* d = &c.element_data[static_cast<std::size_t>(k) * Checkpoint::element_values];
       for (int j = 0; j < 6; ++j) b.stress[j][e] = d[j];
       if (!b.plastic_strain.empty()) b.plastic_strain[e] = d[6];
@@ -578,6 +580,7 @@ void Simulation::restore(const Checkpoint& c) {
         if (!a.empty()) a[e] = a[n - 1];
     }
   }
+  if (sph_) restore_particles(c, from);
 }
 
 void Simulation::decompose_now() {

@@ -139,6 +139,8 @@ private:
   std::vector<ContactNodeItem>& particle_contact_items(double dt);
   void correct_particles(double& contact_work);
   void update_particles(double dt);
+  // restore() for the particles; `from` names the checkpoint in messages. Collective.
+  void restore_particles(const Checkpoint& c, const std::string& from);
 
   Config config_;
   const Comm& comm_;

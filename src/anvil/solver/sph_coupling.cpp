@@ -4,10 +4,12 @@
 // coupled to the mesh only through contact: each is a contact node (slave) against the
 // exterior faces, with an id after every node and face id.
 #include <algorithm>
+#include <limits>
 #include <optional>
 
 #include <fmt/format.h>
 
+#include "anvil/io/checkpoint.hpp"
 #include "anvil/solver/model.hpp"
 #include "anvil/solver/simulation.hpp"
 
@@ -209,6 +211,40 @@ void Simulation::update_particles(double dt) {
 #pragma omp simd
     for (std::size_t i = 0; i < n; ++i) x[i] += dt * v[i];
   }
+}
+
+// The particles' part of restore(): every rank overwrites the evolving state of the
+// particles it holds (those of the deck's first partition), then the particles are
+// partitioned afresh at their restored positions. What the deck fixes (set, mass,
+// reference position, constraints) stays as the constructor made it.
+void Simulation::restore_particles(const Checkpoint& c, const std::string& from) {
+  sph::Particles& pt = sph_->particles();
+  // Every rank must throw, not only the one missing a particle.
+  const std::int64_t none = std::numeric_limits<std::int64_t>::max();
+  std::int64_t missing = none;
+  for (std::size_t i = 0; i < pt.size(); ++i)
+    if (!std::binary_search(c.particle_gid.begin(), c.particle_gid.end(), pt.gid[i]))
+      missing = std::min(missing, pt.gid[i]);
+  missing = comm_.min(missing);
+  if (missing != none) throw InputError(from + " lacks particle " + std::to_string(missing + 1));
+  for (std::size_t i = 0; i < pt.size(); ++i) {
+    const auto it = std::lower_bound(c.particle_gid.begin(), c.particle_gid.end(), pt.gid[i]);
+    const auto k = static_cast<std::size_t>(it - c.particle_gid.begin());
+    const double* d = &c.particle_data[k * Checkpoint::particle_values];
+    for (int j = 0; j < 3; ++j) {
+      pt.x[j][i] = d[j];
+      pt.v[j][i] = d[3 + j];
+    }
+    pt.rho[i] = d[6];
+    pt.h[i] = d[7];
+    for (int j = 0; j < 6; ++j) pt.stress[j][i] = d[8 + j];
+    pt.energy[i] = d[14];
+    pt.plastic_strain[i] = d[15];
+    pt.temperature[i] = d[16];
+    pt.wave_speed[i] = d[17];
+    pt.last_face[i] = c.particle_face[k];
+  }
+  sph_->redistribute();
 }
 
 } // namespace anvil

@@ -99,6 +99,10 @@ SphPhase::SphPhase(const Config& config, const std::function<const Material*(int
   p_.x0 = p_.x;
 
   // The first partition, and every particle to its box.
+  redistribute();
+}
+
+void SphPhase::redistribute() {
   const RcbPoints pts{p_.x[0], p_.x[1], p_.x[2], p_.gid, {}};
   rcb_.partition(pts);
   ++stats_.rebalances;

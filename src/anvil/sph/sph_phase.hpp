@@ -76,6 +76,11 @@ public:
   const std::vector<std::int64_t>& set_offsets() const { return set_offsets_; }
   // Local index of a particle by global id, or -1 if this rank does not hold it.
   int find(std::int64_t gid) const;
+  // Partitions afresh by RCB at the particles' current positions and moves each particle
+  // to its box's rank: after particles() was overwritten with a checkpoint's state, whose
+  // positions may lie outside this rank's box. The results do not depend on the
+  // decomposition, so this one need not be the interrupted run's. Collective.
+  void redistribute();
 
 private:
   // Moves every field of own particle i to rank dest[i] (collective), then restores
