@@ -220,6 +220,8 @@ void Outputs::resume(const OutputState& state) {
   pvd_ = state.pvd;
   particle_pvd_ = state.particle_pvd;
   last_field_cycle_ = sim_.clock().cycle; // the fields at the checkpoint were written then
+  start_cycle_ = sim_.clock().cycle;
+  start_fraction_ = last_progress_fraction_ = fraction_done();
   // A restart may run on another number of ranks, so the Exodus files of the first run
   // cannot be extended: the continuation goes to results-sCYCLE.exo[.P.R], starting with
   // the checkpoint's state (the earlier files stay as they were).
@@ -347,8 +349,7 @@ void Outputs::write_particles(const std::string& stem) {
   }
 }
 
-void Outputs::progress(bool last) {
-  if (!opt_.progress || sim_.comm().rank() != 0) return;
+double Outputs::fraction_done() const {
   const Config& c = sim_.config();
   const Clock& clk = sim_.clock();
   double frac = 0;
@@ -356,7 +357,13 @@ void Outputs::progress(bool last) {
   if (c.end_cycles < std::numeric_limits<std::int64_t>::max())
     frac = std::max(frac, static_cast<double>(clk.cycle) /
                               static_cast<double>(std::max<std::int64_t>(c.end_cycles, 1)));
-  frac = std::min(frac, 1.0);
+  return std::min(frac, 1.0);
+}
+
+void Outputs::progress(bool last) {
+  if (!opt_.progress || sim_.comm().rank() != 0) return;
+  const Clock& clk = sim_.clock();
+  const double frac = fraction_done();
   const double now = wall_seconds();
   const bool due = tty_
                        ? (now - last_progress_wall_ >= 0.25)
@@ -365,10 +372,13 @@ void Outputs::progress(bool last) {
   last_progress_wall_ = now;
   last_progress_fraction_ = frac;
   const double elapsed = now - start_wall_;
-  const double eta = frac > 0 ? elapsed * (1 - frac) / frac : 0;
+  // This run's own progress: a restarted run counts from its checkpoint.
+  const double done = frac - start_fraction_;
+  const double eta = done > 0 ? elapsed * (1 - frac) / done : 0;
   const double n =
       static_cast<double>(sim_.global_elements() + (sim_.sph() ? sim_.sph()->global_count() : 0));
-  const double grind = clk.cycle > 0 ? elapsed / static_cast<double>(clk.cycle) / n * 1e6 : 0;
+  const std::int64_t cycles = clk.cycle - start_cycle_;
+  const double grind = cycles > 0 ? elapsed / static_cast<double>(cycles) / n * 1e6 : 0;
   const std::string line =
       fmt::format("cycle {:>8}  t {:.4e} s  dt {:.3e} s  {:5.1f}%  left {:6.1f} s  grind {:.4f} us",
                   clk.cycle, clk.time, clk.dt, 100 * frac, eta, grind);
@@ -409,7 +419,8 @@ void Outputs::write_summary(int status, const std::string& message) {
   using nlohmann::json;
   const Clock& clk = sim_.clock();
   const double n = static_cast<double>(sim_.global_elements() + particles);
-  const double cycles = static_cast<double>(std::max<std::int64_t>(clk.cycle, 1));
+  // The wall time is this run's (a restarted run's own), so are the cycles it divides.
+  const double cycles = static_cast<double>(std::max<std::int64_t>(clk.cycle - start_cycle_, 1));
   json j;
   j["anvil_version"] = std::string(version);
   j["title"] = sim_.config().title;
@@ -422,6 +433,7 @@ void Outputs::write_summary(int status, const std::string& message) {
   j["elements"] = sim_.global_elements();
   j["particles"] = particles;
   j["cycles"] = clk.cycle;
+  if (start_cycle_ > 0) j["restart_cycle"] = start_cycle_; // wall time and grind: from here
   j["eroded_elements"] = eroded;
   j["time"] = clk.time;
   j["dt_initial"] = clk.dt_initial;

@@ -41,6 +41,7 @@ public:
   void finish(int status, const std::string& message);
 
   double loop_seconds() const;
+  double fraction_done() const; // of the run to its end time or cycle count
 
 private:
   void write_fields();
@@ -62,6 +63,8 @@ private:
   std::int64_t last_field_cycle_ = -1;
   int field_count_ = 0;
   double start_wall_ = 0, last_progress_wall_ = 0, last_progress_fraction_ = 0;
+  std::int64_t start_cycle_ = 0; // the cycle this run started from (its checkpoint's)
+  double start_fraction_ = 0;    // the fraction done at that cycle
   bool tty_ = false;
   PhaseTimers output_timer_;
   Sample last_sample_;
