@@ -226,7 +226,13 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, const N
             Lc[a][b] = L[a][0] * Bi[0][b] + L[a][1] * Bi[1][b] + L[a][2] * Bi[2][b];
         for (int a = 0; a < 3; ++a)
           for (int b = 0; b < 3; ++b) L[a][b] = Lc[a][b];
+      } else {
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) Bi[a][b] = a == b ? 1.0 : 0.0;
       }
+      // The momentum equation pairs sigma B^-T (sph_kinematics, after the stress update).
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) w.binv[9 * i + 3 * a + b] = Bi[a][b];
     }
     const double d[6] = {L[0][0],
                          L[1][1],
@@ -264,6 +270,9 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
   for (auto& d : w.d) d.resize(n);
   w.power_old.resize(n);
   w.energy_pred.resize(n);
+  bool any_corrected = false;
+  for (const auto& st : sets) any_corrected = any_corrected || st.corrected;
+  if (any_corrected) w.binv.resize(9 * n);
   w.read1.resize(p.n_all);
   for (std::size_t i = 0; i < p.n_all; ++i) {
     NeighbourRead1& r = w.read1[i];
@@ -321,39 +330,35 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
                          2 * (s[3] * w.d[3][i] + s[4] * w.d[4][i] + s[5] * w.d[5][i]);
     const double rho = p.rho[i];
     p.energy[i] += 0.5 * (w.power_old[i] + power) * dt / rho;
-    for (int k = 0; k < 6; ++k) p.S[k][i] = s[k];
+    if (si.corrected) {
+      // P = sigma B^-T: P_ab = sigma_ac Bi_bc (pass 2's stress for this particle).
+      const double* bi = &w.binv[9 * i];
+      const double sg[3][3] = {{s[0], s[3], s[5]}, {s[3], s[1], s[4]}, {s[5], s[4], s[2]}};
+      double P[3][3];
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          P[a][b] = sg[a][0] * bi[3 * b] + sg[a][1] * bi[3 * b + 1] + sg[a][2] * bi[3 * b + 2];
+      const double pk[9] = {P[0][0], P[1][1], P[2][2], P[0][1], P[1][2],
+                            P[0][2], P[1][0], P[2][1], P[2][0]};
+      for (int k = 0; k < 9; ++k) p.S[k][i] = pk[k];
+    } else {
+      for (int k = 0; k < 6; ++k) p.S[k][i] = s[k];
+      p.S[6][i] = s[3];
+      p.S[7][i] = s[4];
+      p.S[8][i] = s[5];
+    }
     double R[6] = {0, 0, 0, 0, 0, 0};
     if (si.epsilon > 0) artificial_stress(s, si.epsilon, R);
     for (int k = 0; k < 6; ++k) p.R[k][i] = R[k];
   }
 }
 
-void sph_forces(const SphView& p, std::span<const SetParams> sets, const NeighbourList& nl,
-                SphWorkspace& w, SphResult& res) {
+namespace {
+
+// Pass 2's pair loop; Corr: some set normalises its gradient (P is not symmetric).
+template <bool Corr>
+void forces_pairs(const SphView& p, const NeighbourList& nl, SphWorkspace& w, SphResult& res) {
   const std::size_t n = p.n_local;
-  w.read2.resize(p.n_all);
-  for (std::size_t i = 0; i < p.n_all; ++i) {
-    NeighbourRead2& r = w.read2[i];
-    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
-    for (int a = 0; a < 3; ++a) {
-      r.x[a] = p.x[a][i];
-      r.v[a] = p.v[a][i];
-    }
-    r.mass = p.mass[i];
-    r.rho = p.rho[i];
-    r.inv_rho = 1 / p.rho[i];
-    r.h = p.h[i];
-    r.c = p.wave_speed[i];
-    r.alpha = si.alpha;
-    r.beta = si.beta;
-    int any = 0;
-    for (int c = 0; c < 6; ++c) {
-      r.S[c] = p.S[c][i];
-      r.R[c] = p.R[c][i];
-      any |= p.R[c][i] != 0.0;
-    }
-    r.has_r = any;
-  }
   const NeighbourRead2* rd = w.read2.data();
   for (std::size_t i = 0; i < n; ++i) {
     const NeighbourRead2& pi = rd[i];
@@ -395,8 +400,11 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, const Neighbo
         stdx::where(approaching, mumv) = stdx::max(mumv, -mu);
       }
       const vdouble irr = pi.inv_rho * get([](const NeighbourRead2& q) { return q.inv_rho; });
-      vdouble T[6];
-      for (int c = 0; c < 6; ++c)
+      // T = (P_i + P_j + f^n (R_i + R_j)) / (rho_i rho_j) - Pi I; T[6..8] (yx zy zx)
+      // differ from T[3..5] only where a gradient is normalised (Corr).
+      constexpr int nt = Corr ? 9 : 6;
+      vdouble T[nt];
+      for (int c = 0; c < nt; ++c)
         T[c] = (pi.S[c] + get([c](const NeighbourRead2& q) { return q.S[c]; })) * irr;
       vdouble rg = 0.0;
       if (stdx::any_of(fn > 0.0) && (pi.has_r || stdx::any_of(get([](const NeighbourRead2& q) {
@@ -405,6 +413,9 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, const Neighbo
         const vdouble fi = fn * irr;
         for (int c = 0; c < 6; ++c)
           T[c] += fi * (pi.R[c] + get([c](const NeighbourRead2& q) { return q.R[c]; }));
+        if constexpr (Corr)
+          for (int c = 6; c < 9; ++c)
+            T[c] += fi * (pi.R[c - 3] + get([c](const NeighbourRead2& q) { return q.R[c - 3]; }));
         // The artificial stress's own work on particle i (the stress's is in pass 1).
         rg = fi * (dv[0] * (pi.R[0] * g[0] + pi.R[3] * g[1] + pi.R[5] * g[2]) +
                    dv[1] * (pi.R[3] * g[0] + pi.R[1] * g[1] + pi.R[4] * g[2]) +
@@ -415,9 +426,10 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, const Neighbo
       T[2] -= visc;
       // Padding lanes have zero kernel gradients: they add nothing.
       const vdouble mj = get([](const NeighbourRead2& q) { return q.mass; });
+      const int yx = Corr ? 6 : 3, zy = Corr ? 7 : 4, zx = Corr ? 8 : 5;
       accv[0] += mj * (T[0] * g[0] + T[3] * g[1] + T[5] * g[2]);
-      accv[1] += mj * (T[3] * g[0] + T[1] * g[1] + T[4] * g[2]);
-      accv[2] += mj * (T[5] * g[0] + T[4] * g[1] + T[2] * g[2]);
+      accv[1] += mj * (T[yx] * g[0] + T[1] * g[1] + T[4] * g[2]);
+      accv[2] += mj * (T[zx] * g[0] + T[zy] * g[1] + T[2] * g[2]);
       // Half the viscous dissipation of the pair heats particle i.
       const vdouble dvg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
       dev += mj * (0.5 * visc * dvg - rg);
@@ -439,6 +451,41 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, const Neighbo
     if (!finite && (res.nonfinite_gid < 0 || p.gid[i] < res.nonfinite_gid))
       res.nonfinite_gid = p.gid[i];
   }
+}
+
+} // namespace
+
+void sph_forces(const SphView& p, std::span<const SetParams> sets, const NeighbourList& nl,
+                SphWorkspace& w, SphResult& res) {
+  w.read2.resize(p.n_all);
+  for (std::size_t i = 0; i < p.n_all; ++i) {
+    NeighbourRead2& r = w.read2[i];
+    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
+    for (int a = 0; a < 3; ++a) {
+      r.x[a] = p.x[a][i];
+      r.v[a] = p.v[a][i];
+    }
+    r.mass = p.mass[i];
+    r.rho = p.rho[i];
+    r.inv_rho = 1 / p.rho[i];
+    r.h = p.h[i];
+    r.c = p.wave_speed[i];
+    r.alpha = si.alpha;
+    r.beta = si.beta;
+    int any = 0;
+    for (int c = 0; c < 9; ++c) r.S[c] = p.S[c][i];
+    for (int c = 0; c < 6; ++c) {
+      r.R[c] = p.R[c][i];
+      any |= p.R[c][i] != 0.0;
+    }
+    r.has_r = any;
+  }
+  bool any_corrected = false;
+  for (const auto& st : sets) any_corrected = any_corrected || st.corrected;
+  if (any_corrected)
+    forces_pairs<true>(p, nl, w, res);
+  else
+    forces_pairs<false>(p, nl, w, res);
 }
 
 } // namespace anvil::sph
