@@ -38,6 +38,14 @@ inline void kernel_simd(const vdouble& r, const vdouble& h, vdouble& w, vdouble&
   }
 }
 
+// The kernel at r = 0 (a particle's own term in the summation density): the
+// normalisation over h^D times the shape's value 1 (cubic spline) or 1 (Wendland C2).
+template <KernelType K, int D>
+inline double self_weight(double h) {
+  const double ih = 1.0 / h;
+  return kernel_norm<K, D>() * (D == 1 ? ih : (D == 2 ? ih * ih : ih * ih * ih));
+}
+
 } // namespace
 
 void principal(const double s[6], double lambda[3], double Q[3][3]) {
@@ -144,7 +152,7 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, const N
     // The pairs, `width` at a time (lane l takes the entries k0 + l): each lane sums its
     // entries in list order and the lanes are added in lane order at the end, so the
     // sums depend only on the list, which is the same on every rank.
-    vdouble Lv[3][3], Bv[3][3];
+    vdouble Lv[3][3], Bv[3][3], sum_mw = 0.0;
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) Lv[a][b] = Bv[a][b] = 0.0;
     const vdouble xi[3] = {pi.x[0], pi.x[1], pi.x[2]}, vi[3] = {pi.v[0], pi.v[1], pi.v[2]};
@@ -201,6 +209,7 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, const N
         dv[a] = vj * (get([a](const NeighbourRead1& q) { return q.v[a]; }) - vi[a]);
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) Lv[a][b] += dv[a] * g[b];
+      if (si.summation) sum_mw += valid * get([](const NeighbourRead1& q) { return q.mass; }) * wk;
       if (si.corrected)
         for (int a = 0; a < 3; ++a)
           for (int b = 0; b < 3; ++b) Bv[a][b] -= (vj * dx[a]) * g[b];
@@ -242,9 +251,15 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, const N
                          0.5 * (L[0][2] + L[2][0])};
     const double spin[3] = {0.5 * (L[2][1] - L[1][2]), 0.5 * (L[0][2] - L[2][0]),
                             0.5 * (L[1][0] - L[0][1])};
-    // Continuity, time-centred: rho(n) = rho(n-1) (1 - tr D dt/2) / (1 + tr D dt/2).
+    // Continuity, time-centred: rho(n) = rho(n-1) (1 - tr D dt/2) / (1 + tr D dt/2); or
+    // the summation at x(n) (tied to the particles' spacing: across a shock the
+    // integrated rate drifts from it, and the pressure with it; docs/sph.md, Sod).
     const double tr = (d[0] + d[1] + d[2]) * dt;
-    p.rho[i] = p.rho[i] * (1 - 0.5 * tr) / (1 + 0.5 * tr);
+    if (si.summation) {
+      p.rho[i] = lane_sum(sum_mw) + pi.mass * self_weight<K, D>(pi.h);
+    } else {
+      p.rho[i] = p.rho[i] * (1 - 0.5 * tr) / (1 + 0.5 * tr);
+    }
     // Objective stress rate: rotate the old stress by Hughes-Winget, as the element does.
     double Q[3][3], s[6];
     hex8::hughes_winget(spin, dt, Q);
@@ -281,6 +296,7 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
       r.v[a] = p.v[a][i];
     }
     r.volume = p.mass[i] / p.rho[i];
+    r.mass = p.mass[i];
     r.h = p.h[i];
     r.set = p.set[i];
   }

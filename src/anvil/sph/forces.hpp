@@ -5,8 +5,9 @@
 //
 //  1. kinematics: velocity gradient L_i = sum_j V_j (v_j - v_i) (x) grad_i W_ij with the
 //     volumes V_j = m_j / rho_j (optionally normalised, Randles and Libersky 1996),
-//     continuity d rho_i / dt = -rho_i tr L_i, stress rotated by Hughes-Winget with the
-//     spin and advanced by the material's batch update with D, internal energy from the
+//     continuity d rho_i / dt = -rho_i tr L_i (or, per set, the summation
+//     rho_i = sum_j m_j W_ij over the neighbours and i itself), stress rotated by Hughes-Winget
+//     with the spin and advanced by the material's batch update with D, internal energy from the
 //     stress power sigma : D / rho; then Monaghan's artificial stress R_i (Gray,
 //     Monaghan and Swift 2001) for the neighbours.
 //  2. forces: the symmetric conservative momentum equation that matches that gradient
@@ -51,6 +52,7 @@ struct SetParams {
   double exponent = 4;                // its exponent n
   double w_spacing = 1;               // kernel shape w(q) at q = 1 / smoothing_ratio
   bool corrected = false;             // normalised velocity gradient
+  bool summation = false;             // density by summation, sum_j m_j W_ij (with j = i)
   int dimensions = 3;                 // of the particle model (1, 2 or 3)
 };
 
@@ -100,6 +102,7 @@ struct SphResult {
 struct NeighbourRead1 {
   double x[3], v[3];
   double volume; // m / rho
+  double mass;
   double h;
   int set;
 };

@@ -55,6 +55,7 @@ SphPhase::SphPhase(const Config& config, const std::function<const Material*(int
     sp.exponent = psets[s].artificial_stress_exponent;
     sp.w_spacing = kernel_shape(kernel_, 1.0 / psets[s].smoothing_ratio);
     sp.corrected = psets[s].corrected_gradient;
+    sp.summation = psets[s].summation_density;
     sp.dimensions = config.sph.dimensions;
     sets_.push_back(sp);
   }
