@@ -38,7 +38,8 @@ particles:
   ball: {generate: {shape: sphere, center: [0, 0, 0.0032], radius: 3.0e-3, spacing: 6.0e-4},
          material: copper, smoothing_ratio: 1.3, corrected_gradient: true}
   slab: {generate: {shape: box, min: [0.004, -0.002, 0.001], max: [0.007, 0.002, 0.003], spacing: 6.0e-4},
-         material: tin, smoothing_ratio: 1.2, artificial_stress: {epsilon: 0.3}}
+         material: tin, smoothing_ratio: 1.2, artificial_stress: {epsilon: 0.3},
+         summation_density: true}
 initial_conditions:
   - {part: ball, velocity: [0, 0, -300.0], angular_velocity: [0, 0, 20000.0], center: [0, 0, 0]}
   - {part: slab, velocity: [-150.0, 0, 0]}

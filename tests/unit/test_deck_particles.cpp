@@ -31,7 +31,7 @@ particles:
     artificial_stress: {epsilon: 0.2, exponent: 3}
     corrected_gradient: true
   air: {generate: {shape: box, min: [0, 0, 0], max: [0.01, 0.01, 0.01], spacing: 1.0e-3},
-        material: gas, kernel: wendland_c2}
+        material: gas, kernel: wendland_c2, summation_density: true}
 sph: {rebalance_threshold: 1.5}
 initial_conditions:
   - {part: ball, velocity: [0, 0, -100.0]}
@@ -72,6 +72,7 @@ TEST(DeckParticles, ParsesParticleSetsAndEos) {
   EXPECT_DOUBLE_EQ(b.artificial_stress, 0.2);
   EXPECT_DOUBLE_EQ(b.artificial_stress_exponent, 3);
   EXPECT_TRUE(b.corrected_gradient);
+  EXPECT_FALSE(b.summation_density); // the default
   // Defaults.
   const auto& a = c.particles[1];
   EXPECT_DOUBLE_EQ(a.smoothing_ratio, 1.3);
@@ -79,6 +80,7 @@ TEST(DeckParticles, ParsesParticleSetsAndEos) {
   EXPECT_DOUBLE_EQ(a.viscosity_quadratic, 2.0);
   EXPECT_DOUBLE_EQ(a.artificial_stress, 0.3);
   EXPECT_FALSE(a.corrected_gradient);
+  EXPECT_TRUE(a.summation_density);
   EXPECT_EQ(c.particle_set("air"), 1);
   EXPECT_DOUBLE_EQ(c.sph.rebalance_threshold, 1.5);
   EXPECT_EQ(c.materials[0].eos_model, "mie_gruneisen");

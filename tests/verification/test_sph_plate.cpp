@@ -10,11 +10,15 @@
 // stress epsilon 0.3, normalised (corrected) velocity gradient. Tolerance (stated before
 // the run): the period within 5% of the analytic value (the plate is thick enough,
 // L/H = 10, for shear deformation to lower the frequency by ~1%).
-// FINDING (docs/sph.md): the period is 18% long at this resolution (14% without the
-// artificial stress, which softens the tensile side; the rest is the free surfaces'
-// kernel deficiency over 8 particles through the thickness). The 5% check is kept,
-// disabled (run with --gtest_also_run_disabled_tests); the enabled test checks that the
-// plate oscillates and that the period does not get worse than this finding (25%).
+// FINDING (docs/sph.md): the period is 13.5% long at this resolution (it was 18.4% while
+// the normalised gradient was not carried into the forces). It is resolution: the same
+// settings give +38.5%, +13.5%, +4.2% at 4, 8, 16 particles through the thickness, and
+// the Richardson extrapolation of the last two (order 1.7) is 0.2541 s, the analytic
+// value; a half period between the first two zero crossings gives +12.5% at 8. The
+// 16-particle plate takes ~8 times this test's time, beyond the suite's budget. The 5%
+// check is kept, disabled (run with --gtest_also_run_disabled_tests); the enabled test
+// checks that the plate oscillates and that the period does not get worse than this
+// finding (20%).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -90,7 +94,7 @@ TEST(SphPlate, CantileverOscillates) {
   const auto [T_sph, T] = plate_periods();
   EXPECT_NEAR(T, 0.2541, 5e-4);
   ASSERT_GT(T_sph, 0) << "the tip velocity did not change sign";
-  EXPECT_LT(std::abs(T_sph / T - 1), 0.25); // regression guard at the finding, not the goal
+  EXPECT_LT(std::abs(T_sph / T - 1), 0.20); // regression guard at the finding, not the goal
 }
 
 TEST(SphPlate, DISABLED_CantileverPeriodWithin5Percent) {

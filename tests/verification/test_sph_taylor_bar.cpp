@@ -4,14 +4,19 @@
 // plasticity, E = 117 GPa, nu = 0.35, yield 400 MPa, hardening 100 MPa, 80 us) as a
 // particle cylinder against a rigid frictionless wall (the FE run fixes the impact face
 // axially; the wall lets it slide alike). Coarse: spacing 0.8 mm (4 particles across
-// the radius, 2,000 particles), h = 1.3 spacing, default viscosity (1, 2) and artificial
-// stress (0.3). Particle surfaces are taken half a spacing beyond the outermost centres.
+// the radius, 2,080 particles), h = 1.3 spacing, normalised gradient
+// (`corrected_gradient: true`), viscosity alpha 0.2, beta 0.4, default artificial stress
+// (0.3). Particle surfaces are taken half a spacing beyond the outermost centres.
 // Tolerances (stated before the run): final length within 3% of 21.5 mm; footprint
 // radius within 10% of 7.12 mm (4 particles across the radius).
-// FINDING (docs/sph.md): at this resolution the SPH bar ends 22.65 mm long (+5.4%) with
-// a 5.3 mm footprint (-25%): too little mushrooming. The stated check is kept, disabled
-// (run with --gtest_also_run_disabled_tests); the enabled test guards the behaviour
-// (the bar stops, shortens and mushrooms) and the numbers of the finding.
+// Why these settings (docs/sph.md, "Taylor bar"): with the plain gradient the outer
+// particles' kernels are cut by the free surface, their strain rate is under-estimated
+// and they yield late: footprint -25% at 0.8 mm and still -25% at 0.6 mm spacing (not a
+// resolution error). Monaghan's viscosity at its gas-shock defaults (1, 2) resists the
+// isochoric plastic flow (pairs along the axis approach although the volume does not
+// change; the FE bar has only a bulk viscosity on the volume rate): with the normalised
+// gradient, length +9.1% / +5.2% / +1.3% at alpha 1 / 0.5 / 0.2. At 0.6 mm spacing these
+// settings give +0.95% and +7.2% (0.8 mm: +1.3%, +9.3%).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -39,7 +44,8 @@ materials:
 particles:
   bar: {generate: {shape: cylinder, origin: [0, 0, 0], radius: 3.2e-3, length: 32.4e-3, axis: z,
                    spacing: 0.8e-3},
-        material: copper, smoothing_ratio: 1.3}
+        material: copper, smoothing_ratio: 1.3, corrected_gradient: true,
+        viscosity: {linear: 0.2, quadratic: 0.4}}
 initial_conditions:
   - {part: bar, velocity: [0, 0, -227.0]}
 rigid_walls:
@@ -69,15 +75,9 @@ rigid_walls:
   return {length, radius, ke};
 }
 
-TEST(SphTaylorBar, BarStopsShortensAndMushrooms) {
+TEST(SphTaylorBar, FinalLengthAndFootprintMatchFeResult) {
   const TaylorResult r = run_bar();
   EXPECT_LT(r.kinetic, 0.01 * 0.5 * 8930 * M_PI * 3.2e-3 * 3.2e-3 * 32.4e-3 * 227 * 227);
-  EXPECT_LT(r.length, 23.5); // regression guards at the finding, not the goal
-  EXPECT_GT(r.radius, 5.0);
-}
-
-TEST(SphTaylorBar, DISABLED_FinalLengthAndFootprintMatchFeResult) {
-  const TaylorResult r = run_bar();
   EXPECT_LT(std::abs(r.length / 21.5 - 1), 0.03);
   EXPECT_LT(std::abs(r.radius / 7.12 - 1), 0.10);
 }

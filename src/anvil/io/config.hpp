@@ -80,6 +80,7 @@ struct ParticleSetConfig {
   double artificial_stress = 0.3;   // Monaghan's epsilon (Gray et al. 2001); 0 turns it off
   double artificial_stress_exponent = 4;
   bool corrected_gradient = false; // Randles-Libersky normalised velocity gradient
+  bool summation_density = false;  // rho = sum m W (gases, shocks) instead of continuity
   SourceLocation where;
 };
 

@@ -411,7 +411,7 @@ ParticleSetConfig parse_particle_set(const std::string& name, const Node& n) {
   p.name = name;
   p.where = n.where();
   n.check_keys({"generate", "material", "smoothing_ratio", "kernel", "viscosity",
-                "artificial_stress", "corrected_gradient"});
+                "artificial_stress", "corrected_gradient", "summation_density"});
   const Node g = n.required("generate");
   const std::string shape = g.required("shape").str();
   LatticeSpec& l = p.lattice;
@@ -488,6 +488,11 @@ ParticleSetConfig parse_particle_set(const std::string& name, const Node& n) {
     const std::string b = n.child("corrected_gradient").str();
     if (b != "true" && b != "false") n.child("corrected_gradient").fail("expected true or false");
     p.corrected_gradient = b == "true";
+  }
+  if (n.has("summation_density")) {
+    const std::string b = n.child("summation_density").str();
+    if (b != "true" && b != "false") n.child("summation_density").fail("expected true or false");
+    p.summation_density = b == "true";
   }
   return p;
 }

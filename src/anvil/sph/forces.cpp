@@ -38,6 +38,14 @@ inline void kernel_simd(const vdouble& r, const vdouble& h, vdouble& w, vdouble&
   }
 }
 
+// The kernel at r = 0 (a particle's own term in the summation density): the
+// normalisation over h^D times the shape's value 1 (cubic spline) or 1 (Wendland C2).
+template <KernelType K, int D>
+inline double self_weight(double h) {
+  const double ih = 1.0 / h;
+  return kernel_norm<K, D>() * (D == 1 ? ih : (D == 2 ? ih * ih : ih * ih * ih));
+}
+
 } // namespace
 
 void principal(const double s[6], double lambda[3], double Q[3][3]) {
@@ -144,7 +152,7 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, const N
     // The pairs, `width` at a time (lane l takes the entries k0 + l): each lane sums its
     // entries in list order and the lanes are added in lane order at the end, so the
     // sums depend only on the list, which is the same on every rank.
-    vdouble Lv[3][3], Bv[3][3];
+    vdouble Lv[3][3], Bv[3][3], sum_mw = 0.0;
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) Lv[a][b] = Bv[a][b] = 0.0;
     const vdouble xi[3] = {pi.x[0], pi.x[1], pi.x[2]}, vi[3] = {pi.v[0], pi.v[1], pi.v[2]};
@@ -201,6 +209,7 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, const N
         dv[a] = vj * (get([a](const NeighbourRead1& q) { return q.v[a]; }) - vi[a]);
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) Lv[a][b] += dv[a] * g[b];
+      if (si.summation) sum_mw += valid * get([](const NeighbourRead1& q) { return q.mass; }) * wk;
       if (si.corrected)
         for (int a = 0; a < 3; ++a)
           for (int b = 0; b < 3; ++b) Bv[a][b] -= (vj * dx[a]) * g[b];
@@ -226,7 +235,13 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, const N
             Lc[a][b] = L[a][0] * Bi[0][b] + L[a][1] * Bi[1][b] + L[a][2] * Bi[2][b];
         for (int a = 0; a < 3; ++a)
           for (int b = 0; b < 3; ++b) L[a][b] = Lc[a][b];
+      } else {
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) Bi[a][b] = a == b ? 1.0 : 0.0;
       }
+      // The momentum equation pairs sigma B^-T (sph_kinematics, after the stress update).
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) w.binv[9 * i + 3 * a + b] = Bi[a][b];
     }
     const double d[6] = {L[0][0],
                          L[1][1],
@@ -236,9 +251,15 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, const N
                          0.5 * (L[0][2] + L[2][0])};
     const double spin[3] = {0.5 * (L[2][1] - L[1][2]), 0.5 * (L[0][2] - L[2][0]),
                             0.5 * (L[1][0] - L[0][1])};
-    // Continuity, time-centred: rho(n) = rho(n-1) (1 - tr D dt/2) / (1 + tr D dt/2).
+    // Continuity, time-centred: rho(n) = rho(n-1) (1 - tr D dt/2) / (1 + tr D dt/2); or
+    // the summation at x(n) (tied to the particles' spacing: across a shock the
+    // integrated rate drifts from it, and the pressure with it; docs/sph.md, Sod).
     const double tr = (d[0] + d[1] + d[2]) * dt;
-    p.rho[i] = p.rho[i] * (1 - 0.5 * tr) / (1 + 0.5 * tr);
+    if (si.summation) {
+      p.rho[i] = lane_sum(sum_mw) + pi.mass * self_weight<K, D>(pi.h);
+    } else {
+      p.rho[i] = p.rho[i] * (1 - 0.5 * tr) / (1 + 0.5 * tr);
+    }
     // Objective stress rate: rotate the old stress by Hughes-Winget, as the element does.
     double Q[3][3], s[6];
     hex8::hughes_winget(spin, dt, Q);
@@ -264,6 +285,9 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
   for (auto& d : w.d) d.resize(n);
   w.power_old.resize(n);
   w.energy_pred.resize(n);
+  bool any_corrected = false;
+  for (const auto& st : sets) any_corrected = any_corrected || st.corrected;
+  if (any_corrected) w.binv.resize(9 * n);
   w.read1.resize(p.n_all);
   for (std::size_t i = 0; i < p.n_all; ++i) {
     NeighbourRead1& r = w.read1[i];
@@ -272,6 +296,7 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
       r.v[a] = p.v[a][i];
     }
     r.volume = p.mass[i] / p.rho[i];
+    r.mass = p.mass[i];
     r.h = p.h[i];
     r.set = p.set[i];
   }
@@ -321,39 +346,35 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
                          2 * (s[3] * w.d[3][i] + s[4] * w.d[4][i] + s[5] * w.d[5][i]);
     const double rho = p.rho[i];
     p.energy[i] += 0.5 * (w.power_old[i] + power) * dt / rho;
-    for (int k = 0; k < 6; ++k) p.S[k][i] = s[k];
+    if (si.corrected) {
+      // P = sigma B^-T: P_ab = sigma_ac Bi_bc (pass 2's stress for this particle).
+      const double* bi = &w.binv[9 * i];
+      const double sg[3][3] = {{s[0], s[3], s[5]}, {s[3], s[1], s[4]}, {s[5], s[4], s[2]}};
+      double P[3][3];
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          P[a][b] = sg[a][0] * bi[3 * b] + sg[a][1] * bi[3 * b + 1] + sg[a][2] * bi[3 * b + 2];
+      const double pk[9] = {P[0][0], P[1][1], P[2][2], P[0][1], P[1][2],
+                            P[0][2], P[1][0], P[2][1], P[2][0]};
+      for (int k = 0; k < 9; ++k) p.S[k][i] = pk[k];
+    } else {
+      for (int k = 0; k < 6; ++k) p.S[k][i] = s[k];
+      p.S[6][i] = s[3];
+      p.S[7][i] = s[4];
+      p.S[8][i] = s[5];
+    }
     double R[6] = {0, 0, 0, 0, 0, 0};
     if (si.epsilon > 0) artificial_stress(s, si.epsilon, R);
     for (int k = 0; k < 6; ++k) p.R[k][i] = R[k];
   }
 }
 
-void sph_forces(const SphView& p, std::span<const SetParams> sets, const NeighbourList& nl,
-                SphWorkspace& w, SphResult& res) {
+namespace {
+
+// Pass 2's pair loop; Corr: some set normalises its gradient (P is not symmetric).
+template <bool Corr>
+void forces_pairs(const SphView& p, const NeighbourList& nl, SphWorkspace& w, SphResult& res) {
   const std::size_t n = p.n_local;
-  w.read2.resize(p.n_all);
-  for (std::size_t i = 0; i < p.n_all; ++i) {
-    NeighbourRead2& r = w.read2[i];
-    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
-    for (int a = 0; a < 3; ++a) {
-      r.x[a] = p.x[a][i];
-      r.v[a] = p.v[a][i];
-    }
-    r.mass = p.mass[i];
-    r.rho = p.rho[i];
-    r.inv_rho = 1 / p.rho[i];
-    r.h = p.h[i];
-    r.c = p.wave_speed[i];
-    r.alpha = si.alpha;
-    r.beta = si.beta;
-    int any = 0;
-    for (int c = 0; c < 6; ++c) {
-      r.S[c] = p.S[c][i];
-      r.R[c] = p.R[c][i];
-      any |= p.R[c][i] != 0.0;
-    }
-    r.has_r = any;
-  }
   const NeighbourRead2* rd = w.read2.data();
   for (std::size_t i = 0; i < n; ++i) {
     const NeighbourRead2& pi = rd[i];
@@ -395,8 +416,11 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, const Neighbo
         stdx::where(approaching, mumv) = stdx::max(mumv, -mu);
       }
       const vdouble irr = pi.inv_rho * get([](const NeighbourRead2& q) { return q.inv_rho; });
-      vdouble T[6];
-      for (int c = 0; c < 6; ++c)
+      // T = (P_i + P_j + f^n (R_i + R_j)) / (rho_i rho_j) - Pi I; T[6..8] (yx zy zx)
+      // differ from T[3..5] only where a gradient is normalised (Corr).
+      constexpr int nt = Corr ? 9 : 6;
+      vdouble T[nt];
+      for (int c = 0; c < nt; ++c)
         T[c] = (pi.S[c] + get([c](const NeighbourRead2& q) { return q.S[c]; })) * irr;
       vdouble rg = 0.0;
       if (stdx::any_of(fn > 0.0) && (pi.has_r || stdx::any_of(get([](const NeighbourRead2& q) {
@@ -405,6 +429,9 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, const Neighbo
         const vdouble fi = fn * irr;
         for (int c = 0; c < 6; ++c)
           T[c] += fi * (pi.R[c] + get([c](const NeighbourRead2& q) { return q.R[c]; }));
+        if constexpr (Corr)
+          for (int c = 6; c < 9; ++c)
+            T[c] += fi * (pi.R[c - 3] + get([c](const NeighbourRead2& q) { return q.R[c - 3]; }));
         // The artificial stress's own work on particle i (the stress's is in pass 1).
         rg = fi * (dv[0] * (pi.R[0] * g[0] + pi.R[3] * g[1] + pi.R[5] * g[2]) +
                    dv[1] * (pi.R[3] * g[0] + pi.R[1] * g[1] + pi.R[4] * g[2]) +
@@ -415,9 +442,10 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, const Neighbo
       T[2] -= visc;
       // Padding lanes have zero kernel gradients: they add nothing.
       const vdouble mj = get([](const NeighbourRead2& q) { return q.mass; });
+      const int yx = Corr ? 6 : 3, zy = Corr ? 7 : 4, zx = Corr ? 8 : 5;
       accv[0] += mj * (T[0] * g[0] + T[3] * g[1] + T[5] * g[2]);
-      accv[1] += mj * (T[3] * g[0] + T[1] * g[1] + T[4] * g[2]);
-      accv[2] += mj * (T[5] * g[0] + T[4] * g[1] + T[2] * g[2]);
+      accv[1] += mj * (T[yx] * g[0] + T[1] * g[1] + T[4] * g[2]);
+      accv[2] += mj * (T[zx] * g[0] + T[zy] * g[1] + T[2] * g[2]);
       // Half the viscous dissipation of the pair heats particle i.
       const vdouble dvg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
       dev += mj * (0.5 * visc * dvg - rg);
@@ -439,6 +467,41 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, const Neighbo
     if (!finite && (res.nonfinite_gid < 0 || p.gid[i] < res.nonfinite_gid))
       res.nonfinite_gid = p.gid[i];
   }
+}
+
+} // namespace
+
+void sph_forces(const SphView& p, std::span<const SetParams> sets, const NeighbourList& nl,
+                SphWorkspace& w, SphResult& res) {
+  w.read2.resize(p.n_all);
+  for (std::size_t i = 0; i < p.n_all; ++i) {
+    NeighbourRead2& r = w.read2[i];
+    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
+    for (int a = 0; a < 3; ++a) {
+      r.x[a] = p.x[a][i];
+      r.v[a] = p.v[a][i];
+    }
+    r.mass = p.mass[i];
+    r.rho = p.rho[i];
+    r.inv_rho = 1 / p.rho[i];
+    r.h = p.h[i];
+    r.c = p.wave_speed[i];
+    r.alpha = si.alpha;
+    r.beta = si.beta;
+    int any = 0;
+    for (int c = 0; c < 9; ++c) r.S[c] = p.S[c][i];
+    for (int c = 0; c < 6; ++c) {
+      r.R[c] = p.R[c][i];
+      any |= p.R[c][i] != 0.0;
+    }
+    r.has_r = any;
+  }
+  bool any_corrected = false;
+  for (const auto& st : sets) any_corrected = any_corrected || st.corrected;
+  if (any_corrected)
+    forces_pairs<true>(p, nl, w, res);
+  else
+    forces_pairs<false>(p, nl, w, res);
 }
 
 } // namespace anvil::sph

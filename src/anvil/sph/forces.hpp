@@ -5,14 +5,18 @@
 //
 //  1. kinematics: velocity gradient L_i = sum_j V_j (v_j - v_i) (x) grad_i W_ij with the
 //     volumes V_j = m_j / rho_j (optionally normalised, Randles and Libersky 1996),
-//     continuity d rho_i / dt = -rho_i tr L_i, stress rotated by Hughes-Winget with the
-//     spin and advanced by the material's batch update with D, internal energy from the
+//     continuity d rho_i / dt = -rho_i tr L_i (or, per set, the summation
+//     rho_i = sum_j m_j W_ij over the neighbours and i itself), stress rotated by Hughes-Winget
+//     with the spin and advanced by the material's batch update with D, internal energy from the
 //     stress power sigma : D / rho; then Monaghan's artificial stress R_i (Gray,
 //     Monaghan and Swift 2001) for the neighbours.
 //  2. forces: the symmetric conservative momentum equation that matches that gradient
 //     (so that the stress power and the forces' work cancel exactly, pair by pair)
-//     dv_i/dt = sum_j m_j ((sigma_i + sigma_j + f_ij^n (R_i + R_j)) / (rho_i rho_j)
+//     dv_i/dt = sum_j m_j ((P_i + P_j + f_ij^n (R_i + R_j)) / (rho_i rho_j)
 //                          - Pi_ij I) grad_i W_ij
+//     with P = sigma, or P = sigma B^-T where the gradient is normalised (Bonet and Lok
+//     1999: the same normalisation in both equations keeps the pair forces equal and
+//     opposite and the energy exact, and lets a free surface carry its stress gradient)
 //     with Monaghan and Gingold's (1983) artificial viscosity Pi_ij and
 //     f_ij = W(r_ij) / W(dp); the work of Pi and R as an energy rate; the particle
 //     stable time step. The (sigma_i + sigma_j)/(rho_i rho_j) form with volume-weighted
@@ -48,6 +52,7 @@ struct SetParams {
   double exponent = 4;                // its exponent n
   double w_spacing = 1;               // kernel shape w(q) at q = 1 / smoothing_ratio
   bool corrected = false;             // normalised velocity gradient
+  bool summation = false;             // density by summation, sum_j m_j W_ij (with j = i)
   int dimensions = 3;                 // of the particle model (1, 2 or 3)
 };
 
@@ -76,7 +81,10 @@ struct SphView {
   double* temperature = nullptr;
   // all: written by pass 1 for own particles, read by pass 2 for all
   double* wave_speed = nullptr;
-  double* S[6] = {}; // stress (a copy the ghosts receive), Pa
+  // The stress the momentum equation pairs, P = sigma B^-T (a copy the ghosts receive;
+  // xx yy zz xy yz xz yx zy zx, row index first), Pa: sigma itself (the last three
+  // repeat the shear) unless the set normalises its gradient.
+  double* S[9] = {};
   double* R[6] = {}; // artificial stress, Pa
   // own, out of pass 2
   double* force[3] = {};         // N
@@ -94,6 +102,7 @@ struct SphResult {
 struct NeighbourRead1 {
   double x[3], v[3];
   double volume; // m / rho
+  double mass;
   double h;
   int set;
 };
@@ -101,7 +110,7 @@ struct NeighbourRead2 {
   double x[3], v[3];
   double mass, rho, inv_rho, h, c;
   double alpha, beta; // the particle's set's viscosity coefficients
-  double S[6], R[6];
+  double S[9], R[6];
   int has_r; // R is not zero
 };
 
@@ -111,6 +120,7 @@ struct SphWorkspace {
   std::vector<NeighbourRead2> read2;
   std::vector<double> pair;        // per neighbour entry: grad W (3), f^n
   std::vector<double> d[6];        // rate of deformation of own particles
+  std::vector<double> binv;        // B^-1 of own particles, 9 per particle (row-major)
   std::vector<double> power_old;   // rotated old stress : D
   std::vector<double> energy_pred; // e predicted at the new state (equations of state)
 };

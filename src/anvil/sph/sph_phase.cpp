@@ -55,6 +55,7 @@ SphPhase::SphPhase(const Config& config, const std::function<const Material*(int
     sp.exponent = psets[s].artificial_stress_exponent;
     sp.w_spacing = kernel_shape(kernel_, 1.0 / psets[s].smoothing_ratio);
     sp.corrected = psets[s].corrected_gradient;
+    sp.summation = psets[s].summation_density;
     sp.dimensions = config.sph.dimensions;
     sets_.push_back(sp);
   }
@@ -203,10 +204,8 @@ void SphPhase::exchange_ghosts_out() {
   for (std::size_t k = 0; k < ghost_src_.size(); ++k) {
     const auto i = static_cast<std::size_t>(ghost_src_[k]);
     GhostOut& g = out_send_[k];
-    for (int c = 0; c < 6; ++c) {
-      g.S[c] = S_[c][i];
-      g.R[c] = R_[c][i];
-    }
+    for (int c = 0; c < 9; ++c) g.S[c] = S_[c][i];
+    for (int c = 0; c < 6; ++c) g.R[c] = R_[c][i];
     g.rho = p_.rho[i];
     g.c = p_.wave_speed[i];
   }
@@ -214,10 +213,8 @@ void SphPhase::exchange_ghosts_out() {
   for (std::size_t k = 0; k < out_recv_.size(); ++k) {
     const GhostOut& g = out_recv_[k];
     const std::size_t i = n + k;
-    for (int c = 0; c < 6; ++c) {
-      S_[c][i] = g.S[c];
-      R_[c][i] = g.R[c];
-    }
+    for (int c = 0; c < 9; ++c) S_[c][i] = g.S[c];
+    for (int c = 0; c < 6; ++c) R_[c][i] = g.R[c];
     p_.rho[i] = g.rho;
     p_.wave_speed[i] = g.c;
   }
@@ -306,10 +303,8 @@ void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
   }
 
   const std::size_t na = p_.gid.size();
-  for (int c = 0; c < 6; ++c) {
-    S_[c].resize(na);
-    R_[c].resize(na);
-  }
+  for (auto& a : S_) a.resize(na);
+  for (auto& a : R_) a.resize(na);
   for (auto& a : p_.f) a.resize(n);
   energy_rate_.resize(n);
   SphView view;
@@ -327,9 +322,9 @@ void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
   view.rho = p_.rho.data();
   for (int c = 0; c < 6; ++c) {
     view.stress[c] = p_.stress[c].data();
-    view.S[c] = S_[c].data();
     view.R[c] = R_[c].data();
   }
+  for (int c = 0; c < 9; ++c) view.S[c] = S_[c].data();
   view.energy = p_.energy.data();
   view.plastic_strain = p_.plastic_strain.data();
   view.temperature = p_.temperature.data();

@@ -131,11 +131,11 @@ private:
     double x[3], v[3], mass, rho, h;
   };
   struct GhostOut {
-    double S[6], R[6], rho, c;
+    double S[9], R[6], rho, c;
   };
   std::vector<GhostIn> in_send_, in_recv_;
   std::vector<GhostOut> out_send_, out_recv_;
-  std::vector<double> S_[6], R_[6], energy_rate_;
+  std::vector<double> S_[9], R_[6], energy_rate_;
   std::vector<int> ranks_, dest_, perm_;
   std::vector<double> tmp_d_;
   std::vector<std::int64_t> tmp_l_;
