@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <initializer_list>
 #include <vector>
 
 #include "anvil/mesh/mesh.hpp"
@@ -61,8 +62,10 @@ FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, in
 class CornerExchange {
 public:
   CornerExchange(const FeDecomposition& d, const Comm& comm);
-  // Fills the remote slots of `components` arrays of total_slots() values each.
-  void exchange(const std::vector<double*>& arrays);
+  // Fills the remote slots of `components` arrays of total_slots() values each. The
+  // arrays come as a braced list (an initializer_list lives on the stack: the cycle
+  // allocates nothing for it).
+  void exchange(std::initializer_list<double*> arrays);
 
 private:
   const FeDecomposition& d_;
@@ -85,8 +88,10 @@ private:
 };
 
 // Sums the corner slots of every local node (the gather): out[i][n] = sum over the
-// node's slots in order of corner[i][slot]. Pure arithmetic, no communication.
-void gather_corners(const FeDecomposition& d, const std::vector<const double*>& corner,
-                    const std::vector<double*>& out);
+// node's slots in order of corner[i][slot]. Pure arithmetic, no communication. One or
+// three components (mass, force) per call, as braced lists of equal length; the three
+// components are summed in one pass over the slot list (each still in slot order).
+void gather_corners(const FeDecomposition& d, std::initializer_list<const double*> corner,
+                    std::initializer_list<double*> out);
 
 } // namespace anvil
