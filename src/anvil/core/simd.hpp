@@ -29,6 +29,15 @@ inline void store(const vdouble& v, double* p) {
   v.copy_to(p, stdx::element_aligned);
 }
 
+// v <- (m ? v : other) per lane; the scalar overload lets one template serve a vector
+// body and its scalar remainder.
+inline void keep_where(const vmask& m, vdouble& v, double other) {
+  stdx::where(!m, v) = other;
+}
+inline void keep_where(bool m, double& v, double other) {
+  if (!m) v = other;
+}
+
 } // namespace anvil::simd
 
 namespace anvil::simd {
