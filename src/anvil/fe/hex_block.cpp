@@ -122,7 +122,6 @@ HexWorkspace::HexWorkspace() : buf_(static_cast<std::size_t>(s_count) * chunk, 0
 void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corners,
                 HexWorkspace& work, HexResult& result) {
   const int n = b.size();
-  const int stride = padded_size(n); // corner slot stride of this block
   constexpr int C = HexWorkspace::chunk;
   auto scratch = [&](int slot) { return work.buf_.data() + static_cast<std::size_t>(slot) * C; };
   const double M = b.material->elastic().plane_wave_modulus();
@@ -313,8 +312,8 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
           if (any_dead) stdx::where(dead, fa[a]) = 0.0;
           check += fa[a];
         }
-        double* fi = corners.f[i] + b.corner_base + e;
-        for (int a = 0; a < 8; ++a) simd::store(fa[a], fi + static_cast<std::size_t>(a) * stride);
+        // Element-major slots: the lanes' eight corners are contiguous.
+        simd::store_transposed(fa, corners.f[i] + b.corner_base + 8 * static_cast<std::size_t>(e));
       }
 
       // Bookkeeping. The common case (every live element healthy, none to erode) stays in
@@ -342,7 +341,7 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
           b.alive[e + k] = 0.0;
           for (int a = 0; a < 8; ++a)
             for (int i = 0; i < 3; ++i)
-              corners.f[i][b.corner_base + static_cast<std::size_t>(a) * stride + e + k] = 0.0;
+              corners.f[i][b.corner_base + 8 * static_cast<std::size_t>(e + k) + a] = 0.0;
           for (auto& sk : b.stress) sk[e + k] = 0.0;
           ++result.eroded;
           continue;

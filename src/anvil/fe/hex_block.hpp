@@ -61,7 +61,7 @@ struct HexBlock {
   std::vector<double> internal_energy;                 // J, stress work plus bulk viscosity work
   std::vector<double> hourglass_energy;                // J
   std::size_t corner_base = 0;                         // corner (e, a) of this block lives at slot
-                                                       // corner_base + a * size() + e
+                                                       // corner_base + 8 e + a (element-major)
 
   int size() const { return static_cast<int>(gid.size()); }
 

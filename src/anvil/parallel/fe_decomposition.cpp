@@ -93,7 +93,8 @@ FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, in
   auto local_slot = [&](std::int64_t c) -> std::int64_t {
     const auto e = c / 8;
     const auto& b = d.blocks[block_of[e]];
-    return static_cast<std::int64_t>(b.corner_base) + (c % 8) * b.stride + local_index[e];
+    return static_cast<std::int64_t>(
+        b.slot(static_cast<std::size_t>(local_index[e]), static_cast<int>(c % 8)));
   };
 
   // Slot of every corner of every local node: local corners directly, remote ones in the

@@ -30,8 +30,11 @@ struct FeDecomposition {
   struct Block {
     std::vector<std::int64_t> gid;        // owned elements of this mesh block, ascending
     std::vector<std::array<int, 8>> conn; // their corners as local node indices
-    std::size_t corner_base = 0;          // slot of corner (e, a): base + a * stride + e
+    std::size_t corner_base = 0;          // slot of corner (e, a): slot(e, a)
     int stride = 0;                       // padded element count (simd::padded_size)
+    // Corners are element-major: an element's eight corners are adjacent (64 bytes per
+    // component), so the kernel writes, and the gather reads, few memory streams.
+    std::size_t slot(std::size_t e, int a) const { return corner_base + 8 * e + a; }
   };
   std::vector<Block> blocks; // one per mesh block, possibly empty
 

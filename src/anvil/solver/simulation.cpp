@@ -77,7 +77,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     }
     for (int e = 0; e < hb.size(); ++e)
       for (int a = 0; a < 8; ++a)
-        corner_mass[lb.corner_base + static_cast<std::size_t>(a) * lb.stride + e] = hb.mass[e] / 8;
+        corner_mass[lb.slot(static_cast<std::size_t>(e), a)] = hb.mass[e] / 8;
     blocks_.push_back(std::move(hb));
   }
   corner_exchange_->exchange({corner_mass.data()});
