@@ -4,8 +4,8 @@
 // updates) for a particle model of two sets with plasticity and artificial stress make no
 // C++ allocation. Particles that leave their box would legitimately grow the arrays that
 // receive them, so the motion is slow. Tolerance: zero allocations.
-// (The whole step is not measured: Simulation::fe_forces makes 3 allocations per cycle
-// of its own, the initializer-list vectors of its corner exchange and gather.)
+// (The whole step is not measured: on several ranks the corner exchange of
+// Simulation::fe_forces still allocates its MPI request list every cycle.)
 #include <gtest/gtest.h>
 
 #include <cstdlib>

@@ -17,7 +17,8 @@ struct KernelRig {
   FeDecomposition fe;
   std::unique_ptr<Material> material;
   HexBlock block;
-  std::array<std::vector<double>, 3> x, v, f, corner;
+  std::array<std::vector<double>, 3> x, v, f;
+  std::array<CornerArray, 3> corner;
   HexWorkspace work;
   HexResult result;
 

@@ -130,6 +130,10 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
   const double c1 = b.bulk_viscosity.linear, c2 = b.bulk_viscosity.quadratic;
   const bool has_ep = !b.plastic_strain.empty(), has_T = !b.temperature.empty();
   const bool erode_ep = b.erosion.plastic_strain > 0 && has_ep;
+  // Non-temporal corner stores need 32-byte aligned rows (every row is if the arrays are).
+  bool stream = true;
+  for (double* f : corners.f)
+    stream = stream && reinterpret_cast<std::uintptr_t>(f + b.corner_base) % 32 == 0;
   Gathered g;
   // The smallest stable step: the element's if it is smaller, or equal with a smaller id.
   auto take_step = [&](double dte, std::int64_t id) {
@@ -312,8 +316,13 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
           if (any_dead) stdx::where(dead, fa[a]) = 0.0;
           check += fa[a];
         }
-        // Element-major slots: the lanes' eight corners are contiguous.
-        simd::store_transposed(fa, corners.f[i] + b.corner_base + 8 * static_cast<std::size_t>(e));
+        // Element-major slots: the lanes' eight corners are contiguous, whole rows that
+        // the gather reads only after the kernel, streamed past the cache when aligned.
+        double* row = corners.f[i] + b.corner_base + 8 * static_cast<std::size_t>(e);
+        if (stream)
+          simd::store_transposed<true>(fa, row);
+        else
+          simd::store_transposed(fa, row);
       }
 
       // Bookkeeping. The common case (every live element healthy, none to erode) stays in
@@ -355,6 +364,7 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       }
     }
   }
+  if (stream) simd::stream_fence();
   for (int k = 0; k < width; ++k)
     if (best_e[k] >= 0) take_step(best_dt[k], b.gid[static_cast<std::size_t>(best_e[k])]);
 }

@@ -52,7 +52,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     return nullptr;
   };
   for (int i = 0; i < 3; ++i) corner_force_[i].assign(fe_.total_slots(), 0.0);
-  std::vector<double>& corner_mass = corner_force_[0]; // reused once for the mass
+  CornerArray& corner_mass = corner_force_[0]; // reused once for the mass
   const double* xs[3] = {nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()};
   for (std::size_t b = 0; b < config_.parts.size(); ++b) {
     const auto& part = config_.parts[b];
