@@ -340,6 +340,9 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
         stdx::where(lower, best_e) = lane + static_cast<double>(e);
         continue;
       }
+      // The scalar path may overwrite this vector's streamed corner rows (erosion): order
+      // the non-temporal stores first.
+      if (stream) simd::stream_fence();
       const int lanes = std::min(width, n - e);
       for (int k = 0; k < lanes; ++k) {
         const std::int64_t id = b.gid[e + k];
