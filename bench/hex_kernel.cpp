@@ -17,7 +17,8 @@ struct Fixture {
   FeDecomposition fe;
   std::unique_ptr<Material> material;
   HexBlock block;
-  std::array<std::vector<double>, 3> x, v, f, corner;
+  std::array<std::vector<double>, 3> x, v, f;
+  std::array<CornerArray, 3> corner;
   HexWorkspace work;
 
   Fixture(int n, const std::string& model, HourglassControl::Model hg) {
@@ -58,9 +59,8 @@ struct Fixture {
     const CornerView cv{{corner[0].data(), corner[1].data(), corner[2].data()}};
     HexResult r;
     hex_forces(block, nv, dt, cv, work, r);
-    gather_corners(
-        fe, std::array<const double*, 3>{corner[0].data(), corner[1].data(), corner[2].data()},
-        std::array{f[0].data(), f[1].data(), f[2].data()});
+    gather_corners(fe, {corner[0].data(), corner[1].data(), corner[2].data()},
+                   {f[0].data(), f[1].data(), f[2].data()});
     benchmark::DoNotOptimize(r.dt_stable);
   }
 };

@@ -17,7 +17,8 @@ struct KernelRig {
   FeDecomposition fe;
   std::unique_ptr<Material> material;
   HexBlock block;
-  std::array<std::vector<double>, 3> x, v, f, corner;
+  std::array<std::vector<double>, 3> x, v, f;
+  std::array<CornerArray, 3> corner;
   HexWorkspace work;
   HexResult result;
 
@@ -50,9 +51,8 @@ struct KernelRig {
     const CornerView cv{{corner[0].data(), corner[1].data(), corner[2].data()}};
     result = HexResult{};
     hex_forces(block, nv, dt_prev, cv, work, result);
-    gather_corners(
-        fe, std::array<const double*, 3>{corner[0].data(), corner[1].data(), corner[2].data()},
-        std::array{f[0].data(), f[1].data(), f[2].data()});
+    gather_corners(fe, {corner[0].data(), corner[1].data(), corner[2].data()},
+                   {f[0].data(), f[1].data(), f[2].data()});
   }
 };
 

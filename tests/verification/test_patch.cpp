@@ -117,8 +117,8 @@ TEST_P(Patch, DrivenBoundaryCarriesInteriorAlongHomogeneousDeformation) {
   std::vector<double> corner_mass(rig.fe.total_slots(), 0.0), mass(nn);
   for (int e = 0; e < rig.block.size(); ++e)
     for (int a = 0; a < 8; ++a)
-      corner_mass[a * simd::padded_size(rig.block.size()) + e] = rig.block.mass[e] / 8;
-  gather_corners(rig.fe, std::array<const double*, 1>{corner_mass.data()}, std::array{mass.data()});
+      corner_mass[rig.fe.blocks[0].slot(static_cast<std::size_t>(e), a)] = rig.block.mass[e] / 8;
+  gather_corners(rig.fe, {corner_mass.data()}, {mass.data()});
   std::vector<Vec3> X(nn), V(nn);
   for (std::size_t k = 0; k < nn; ++k) {
     X[k] = rig.mesh.nodes[rig.fe.node_gid[k]];

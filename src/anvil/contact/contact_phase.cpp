@@ -253,7 +253,7 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
   }
   {
     ScopedPhase t(timers, Phase::transfer);
-    exchange_->from_owners(std::array{nd.force[0], nd.force[1], nd.force[2]});
+    exchange_->from_owners({nd.force[0], nd.force[1], nd.force[2]});
   }
 }
 

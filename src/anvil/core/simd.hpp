@@ -5,6 +5,9 @@
 #pragma once
 
 #include <experimental/simd>
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
 
 namespace anvil::simd {
 
@@ -27,6 +30,54 @@ inline vdouble load(const double* p) {
 }
 inline void store(const vdouble& v, double* p) {
   v.copy_to(p, stdx::element_aligned);
+}
+
+// Stores eight vectors as `width` rows of eight: p[8 l + a] = v[a][l] (the element-major
+// corner slots: lane l's eight values are contiguous). Moves values, no arithmetic.
+// stream: non-temporal stores (p must be 32-byte aligned), for rows that are written
+// once and read back only after the whole kernel: they bypass the cache instead of first
+// reading every line in; stream_fence() after the last one.
+template <bool stream = false>
+inline void store_transposed(const vdouble (&v)[8], double* p) {
+#if defined(__AVX__)
+  if constexpr (width == 4) {
+    auto put = [](double* q, __m256d r) {
+      if constexpr (stream)
+        _mm256_stream_pd(q, r);
+      else
+        _mm256_storeu_pd(q, r);
+    };
+    for (int h = 0; h < 2; ++h) { // values 0-3, then 4-7, of every lane
+      const __m256d a = static_cast<__m256d>(v[4 * h]), b = static_cast<__m256d>(v[4 * h + 1]);
+      const __m256d c = static_cast<__m256d>(v[4 * h + 2]), d = static_cast<__m256d>(v[4 * h + 3]);
+      const __m256d ab0 = _mm256_unpacklo_pd(a, b), ab1 = _mm256_unpackhi_pd(a, b);
+      const __m256d cd0 = _mm256_unpacklo_pd(c, d), cd1 = _mm256_unpackhi_pd(c, d);
+      put(p + 4 * h, _mm256_permute2f128_pd(ab0, cd0, 0x20));
+      put(p + 8 + 4 * h, _mm256_permute2f128_pd(ab1, cd1, 0x20));
+      put(p + 16 + 4 * h, _mm256_permute2f128_pd(ab0, cd0, 0x31));
+      put(p + 24 + 4 * h, _mm256_permute2f128_pd(ab1, cd1, 0x31));
+    }
+    return;
+  }
+#endif
+  for (int l = 0; l < width; ++l)
+    for (int a = 0; a < 8; ++a) p[8 * l + a] = v[a][l];
+}
+
+// Orders the non-temporal stores before everything after it (they are weakly ordered).
+inline void stream_fence() {
+#if defined(__SSE__)
+  _mm_sfence();
+#endif
+}
+
+// v <- (m ? v : other) per lane; the scalar overload lets one template serve a vector
+// body and its scalar remainder.
+inline void keep_where(const vmask& m, vdouble& v, double other) {
+  stdx::where(!m, v) = other;
+}
+inline void keep_where(bool m, double& v, double other) {
+  if (!m) v = other;
 }
 
 } // namespace anvil::simd

@@ -1,6 +1,7 @@
 #include "anvil/fe/hex_block.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "anvil/core/simd.hpp"
 #include "anvil/fe/hex8.hpp"
@@ -41,6 +42,8 @@ enum Slot : int {
   s_count = s_v0 + 24
 };
 
+constexpr int prefetch_ahead = 32; // elements
+
 struct Gathered {
   vdouble x[8][3], v[8][3];
 };
@@ -51,7 +54,15 @@ void gather(const HexBlock& b, const NodalView& n, int e, Gathered& g, double* x
             int l) {
   constexpr int C = HexWorkspace::chunk;
   for (int a = 0; a < 8; ++a) {
-    const int* idx = b.conn[a].data() + e;
+    // The corner's node indices once, for all six gathers (x and v share them).
+    std::ptrdiff_t idx[width];
+    for (int k = 0; k < width; ++k) idx[k] = b.conn[a][e + k];
+    // Prefetch the corner's node some elements ahead (a few per cent on 100k elements).
+    const std::ptrdiff_t ahead = b.conn[a][std::min(e + prefetch_ahead, b.size() - 1)];
+    for (int i = 0; i < 3; ++i) {
+      __builtin_prefetch(n.x[i] + ahead);
+      __builtin_prefetch(n.v[i] + ahead);
+    }
     for (int i = 0; i < 3; ++i) {
       g.x[a][i] = simd::gather(n.x[i], idx);
       g.v[a][i] = simd::gather(n.v[i], idx);
@@ -111,7 +122,6 @@ HexWorkspace::HexWorkspace() : buf_(static_cast<std::size_t>(s_count) * chunk, 0
 void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corners,
                 HexWorkspace& work, HexResult& result) {
   const int n = b.size();
-  const int stride = padded_size(n); // corner slot stride of this block
   constexpr int C = HexWorkspace::chunk;
   auto scratch = [&](int slot) { return work.buf_.data() + static_cast<std::size_t>(slot) * C; };
   const double M = b.material->elastic().plane_wave_modulus();
@@ -119,7 +129,21 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
   const double hg = b.hourglass.coefficient;
   const double c1 = b.bulk_viscosity.linear, c2 = b.bulk_viscosity.quadratic;
   const bool has_ep = !b.plastic_strain.empty(), has_T = !b.temperature.empty();
+  const bool erode_ep = b.erosion.plastic_strain > 0 && has_ep;
+  // Non-temporal corner stores need 32-byte aligned rows (every row is if the arrays are).
+  bool stream = true;
+  for (double* f : corners.f)
+    stream = stream && reinterpret_cast<std::uintptr_t>(f + b.corner_base) % 32 == 0;
   Gathered g;
+  // The smallest stable step: the element's if it is smaller, or equal with a smaller id.
+  auto take_step = [&](double dte, std::int64_t id) {
+    if (dte < result.dt_stable || (dte == result.dt_stable && id < result.stable_gid)) {
+      result.dt_stable = dte;
+      result.stable_gid = id;
+    }
+  };
+  const vdouble lane([](auto l) { return static_cast<double>(l); });
+  vdouble best_dt = 1e300, best_e = -1.0; // per lane: smallest step so far and its element
 
   for (int e0 = 0; e0 < n; e0 += C) {
     const int nc = padded_size(std::min(C, n - e0)); // lanes in this chunk, whole vectors
@@ -149,8 +173,9 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       simd::store(simd::load(&b.mass[e]) * inv, scratch(s_density) + l);
       simd::store(power, scratch(s_power_old) + l);
       simd::store(vol, scratch(s_volume_mid) + l);
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) simd::store(Q[i][j], scratch(s_q0 + 3 * i + j) + l);
+      if (stiff) // the stiffness form rotates its hourglass forces with Q
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) simd::store(Q[i][j], scratch(s_q0 + 3 * i + j) + l);
     }
 
     // Stage B: constitutive update of the whole chunk through the batch interface.
@@ -249,13 +274,6 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
         for (int j = 0; j < 3; ++j)
           S[i][j] -=
               Qh[i][0] * h[0][j] + Qh[i][1] * h[1][j] + Qh[i][2] * h[2][j] + Qh[i][3] * h[3][j];
-      vdouble f[8][3];
-      for (int a = 0; a < 8; ++a)
-        for (int i = 0; i < 3; ++i) {
-          vdouble t = S[i][0] * B[a][0] + S[i][1] * B[a][1] + S[i][2] * B[a][2];
-          for (int al = 0; al < 4; ++al) t += hex8::gamma_base[al][a] * Qh[i][al];
-          f[a][i] = -t;
-        }
 
       // Energies over the step just taken (dt = 0 on the first cycle).
       const vdouble power_new =
@@ -263,6 +281,7 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       const vdouble vmid = simd::load(scratch(s_volume_mid) + l);
       vdouble dE = dt * vmid * (0.5 * (simd::load(scratch(s_power_old) + l) + power_new) - q * trd);
       const auto dead = simd::load(&b.alive[e]) == 0.0; // eroded elements store no energy
+      const bool any_dead = stdx::any_of(dead);
       stdx::where(dead, dE) = 0.0;
       stdx::where(dead, hg_power) = 0.0;
       simd::store(simd::load(&b.internal_energy[e]) + dE, &b.internal_energy[e]);
@@ -276,9 +295,7 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
 
       // Eroded elements: no force, no energy, no time step (select, not multiply: their
       // arithmetic may have produced non-finite values).
-      if (stdx::any_of(dead)) {
-        for (int a = 0; a < 8; ++a)
-          for (int i = 0; i < 3; ++i) stdx::where(dead, f[a][i]) = 0.0;
+      if (any_dead) {
         stdx::where(dead, dte) = 1e300;
         for (int k = 0; k < 6; ++k) {
           vdouble sk = simd::load(&b.stress[k][e]);
@@ -287,27 +304,56 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
         }
       }
 
+      // Corner forces f_a = -(S B_a + sum_al Q_al Gamma_al,a), formed and stored one
+      // component at a time (the hourglass part of all eight corners comes from four
+      // values), with their sum kept for the finiteness check.
       vdouble check = dte;
-      for (int a = 0; a < 8; ++a)
-        for (int i = 0; i < 3; ++i) {
-          simd::store(f[a][i],
-                      corners.f[i] + b.corner_base + static_cast<std::size_t>(a) * stride + e);
-          check += f[a][i];
+      for (int i = 0; i < 3; ++i) {
+        vdouble hgf[8], fa[8];
+        hex8::gamma_spread(Qh[i], hgf);
+        for (int a = 0; a < 8; ++a) {
+          fa[a] = -(S[i][0] * B[a][0] + S[i][1] * B[a][1] + S[i][2] * B[a][2] + hgf[a]);
+          if (any_dead) stdx::where(dead, fa[a]) = 0.0;
+          check += fa[a];
         }
+        // Element-major slots: the lanes' eight corners are contiguous, whole rows that
+        // the gather reads only after the kernel, streamed past the cache when aligned.
+        double* row = corners.f[i] + b.corner_base + 8 * static_cast<std::size_t>(e);
+        if (stream)
+          simd::store_transposed<true>(fa, row);
+        else
+          simd::store_transposed(fa, row);
+      }
 
-      // Scalar bookkeeping of the vector's lanes that hold real elements.
+      // Bookkeeping. The common case (every live element healthy, none to erode) stays in
+      // the vector: the stable step is kept per lane as a running minimum with the index
+      // of its element (ascending within a lane, so the first of equal steps stays), and
+      // the lanes are merged after the last chunk. A vector with anything to report takes
+      // the scalar path.
+      const auto real = lane < static_cast<double>(n - e); // not padding
+      const auto live = (!dead) && real;
+      auto report = !(vol > 0.0) || !(stdx::abs(check) <= std::numeric_limits<double>::max());
+      if (erode_ep) report = report || simd::load(&b.plastic_strain[e]) >= b.erosion.plastic_strain;
+      if (stdx::none_of(report && live)) {
+        const auto lower = live && dte < best_dt;
+        stdx::where(lower, best_dt) = dte;
+        stdx::where(lower, best_e) = lane + static_cast<double>(e);
+        continue;
+      }
+      // The scalar path may overwrite this vector's streamed corner rows (erosion): order
+      // the non-temporal stores first.
+      if (stream) simd::stream_fence();
       const int lanes = std::min(width, n - e);
       for (int k = 0; k < lanes; ++k) {
         const std::int64_t id = b.gid[e + k];
         if (b.alive[e + k] == 0.0) continue;
         const bool erode = (b.erosion.inverted && !(vol[k] > 0.0)) ||
-                           (b.erosion.plastic_strain > 0 && !b.plastic_strain.empty() &&
-                            b.plastic_strain[e + k] >= b.erosion.plastic_strain);
+                           (erode_ep && b.plastic_strain[e + k] >= b.erosion.plastic_strain);
         if (erode) { // delete it now: this cycle's forces already leave it out
           b.alive[e + k] = 0.0;
           for (int a = 0; a < 8; ++a)
             for (int i = 0; i < 3; ++i)
-              corners.f[i][b.corner_base + static_cast<std::size_t>(a) * stride + e + k] = 0.0;
+              corners.f[i][b.corner_base + 8 * static_cast<std::size_t>(e + k) + a] = 0.0;
           for (auto& sk : b.stress) sk[e + k] = 0.0;
           ++result.eroded;
           continue;
@@ -317,13 +363,13 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
         } else if (!std::isfinite(check[k])) {
           if (result.nonfinite_gid < 0 || id < result.nonfinite_gid) result.nonfinite_gid = id;
         }
-        if (dte[k] < result.dt_stable || (dte[k] == result.dt_stable && id < result.stable_gid)) {
-          result.dt_stable = dte[k];
-          result.stable_gid = id;
-        }
+        take_step(dte[k], id);
       }
     }
   }
+  if (stream) simd::stream_fence();
+  for (int k = 0; k < width; ++k)
+    if (best_e[k] >= 0) take_step(best_dt[k], b.gid[static_cast<std::size_t>(best_e[k])]);
 }
 
 void hex_volumes(const HexBlock& b, const double* const x[3], std::span<double> out) {

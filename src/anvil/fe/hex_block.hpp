@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <new>
 #include <span>
 #include <string>
 #include <vector>
@@ -61,7 +62,7 @@ struct HexBlock {
   std::vector<double> internal_energy;                 // J, stress work plus bulk viscosity work
   std::vector<double> hourglass_energy;                // J
   std::size_t corner_base = 0;                         // corner (e, a) of this block lives at slot
-                                                       // corner_base + a * size() + e
+                                                       // corner_base + 8 e + a (element-major)
 
   int size() const { return static_cast<int>(gid.size()); }
 
@@ -78,8 +79,27 @@ struct NodalView {
   const double* v[3]; // velocities at t(n - 1/2)
 };
 
+// Allocates on 64-byte boundaries (the corner arrays: the kernel streams whole rows of
+// corner forces past the cache when they are aligned).
+template <class T>
+struct CacheAligned {
+  using value_type = T;
+  CacheAligned() = default;
+  template <class U>
+  CacheAligned(const CacheAligned<U>&) noexcept {}
+  T* allocate(std::size_t n) {
+    return static_cast<T*>(::operator new (n * sizeof(T), std::align_val_t{64}));
+  }
+  void deallocate(T* p, std::size_t) noexcept { ::operator delete (p, std::align_val_t{64}); }
+  template <class U>
+  bool operator==(const CacheAligned<U>&) const noexcept {
+    return true;
+  }
+};
+using CornerArray = std::vector<double, CacheAligned<double>>;
+
 struct CornerView {
-  double* f[3]; // corner forces, indexed by slot
+  double* f[3]; // corner forces, indexed by slot (best in CornerArray: aligned)
 };
 
 // What one kernel call reports back.

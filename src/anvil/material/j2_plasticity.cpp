@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "anvil/core/simd.hpp"
+
 namespace anvil {
 
 namespace {
@@ -22,31 +24,75 @@ std::span<const ParamSpec> J2Plasticity::params() {
 J2Plasticity::J2Plasticity(const ParamValues& p)
     : Material(p), yield_(p.at("yield_stress")), hardening_(p.at("hardening_modulus")) {}
 
+namespace {
+
+struct J2Constants {
+  double G, G2, G3, lam, M, H, Y0, dt, G3H;
+};
+
+// The radial return of one point (V = double) or of simd::width points (V = vdouble),
+// the same operations in the same order on both, so that a point gets the same bits
+// whether it falls in a vector or in the scalar remainder of a batch (this file is
+// compiled without contraction). Branch-free: the elastic points are masked, not
+// skipped, so the loop vectorises across points.
+template <class V, class Mask>
+[[gnu::always_inline]] inline void radial_return(const J2Constants& c, const V (&d)[6], V (&s)[6],
+                                                 V& ep, const V& density, V& wave_speed) {
+  using std::sqrt; // and, by argument-dependent lookup, the simd sqrt
+  const V tr = (d[0] + d[1] + d[2]) * c.dt;
+  for (int k = 0; k < 3; ++k) s[k] = s[k] + c.lam * tr + c.G2 * d[k] * c.dt;
+  for (int k = 3; k < 6; ++k) s[k] = s[k] + c.G2 * d[k] * c.dt;
+  const V mean = (s[0] + s[1] + s[2]) * (1.0 / 3.0);
+  const V d0 = s[0] - mean, d1 = s[1] - mean, d2 = s[2] - mean;
+  const V j2 = 0.5 * (d0 * d0 + d1 * d1 + d2 * d2) + s[3] * s[3] + s[4] * s[4] + s[5] * s[5];
+  const V q = sqrt(3.0 * j2); // von Mises stress of the trial state
+  const V f = q - (c.Y0 + c.H * ep);
+  // Radial return: the deviator shrinks by (1 - 3 G dgamma / q); elastic points keep
+  // dgamma = 0 and scale = 1 (selected, not multiplied: q may be 0 there).
+  const Mask yielding = f > 0.0;
+  V dgamma = f / c.G3H;
+  V scale = 1.0 - c.G3 * dgamma / q;
+  simd::keep_where(yielding, dgamma, 0.0);
+  simd::keep_where(yielding, scale, 1.0);
+  s[0] = mean + d0 * scale;
+  s[1] = mean + d1 * scale;
+  s[2] = mean + d2 * scale;
+  for (int k = 3; k < 6; ++k) s[k] = s[k] * scale;
+  ep = ep + dgamma;
+  wave_speed = sqrt(c.M / density);
+}
+
+} // namespace
+
 void J2Plasticity::update(const MaterialBatch& b) const {
-  const double G = elastic().shear, lam = elastic().lambda;
-  const double M = elastic().plane_wave_modulus();
-  const double dt = b.dt, H = hardening_, Y0 = yield_;
-#pragma omp simd
-  for (int p = 0; p < b.n; ++p) {
-    double s[6];
-    const double tr = (b.d[0][p] + b.d[1][p] + b.d[2][p]) * dt;
-    for (int k = 0; k < 3; ++k) s[k] = b.stress[k][p] + lam * tr + 2 * G * b.d[k][p] * dt;
-    for (int k = 3; k < 6; ++k) s[k] = b.stress[k][p] + 2 * G * b.d[k][p] * dt;
-    const double mean = (s[0] + s[1] + s[2]) * (1.0 / 3.0);
-    const double d0 = s[0] - mean, d1 = s[1] - mean, d2 = s[2] - mean;
-    const double j2 = 0.5 * (d0 * d0 + d1 * d1 + d2 * d2) + s[3] * s[3] + s[4] * s[4] + s[5] * s[5];
-    const double q = std::sqrt(3.0 * j2); // von Mises stress of the trial state
-    const double ep = b.plastic_strain[p];
-    const double f = q - (Y0 + H * ep);
-    // Radial return: the deviator shrinks by (1 - 3 G dgamma / q).
-    const double dgamma = f > 0 ? f / (3 * G + H) : 0.0;
-    const double scale = f > 0 ? 1.0 - 3 * G * dgamma / q : 1.0;
-    b.stress[0][p] = mean + d0 * scale;
-    b.stress[1][p] = mean + d1 * scale;
-    b.stress[2][p] = mean + d2 * scale;
-    for (int k = 3; k < 6; ++k) b.stress[k][p] = s[k] * scale;
-    b.plastic_strain[p] = ep + dgamma;
-    b.wave_speed[p] = std::sqrt(M / b.density[p]);
+  using simd::vdouble;
+  const double G = elastic().shear;
+  const J2Constants c{G,          2 * G,  3 * G, elastic().lambda,  elastic().plane_wave_modulus(),
+                      hardening_, yield_, b.dt,  3 * G + hardening_};
+  int p = 0;
+  for (; p + simd::width <= b.n; p += simd::width) {
+    vdouble d[6], s[6];
+    for (int k = 0; k < 6; ++k) {
+      d[k] = simd::load(b.d[k] + p);
+      s[k] = simd::load(b.stress[k] + p);
+    }
+    vdouble ep = simd::load(b.plastic_strain + p), c_l;
+    radial_return<vdouble, simd::vmask>(c, d, s, ep, simd::load(b.density + p), c_l);
+    for (int k = 0; k < 6; ++k) simd::store(s[k], b.stress[k] + p);
+    simd::store(ep, b.plastic_strain + p);
+    simd::store(c_l, b.wave_speed + p);
+  }
+  for (; p < b.n; ++p) { // remainder (particle batches are not padded)
+    double d[6], s[6];
+    for (int k = 0; k < 6; ++k) {
+      d[k] = b.d[k][p];
+      s[k] = b.stress[k][p];
+    }
+    double ep = b.plastic_strain[p], c_l;
+    radial_return<double, bool>(c, d, s, ep, b.density[p], c_l);
+    for (int k = 0; k < 6; ++k) b.stress[k][p] = s[k];
+    b.plastic_strain[p] = ep;
+    b.wave_speed[p] = c_l;
   }
 }
 

@@ -93,7 +93,8 @@ FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, in
   auto local_slot = [&](std::int64_t c) -> std::int64_t {
     const auto e = c / 8;
     const auto& b = d.blocks[block_of[e]];
-    return static_cast<std::int64_t>(b.corner_base) + (c % 8) * b.stride + local_index[e];
+    return static_cast<std::int64_t>(
+        b.slot(static_cast<std::size_t>(local_index[e]), static_cast<int>(c % 8)));
   };
 
   // Slot of every corner of every local node: local corners directly, remote ones in the
@@ -149,9 +150,10 @@ CornerExchange::CornerExchange(const FeDecomposition& d, const Comm& comm) : d_(
   recv_.resize(d.remote_slots * 3);
 }
 
-void CornerExchange::exchange(std::span<double* const> arrays) {
+void CornerExchange::exchange(std::initializer_list<double*> list) {
   if (d_.neighbors.empty()) return;
-  const std::size_t k = arrays.size();
+  const std::size_t k = list.size();
+  double* const* arrays = list.begin();
   Requests& req = requests_;
   for (const auto& nb : d_.neighbors) {
     double* r = recv_.data() + (nb.recv_base - d_.local_slots) * k;
@@ -177,9 +179,10 @@ NodeExchange::NodeExchange(const FeDecomposition& d, const Comm& comm) : d_(d), 
   recv_.resize(3 * n);
 }
 
-void NodeExchange::from_owners(std::span<double* const> arrays) {
+void NodeExchange::from_owners(std::initializer_list<double*> list) {
   if (d_.neighbors.empty()) return;
-  const std::size_t k = arrays.size();
+  const std::size_t k = list.size();
+  double* const* arrays = list.begin();
   Requests& req = requests_;
   // Per neighbour: we send the shared nodes we own, receive those it owns, both in
   // ascending gid, so the two sides agree on the layout without telling each other.
@@ -210,20 +213,41 @@ void NodeExchange::from_owners(std::span<double* const> arrays) {
   }
 }
 
-void gather_corners(const FeDecomposition& d, std::span<const double* const> corner,
-                    std::span<double* const> out) {
+namespace {
+
+// The gather for K components at once: the slot list is read once per node, and each
+// component is summed in slot order (the same bits as K separate passes).
+template <int K>
+void gather_components(const FeDecomposition& d, const double* const* corner, double* const* out) {
   const std::size_t nn = d.node_gid.size();
   const int* ptr = d.gather_ptr.data();
   const std::int64_t* slot = d.gather_slot.data();
-  for (std::size_t c = 0; c < corner.size(); ++c) {
-    const double* src = corner[c];
-    double* dst = out[c];
-    for (std::size_t n = 0; n < nn; ++n) {
-      double s = 0.0;
-      for (int p = ptr[n]; p < ptr[n + 1]; ++p) s += src[slot[p]];
-      dst[n] = s;
-    }
+  const double* src[K];
+  double* dst[K];
+  for (int c = 0; c < K; ++c) {
+    src[c] = corner[c];
+    dst[c] = out[c];
   }
+  for (std::size_t n = 0; n < nn; ++n) {
+    double s[K] = {};
+    for (int p = ptr[n]; p < ptr[n + 1]; ++p) {
+      const std::int64_t k = slot[p];
+      for (int c = 0; c < K; ++c) s[c] += src[c][k];
+    }
+    for (int c = 0; c < K; ++c) dst[c][n] = s[c];
+  }
+}
+
+} // namespace
+
+void gather_corners(const FeDecomposition& d, std::initializer_list<const double*> corner,
+                    std::initializer_list<double*> out) {
+  if (corner.size() != out.size())
+    throw std::invalid_argument("gather_corners: corner and out lists differ in length");
+  std::size_t c = 0;
+  for (; c + 3 <= corner.size(); c += 3)
+    gather_components<3>(d, corner.begin() + c, out.begin() + c);
+  for (; c < corner.size(); ++c) gather_components<1>(d, corner.begin() + c, out.begin() + c);
 }
 
 } // namespace anvil

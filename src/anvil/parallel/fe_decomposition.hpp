@@ -12,7 +12,7 @@
 
 #include <array>
 #include <cstdint>
-#include <span>
+#include <initializer_list>
 #include <vector>
 
 #include "anvil/mesh/mesh.hpp"
@@ -30,8 +30,11 @@ struct FeDecomposition {
   struct Block {
     std::vector<std::int64_t> gid;        // owned elements of this mesh block, ascending
     std::vector<std::array<int, 8>> conn; // their corners as local node indices
-    std::size_t corner_base = 0;          // slot of corner (e, a): base + a * stride + e
+    std::size_t corner_base = 0;          // slot of corner (e, a): slot(e, a)
     int stride = 0;                       // padded element count (simd::padded_size)
+    // Corners are element-major: an element's eight corners are adjacent (64 bytes per
+    // component), so the kernel writes, and the gather reads, few memory streams.
+    std::size_t slot(std::size_t e, int a) const { return corner_base + 8 * e + a; }
   };
   std::vector<Block> blocks; // one per mesh block, possibly empty
 
@@ -62,8 +65,10 @@ FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, in
 class CornerExchange {
 public:
   CornerExchange(const FeDecomposition& d, const Comm& comm);
-  // Fills the remote slots of `components` arrays of total_slots() values each.
-  void exchange(std::span<double* const> arrays);
+  // Fills the remote slots of `components` arrays of total_slots() values each. The
+  // arrays come as a braced list (an initializer_list lives on the stack: the cycle
+  // allocates nothing for it).
+  void exchange(std::initializer_list<double*> arrays);
 
 private:
   const FeDecomposition& d_;
@@ -78,7 +83,7 @@ class NodeExchange {
 public:
   NodeExchange(const FeDecomposition& d, const Comm& comm);
   // `arrays` hold one value per local node; non-owned shared entries are overwritten.
-  void from_owners(std::span<double* const> arrays);
+  void from_owners(std::initializer_list<double*> list);
 
 private:
   const FeDecomposition& d_;
@@ -88,8 +93,10 @@ private:
 };
 
 // Sums the corner slots of every local node (the gather): out[i][n] = sum over the
-// node's slots in order of corner[i][slot]. Pure arithmetic, no communication.
-void gather_corners(const FeDecomposition& d, std::span<const double* const> corner,
-                    std::span<double* const> out);
+// node's slots in order of corner[i][slot]. Pure arithmetic, no communication. One or
+// three components (mass, force) per call, as braced lists of equal length; the three
+// components are summed in one pass over the slot list (each still in slot order).
+void gather_corners(const FeDecomposition& d, std::initializer_list<const double*> corner,
+                    std::initializer_list<double*> out);
 
 } // namespace anvil

@@ -52,7 +52,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     return nullptr;
   };
   for (int i = 0; i < 3; ++i) corner_force_[i].assign(fe_.total_slots(), 0.0);
-  std::vector<double>& corner_mass = corner_force_[0]; // reused once for the mass
+  CornerArray& corner_mass = corner_force_[0]; // reused once for the mass
   const double* xs[3] = {nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()};
   for (std::size_t b = 0; b < config_.parts.size(); ++b) {
     const auto& part = config_.parts[b];
@@ -77,12 +77,11 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     }
     for (int e = 0; e < hb.size(); ++e)
       for (int a = 0; a < 8; ++a)
-        corner_mass[lb.corner_base + static_cast<std::size_t>(a) * lb.stride + e] = hb.mass[e] / 8;
+        corner_mass[lb.slot(static_cast<std::size_t>(e), a)] = hb.mass[e] / 8;
     blocks_.push_back(std::move(hb));
   }
-  corner_exchange_->exchange(std::array{corner_mass.data()});
-  gather_corners(fe_, std::array<const double*, 1>{corner_mass.data()},
-                 std::array{nodes_.mass.data()});
+  corner_exchange_->exchange({corner_mass.data()});
+  gather_corners(fe_, {corner_mass.data()}, {nodes_.mass.data()});
   std::fill(corner_mass.begin(), corner_mass.end(), 0.0);
 
   part_mass_.assign(config_.parts.size(), 0.0);
@@ -292,14 +291,12 @@ void Simulation::fe_forces() {
         comm_.min(r.dt_stable == red[0] ? static_cast<double>(r.stable_gid) : none));
     dt_stable_ = red[0];
     corner_exchange_->exchange(
-        std::array{corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()});
+        {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()});
   }
   {
     ScopedPhase t(timers_, Phase::fe);
-    gather_corners(fe_,
-                   std::array<const double*, 3>{corner_force_[0].data(), corner_force_[1].data(),
-                                                corner_force_[2].data()},
-                   std::array{nodes_.f[0].data(), nodes_.f[1].data(), nodes_.f[2].data()});
+    gather_corners(fe_, {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()},
+                   {nodes_.f[0].data(), nodes_.f[1].data(), nodes_.f[2].data()});
   }
 }
 

@@ -149,7 +149,7 @@ private:
   std::vector<std::unique_ptr<Material>> materials_;
   std::vector<HexBlock> blocks_;
   HexWorkspace workspace_;
-  std::array<std::vector<double>, 3> corner_force_;
+  std::array<CornerArray, 3> corner_force_;
   std::array<std::vector<double>, 3> v_prev_; // v(n-1/2) of the current step (energy accounting)
   NodeState nodes_;
   Clock clock_;
