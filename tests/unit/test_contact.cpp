@@ -106,6 +106,7 @@ struct Scene {
     }
     f.stiffness = 1e6;
     f.depth = 0.2;
+    set_capture(f);
     faces.push_back(f);
   }
   // A node at p whose own face (a small downward-facing face, gid 900 + index) opposes +z.
@@ -132,6 +133,7 @@ struct Scene {
     }
     own.stiffness = 1e6;
     own.depth = 0.01;
+    set_capture(own);
     faces.push_back(own);
   }
   void run() { find_contacts(nodes, faces, SearchOptions{}, work, pairs); }

@@ -26,56 +26,97 @@ FacePlane face_plane(const ContactFaceItem& f) {
 Box3 capture_box(const ContactFaceItem& f, const FacePlane& p) {
   const Vec3 back = p.normal * (-2 * f.depth);
   const double pad = 0.05 * p.size;
-  Box3 b{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
-  for (int a = 0; a < 4; ++a)
-    for (int i = 0; i < 3; ++i) {
-      const double v = f.x[a][i];
-      b.lo[i] = std::min({b.lo[i], v, v + back[i]});
-      b.hi[i] = std::max({b.hi[i], v, v + back[i]});
-    }
+  Box3 b;
   for (int i = 0; i < 3; ++i) {
-    b.lo[i] -= pad;
-    b.hi[i] += pad;
+    double lo = 1e300, hi = -1e300;
+    for (int a = 0; a < 4; ++a) {
+      const double v = f.x[a][i], w = v + back[i];
+      lo = std::min(lo, std::min(v, w));
+      hi = std::max(hi, std::max(v, w));
+    }
+    b.lo[i] = lo - pad;
+    b.hi[i] = hi + pad;
   }
   return b;
 }
 
-void find_contacts(const std::vector<ContactNodeItem>& nodes,
-                   const std::vector<ContactFaceItem>& faces, const SearchOptions& opt,
-                   SearchWorkspace& w, std::vector<ContactPair>& pairs) {
-  pairs.clear();
-  if (nodes.empty() || faces.empty()) return;
-  const std::size_t nf = faces.size();
+FacePlane set_capture(ContactFaceItem& f) {
+  const FacePlane p = face_plane(f);
+  const Box3 b = capture_box(f, p);
+  for (int i = 0; i < 3; ++i) {
+    f.normal[i] = p.normal[i];
+    f.lo[i] = b.lo[i];
+    f.hi[i] = b.hi[i];
+  }
+  f.offset = dot(p.centre, p.normal);
+  f.warp = p.warp;
+  return p;
+}
 
+namespace {
+
+// Capture box (lo, hi) and mean plane (unit normal, offset, warp) of every face, from the
+// items (set_capture), packed for the scans.
+void face_boxes(const std::vector<ContactFaceItem>& faces, SearchWorkspace& w) {
+  const std::size_t nf = faces.size();
   w.box.resize(6 * nf);
-  w.extent.resize(nf);
   w.plane.resize(5 * nf);
   for (std::size_t f = 0; f < nf; ++f) {
-    // Mean plane (unit normal from the diagonals) and how far the warped face strays from
-    // it: cheap tests that discard most candidates before the projection.
-    const FacePlane fp = face_plane(faces[f]);
-    const Box3 cb = capture_box(faces[f], fp);
+    const auto& fc = faces[f];
     double* b = &w.box[6 * f];
-    for (int i = 0; i < 3; ++i) {
-      b[i] = cb.lo[i];
-      b[3 + i] = cb.hi[i];
-    }
-    w.extent[f] = std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
     double* pl = &w.plane[5 * f];
-    pl[0] = fp.normal.x;
-    pl[1] = fp.normal.y;
-    pl[2] = fp.normal.z;
-    pl[3] = dot(fp.centre, fp.normal);
-    pl[4] = fp.warp;
+    for (int i = 0; i < 3; ++i) {
+      b[i] = fc.lo[i];
+      b[3 + i] = fc.hi[i];
+      pl[i] = fc.normal[i];
+    }
+    pl[3] = fc.offset;
+    pl[4] = fc.warp;
   }
-  // Cells the size of the median capture box: a typical face lands in at most 2 x 2 x 2
-  // cells, the few large ones (a crushing block's) in more, and a node's cell lists only
-  // the faces near it.
+}
+
+// True when the candidate lists of the last build still hold every face whose capture box
+// holds each node: the same nodes and faces, none moved more than half the skin. (A node
+// in a box now was then within half a skin of a box side that was itself within half a
+// skin of where it is now. 0.45 rather than 0.5 leaves room for rounding.)
+bool lists_valid(const std::vector<ContactNodeItem>& nodes,
+                 const std::vector<ContactFaceItem>& faces, const SearchWorkspace& w) {
+  if (!w.built || nodes.size() != w.node_gid.size() || faces.size() != w.face_gid.size())
+    return false;
+  const double half = 0.45 * w.skin;
+  bool ok = true;
+  for (std::size_t n = 0; n < nodes.size(); ++n) {
+    const double* r = &w.node_ref[3 * n];
+    ok &= nodes[n].gid == w.node_gid[n];
+    for (int i = 0; i < 3; ++i) ok &= std::abs(nodes[n].x[i] - r[i]) <= half;
+  }
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    ok &= faces[f].gid == w.face_gid[f];
+    for (int i = 0; i < 6; ++i) ok &= std::abs(w.box[6 * f + i] - w.box_ref[6 * f + i]) <= half;
+  }
+  return ok; // false also when anything is not a number
+}
+
+// Builds the candidate lists by binning: the enlarged capture boxes are bucket-sorted on a
+// uniform grid, and each node scans the faces of its cell.
+void build_lists(const std::vector<ContactNodeItem>& nodes,
+                 const std::vector<ContactFaceItem>& faces, const SearchOptions& opt,
+                 SearchWorkspace& w) {
+  const std::size_t nf = faces.size();
+  w.extent.resize(nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    const double* b = &w.box[6 * f];
+    w.extent[f] = std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
+  }
   std::nth_element(w.extent.begin(), w.extent.begin() + static_cast<std::ptrdiff_t>(nf / 2),
                    w.extent.end());
-  double cell = 1.0 * w.extent[nf / 2];
-  // Grid over the nodes' bounding box; cells no smaller than the largest capture box, so
-  // a face lands in at most 2 x 2 x 2 cells, and never more cells than 8 per item.
+  const double median = w.extent[nf / 2];
+  w.skin = opt.skin * median;
+  // Cells the size of the median enlarged capture box: a typical face lands in at most
+  // 2 x 2 x 2 cells, the few large ones (a crushing block's) in more, and a node's cell
+  // lists only the faces near it.
+  double cell = median + 2 * w.skin;
+  // Grid over the nodes' bounding box, never more cells than 8 per item.
   double lo[3], hi[3];
   for (int i = 0; i < 3; ++i) {
     lo[i] = hi[i] = nodes[0].x[i];
@@ -100,28 +141,31 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
   };
   const std::size_t ncell = static_cast<std::size_t>(dims[0]) * dims[1] * dims[2];
   w.cell_start.assign(ncell + 1, 0);
-  // Two passes (count, fill) over the cells each face's box covers, clipped to the grid;
+  // Two passes (count, fill) over the cells each enlarged box covers, clipped to the grid;
   // faces entirely outside the nodes' box are skipped.
   auto for_cells = [&](std::size_t f, auto&& fn) {
-    const double* b = &w.box[6 * f];
-    for (int i = 0; i < 3; ++i)
+    double b[6];
+    for (int i = 0; i < 3; ++i) {
+      b[i] = w.box[6 * f + i] - w.skin;
+      b[3 + i] = w.box[6 * f + 3 + i] + w.skin;
       if (b[3 + i] < lo[i] || b[i] > hi[i]) return;
+    }
     const int i0 = index(0, b[0]), i1 = index(0, b[3]), j0 = index(1, b[1]), j1 = index(1, b[4]);
     const int k0 = index(2, b[2]), k1 = index(2, b[5]);
     for (int k = k0; k <= k1; ++k)
       for (int j = j0; j <= j1; ++j)
         for (int i = i0; i <= i1; ++i)
-          fn((static_cast<std::size_t>(k) * dims[1] + j) * dims[0] + i);
+          fn((static_cast<std::size_t>(k) * dims[1] + j) * dims[0] + i, b);
   };
-  for (std::size_t f = 0; f < nf; ++f) for_cells(f, [&](std::size_t c) { ++w.cell_start[c + 1]; });
+  for (std::size_t f = 0; f < nf; ++f)
+    for_cells(f, [&](std::size_t c, const double*) { ++w.cell_start[c + 1]; });
   for (std::size_t c = 0; c < ncell; ++c) w.cell_start[c + 1] += w.cell_start[c];
   w.entries.resize(static_cast<std::size_t>(w.cell_start[ncell]));
   w.cursor.assign(w.cell_start.begin(), w.cell_start.end() - 1);
   for (std::size_t f = 0; f < nf; ++f)
-    for_cells(f, [&](std::size_t c) {
+    for_cells(f, [&](std::size_t c, const double* b) {
       // Each entry carries its face's box, so the scan of a cell is one contiguous stream.
       auto& en = w.entries[static_cast<std::size_t>(w.cursor[c]++)];
-      const double* b = &w.box[6 * f];
       for (int i = 0; i < 3; ++i) {
         en.lo[i] = b[i];
         en.hi[i] = b[3 + i];
@@ -129,14 +173,58 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
       en.face = static_cast<int>(f);
     });
 
-  const double tol = 1 + opt.parametric_tolerance;
-  // Node ids of every face and its element's other nodes, packed for the hot loop.
-  w.ids.resize(8 * nf);
-  for (std::size_t f = 0; f < nf; ++f)
-    for (int a = 0; a < 4; ++a) {
-      w.ids[8 * f + a] = faces[f].node[a];
-      w.ids[8 * f + 4 + a] = faces[f].opposite[a];
+  // Each node's list: the faces of its cell whose enlarged box holds it, in ascending face
+  // index (the fill pass runs over the faces in order), its own faces marked, faces of
+  // elements it belongs to left out.
+  w.list_start.resize(nodes.size() + 1);
+  w.list.clear();
+  w.list_start[0] = 0;
+  for (std::size_t n = 0; n < nodes.size(); ++n) {
+    const auto& nd = nodes[n];
+    const std::size_t c =
+        (static_cast<std::size_t>(index(2, nd.x[2])) * dims[1] + index(1, nd.x[1])) * dims[0] +
+        index(0, nd.x[0]);
+    for (int k = w.cell_start[c]; k < w.cell_start[c + 1]; ++k) {
+      const auto& en = w.entries[static_cast<std::size_t>(k)];
+      const bool outside = (nd.x[0] < en.lo[0]) | (nd.x[0] > en.hi[0]) | (nd.x[1] < en.lo[1]) |
+                           (nd.x[1] > en.hi[1]) | (nd.x[2] < en.lo[2]) | (nd.x[2] > en.hi[2]);
+      if (outside) continue;
+      const auto& fc = faces[static_cast<std::size_t>(en.face)];
+      if (std::find(fc.node, fc.node + 4, nd.gid) != fc.node + 4)
+        w.list.push_back(~en.face);
+      else if (std::find(fc.opposite, fc.opposite + 4, nd.gid) == fc.opposite + 4)
+        w.list.push_back(en.face);
     }
+    w.list_start[n + 1] = static_cast<int>(w.list.size());
+  }
+
+  w.node_gid.resize(nodes.size());
+  w.node_ref.resize(3 * nodes.size());
+  for (std::size_t n = 0; n < nodes.size(); ++n) {
+    w.node_gid[n] = nodes[n].gid;
+    for (int i = 0; i < 3; ++i) w.node_ref[3 * n + i] = nodes[n].x[i];
+  }
+  w.face_gid.resize(nf);
+  for (std::size_t f = 0; f < nf; ++f) w.face_gid[f] = faces[f].gid;
+  w.box_ref.assign(w.box.begin(), w.box.end());
+  w.built = true;
+  ++w.builds;
+}
+
+} // namespace
+
+void find_contacts(const std::vector<ContactNodeItem>& nodes,
+                   const std::vector<ContactFaceItem>& faces, const SearchOptions& opt,
+                   SearchWorkspace& w, std::vector<ContactPair>& pairs) {
+  pairs.clear();
+  if (nodes.empty() || faces.empty()) {
+    w.built = false;
+    return;
+  }
+  face_boxes(faces, w);
+  if (!lists_valid(nodes, faces, w)) build_lists(nodes, faces, opt, w);
+
+  const double tol = 1 + opt.parametric_tolerance;
   std::vector<int>& own = w.own;
   std::vector<int>& cand = w.cand;
   auto by_gid = [&](int a, int b) {
@@ -160,24 +248,18 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
   for (std::size_t n = 0; n < nodes.size(); ++n) {
     const auto& nd = nodes[n];
     const Vec3 p{nd.x[0], nd.x[1], nd.x[2]};
-    const std::size_t c =
-        (static_cast<std::size_t>(index(2, p.z)) * dims[1] + index(1, p.y)) * dims[0] +
-        index(0, p.x);
-    // Pass 1: the faces of the node's cell whose capture box holds it, split into its own
-    // faces and the others (minus those of elements the node belongs to).
+    // Pass 1: the candidates whose capture box holds the node, split into its own faces
+    // and the others.
     own.clear();
     cand.clear();
-    for (int k = w.cell_start[c]; k < w.cell_start[c + 1]; ++k) {
-      const auto& en = w.entries[static_cast<std::size_t>(k)];
-      const bool outside = (p.x < en.lo[0]) | (p.x > en.hi[0]) | (p.y < en.lo[1]) |
-                           (p.y > en.hi[1]) | (p.z < en.lo[2]) | (p.z > en.hi[2]);
+    for (int k = w.list_start[n]; k < w.list_start[n + 1]; ++k) {
+      const int e = w.list[static_cast<std::size_t>(k)];
+      const int f = e < 0 ? ~e : e;
+      const double* b = &w.box[6 * static_cast<std::size_t>(f)];
+      const bool outside =
+          (p.x < b[0]) | (p.x > b[3]) | (p.y < b[1]) | (p.y > b[4]) | (p.z < b[2]) | (p.z > b[5]);
       if (outside) continue;
-      const int f = en.face;
-      const std::int64_t* id = &w.ids[8 * static_cast<std::size_t>(f)];
-      if (id[0] == nd.gid || id[1] == nd.gid || id[2] == nd.gid || id[3] == nd.gid)
-        own.push_back(f);
-      else if (id[4] != nd.gid && id[5] != nd.gid && id[6] != nd.gid && id[7] != nd.gid)
-        cand.push_back(f);
+      (e < 0 ? own : cand).push_back(f);
     }
     if (cand.empty()) continue;
     // The node's own faces (all of them are here: their capture boxes hold the node),
