@@ -97,34 +97,37 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
   auto predicted = [&](int l, int i) { return nd.x[i][l] + dt * nd.v[i][l]; };
 
   // Items leaving the FE decomposition: owned contact nodes, faces of owned elements
-  // (their constant fields were set at construction).
-  node_out_.resize(my_nodes_.size());
-  for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
-    const int l = my_nodes_[k];
-    auto& it = node_out_[k];
-    for (int i = 0; i < 3; ++i) {
-      it.x[i] = predicted(l, i);
-      it.v[i] = nd.v[i][l];
-    }
-    it.mass = nd.mass[l];
-    it.last_face = last_face_[static_cast<std::size_t>(l)];
-    it.allowance = allowance_[static_cast<std::size_t>(l)];
-  }
-  node_out_.insert(node_out_.end(), extra_.begin(), extra_.end());
+  // (their constant fields were set at construction). Packing is part of the transfer.
   const std::size_t nf = my_face_gid_.size();
   std::vector<ContactFaceItem>& faces = face_local_;
-  face_centre_.resize(nf);
-  for (std::size_t f = 0; f < nf; ++f) {
-    auto& it = faces[f];
-    for (int a = 0; a < 4; ++a) {
-      const int l = my_face_nodes_[f][a];
+  {
+    ScopedPhase t(timers, Phase::transfer);
+    node_out_.resize(my_nodes_.size());
+    for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
+      const int l = my_nodes_[k];
+      auto& it = node_out_[k];
       for (int i = 0; i < 3; ++i) {
-        it.x[a][i] = predicted(l, i);
-        it.v[a][i] = nd.v[i][l];
+        it.x[i] = predicted(l, i);
+        it.v[i] = nd.v[i][l];
       }
-      it.mass[a] = nd.mass[l];
+      it.mass = nd.mass[l];
+      it.last_face = last_face_[static_cast<std::size_t>(l)];
+      it.allowance = allowance_[static_cast<std::size_t>(l)];
     }
-    face_centre_[f] = set_capture(it).centre;
+    node_out_.insert(node_out_.end(), extra_.begin(), extra_.end());
+    face_centre_.resize(nf);
+    for (std::size_t f = 0; f < nf; ++f) {
+      auto& it = faces[f];
+      for (int a = 0; a < 4; ++a) {
+        const int l = my_face_nodes_[f][a];
+        for (int i = 0; i < 3; ++i) {
+          it.x[a][i] = predicted(l, i);
+          it.v[a][i] = nd.v[i][l];
+        }
+        it.mass[a] = nd.mass[l];
+      }
+    }
+    set_captures(faces, face_centre_);
   }
 
   // Rebalance: RCB of node positions and face centroids, unit weights.
@@ -197,6 +200,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       face_dest_built_ = face_dest_;
       face_src_built_ = face_src_;
       plans_built_ = true;
+      ++stats_.plan_builds;
     }
     // Where every item stays on this rank, the search reads the local items in place.
     if (node_plan_.stays()) {
@@ -223,6 +227,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     SearchOptions opt;
     opt.dt = dt;
     find_contacts(*search_nodes_, *search_faces_, opt, search_, pairs_);
+    stats_.list_builds = search_.builds;
   }
 }
 
