@@ -124,26 +124,6 @@ void set_captures(std::span<ContactFaceItem> faces, std::span<Vec3> centres) {
 
 namespace {
 
-// Capture box (lo, hi) and mean plane (unit normal, offset, warp) of every face, from the
-// items (set_capture), packed for the scans.
-void face_boxes(const std::vector<ContactFaceItem>& faces, SearchWorkspace& w) {
-  const std::size_t nf = faces.size();
-  w.box.resize(6 * nf);
-  w.plane.resize(5 * nf);
-  for (std::size_t f = 0; f < nf; ++f) {
-    const auto& fc = faces[f];
-    double* b = &w.box[6 * f];
-    double* pl = &w.plane[5 * f];
-    for (int i = 0; i < 3; ++i) {
-      b[i] = fc.lo[i];
-      b[3 + i] = fc.hi[i];
-      pl[i] = fc.normal[i];
-    }
-    pl[3] = fc.offset;
-    pl[4] = fc.warp;
-  }
-}
-
 // True when the candidate lists of the last build still hold every face whose capture box
 // holds each node: the same nodes and faces, none moved more than half the skin. (A node
 // in a box now was then within half a skin of a box side that was itself within half a
@@ -161,7 +141,10 @@ bool lists_valid(const std::vector<ContactNodeItem>& nodes,
   }
   for (std::size_t f = 0; f < faces.size(); ++f) {
     ok &= faces[f].gid == w.face_gid[f];
-    for (int i = 0; i < 6; ++i) ok &= std::abs(w.box[6 * f + i] - w.box_ref[6 * f + i]) <= half;
+    const double* r = &w.box_ref[6 * f];
+    for (int i = 0; i < 3; ++i)
+      ok &=
+          (std::abs(faces[f].lo[i] - r[i]) <= half) & (std::abs(faces[f].hi[i] - r[3 + i]) <= half);
   }
   return ok; // false also when anything is not a number
 }
@@ -174,8 +157,8 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
   const std::size_t nf = faces.size();
   w.extent.resize(nf);
   for (std::size_t f = 0; f < nf; ++f) {
-    const double* b = &w.box[6 * f];
-    w.extent[f] = std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
+    const auto& fc = faces[f];
+    w.extent[f] = std::max({fc.hi[0] - fc.lo[0], fc.hi[1] - fc.lo[1], fc.hi[2] - fc.lo[2]});
   }
   std::nth_element(w.extent.begin(), w.extent.begin() + static_cast<std::ptrdiff_t>(nf / 2),
                    w.extent.end());
@@ -215,8 +198,8 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
   auto for_cells = [&](std::size_t f, auto&& fn) {
     double b[6];
     for (int i = 0; i < 3; ++i) {
-      b[i] = w.box[6 * f + i] - w.skin;
-      b[3 + i] = w.box[6 * f + 3 + i] + w.skin;
+      b[i] = faces[f].lo[i] - w.skin;
+      b[3 + i] = faces[f].hi[i] + w.skin;
       if (b[3 + i] < lo[i] || b[i] > hi[i]) return;
     }
     const int i0 = index(0, b[0]), i1 = index(0, b[3]), j0 = index(1, b[1]), j1 = index(1, b[4]);
@@ -242,17 +225,21 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
       en.face = static_cast<int>(f);
     });
 
-  // Each node's list: the faces of its cell whose enlarged box holds it, in ascending face
-  // index (the fill pass runs over the faces in order), its own faces marked, faces of
-  // elements it belongs to left out.
-  w.list_start.resize(nodes.size() + 1);
+  // The lists: for each node with at least one candidate (the active nodes), the faces of
+  // its cell whose enlarged box holds it, in ascending face index (the fill pass runs
+  // over the faces in order), first the candidates, then its own faces; faces of elements
+  // it belongs to are left out. A node with no candidate cannot pair before the next build.
+  w.active.clear();
+  w.list_start.clear();
+  w.own_start.clear();
   w.list.clear();
-  w.list_start[0] = 0;
   for (std::size_t n = 0; n < nodes.size(); ++n) {
     const auto& nd = nodes[n];
     const std::size_t c =
         (static_cast<std::size_t>(index(2, nd.x[2])) * dims[1] + index(1, nd.x[1])) * dims[0] +
         index(0, nd.x[0]);
+    const std::size_t first = w.list.size();
+    w.own.clear();
     for (int k = w.cell_start[c]; k < w.cell_start[c + 1]; ++k) {
       const auto& en = w.entries[static_cast<std::size_t>(k)];
       const bool outside = (nd.x[0] < en.lo[0]) | (nd.x[0] > en.hi[0]) | (nd.x[1] < en.lo[1]) |
@@ -260,12 +247,17 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
       if (outside) continue;
       const auto& fc = faces[static_cast<std::size_t>(en.face)];
       if (std::find(fc.node, fc.node + 4, nd.gid) != fc.node + 4)
-        w.list.push_back(~en.face);
+        w.own.push_back(en.face);
       else if (std::find(fc.opposite, fc.opposite + 4, nd.gid) == fc.opposite + 4)
         w.list.push_back(en.face);
     }
-    w.list_start[n + 1] = static_cast<int>(w.list.size());
+    if (w.list.size() == first) continue;
+    w.active.push_back(static_cast<int>(n));
+    w.list_start.push_back(static_cast<int>(first));
+    w.own_start.push_back(static_cast<int>(w.list.size()));
+    w.list.insert(w.list.end(), w.own.begin(), w.own.end());
   }
+  w.list_start.push_back(static_cast<int>(w.list.size()));
 
   w.node_gid.resize(nodes.size());
   w.node_ref.resize(3 * nodes.size());
@@ -275,7 +267,12 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
   }
   w.face_gid.resize(nf);
   for (std::size_t f = 0; f < nf; ++f) w.face_gid[f] = faces[f].gid;
-  w.box_ref.assign(w.box.begin(), w.box.end());
+  w.box_ref.resize(6 * nf);
+  for (std::size_t f = 0; f < nf; ++f)
+    for (int i = 0; i < 3; ++i) {
+      w.box_ref[6 * f + i] = faces[f].lo[i];
+      w.box_ref[6 * f + 3 + i] = faces[f].hi[i];
+    }
   w.built = true;
   ++w.builds;
 }
@@ -290,7 +287,6 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
     w.built = false;
     return;
   }
-  face_boxes(faces, w);
   if (!lists_valid(nodes, faces, w)) build_lists(nodes, faces, opt, w);
 
   const double tol = 1 + opt.parametric_tolerance;
@@ -309,28 +305,31 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
   auto faces_oppose = [&](const std::vector<int>& mine, const Vec3& fn) {
     if (mine.empty()) return true;
     for (int g : mine) {
-      const double* q = &w.plane[5 * static_cast<std::size_t>(g)];
+      const double* q = faces[static_cast<std::size_t>(g)].normal;
       if (q[0] * fn.x + q[1] * fn.y + q[2] * fn.z < -0.3) return true;
     }
     return false;
   };
-  for (std::size_t n = 0; n < nodes.size(); ++n) {
+  auto holds = [&](int f, const Vec3& p) {
+    const auto& fc = faces[static_cast<std::size_t>(f)];
+    return !((p.x < fc.lo[0]) | (p.x > fc.hi[0]) | (p.y < fc.lo[1]) | (p.y > fc.hi[1]) |
+             (p.z < fc.lo[2]) | (p.z > fc.hi[2]));
+  };
+  for (std::size_t k = 0; k < w.active.size(); ++k) {
+    const auto n = static_cast<std::size_t>(w.active[k]);
     const auto& nd = nodes[n];
     const Vec3 p{nd.x[0], nd.x[1], nd.x[2]};
-    // Pass 1: the candidates whose capture box holds the node, split into its own faces
-    // and the others.
-    own.clear();
+    // Pass 1: the candidates whose capture box holds the node, then, if there are any, the
+    // node's own faces whose box holds it.
     cand.clear();
-    for (int k = w.list_start[n]; k < w.list_start[n + 1]; ++k) {
-      const int e = w.list[static_cast<std::size_t>(k)];
-      const int f = e < 0 ? ~e : e;
-      const double* b = &w.box[6 * static_cast<std::size_t>(f)];
-      const bool outside =
-          (p.x < b[0]) | (p.x > b[3]) | (p.y < b[1]) | (p.y > b[4]) | (p.z < b[2]) | (p.z > b[5]);
-      if (outside) continue;
-      (e < 0 ? own : cand).push_back(f);
-    }
+    for (int j = w.list_start[k]; j < w.own_start[k]; ++j)
+      if (holds(w.list[static_cast<std::size_t>(j)], p))
+        cand.push_back(w.list[static_cast<std::size_t>(j)]);
     if (cand.empty()) continue;
+    own.clear();
+    for (int j = w.own_start[k]; j < w.list_start[k + 1]; ++j)
+      if (holds(w.list[static_cast<std::size_t>(j)], p))
+        own.push_back(w.list[static_cast<std::size_t>(j)]);
     // The node's own faces (all of them are here: their capture boxes hold the node),
     // deduplicated (a face can sit in several cells? no: one cell per node, but ghosts of
     // the same face never coexist on a rank; kept for safety).
@@ -345,11 +344,10 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
       // The surfaces must face each other (a node just outside a convex edge can be
       // "behind" the side face there while it is in front of the top face), and the node
       // must be behind the face's mean plane, not deeper than a tracked pair may go.
-      const double* pl = &w.plane[5 * static_cast<std::size_t>(f)];
-      const Vec3 fn{pl[0], pl[1], pl[2]};
+      const Vec3 fn{fc.normal[0], fc.normal[1], fc.normal[2]};
       if (!faces_oppose(own, fn)) continue;
-      const double side = dot(p, fn) - pl[3];
-      if (side > pl[4] || side < -(2 * fc.depth + pl[4])) continue;
+      const double side = dot(p, fn) - fc.offset;
+      if (side > fc.warp || side < -(2 * fc.depth + fc.warp)) continue;
       const std::array<Vec3, 4> x = {
           Vec3{fc.x[0][0], fc.x[0][1], fc.x[0][2]}, Vec3{fc.x[1][0], fc.x[1][1], fc.x[1][2]},
           Vec3{fc.x[2][0], fc.x[2][1], fc.x[2][2]}, Vec3{fc.x[3][0], fc.x[3][1], fc.x[3][2]}};
@@ -378,7 +376,7 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
         const Vec3 p0{nd.x[0] - opt.dt * nd.v[0], nd.x[1] - opt.dt * nd.v[1],
                       nd.x[2] - opt.dt * nd.v[2]};
         const double len0 = norm(n0);
-        if (len0 > 0 && dot(p0 - c0, n0) < -(pl[4] + 1e-3 * fc.depth) * len0) continue;
+        if (len0 > 0 && dot(p0 - c0, n0) < -(fc.warp + 1e-3 * fc.depth) * len0) continue;
       }
       // Least penetration wins; equal penetrations go to the lower face id.
       if (!found || q.gap > best.gap || (q.gap == best.gap && fc.gid < best_gid)) {

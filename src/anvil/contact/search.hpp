@@ -103,22 +103,24 @@ struct SearchWorkspace {
   };
   std::vector<int> cell_start, cursor; // per cell: first entry; fill cursors
   std::vector<CellEntry> entries;      // faces binned by cell
-  std::vector<double> box;             // 6 per face: capture box (lo, hi)
   std::vector<double> extent;          // largest side of each capture box
-  std::vector<double> plane;           // 5 per face: unit normal, offset, warp
   std::vector<int> own, cand;          // a node's own faces and its candidates
 
-  // Candidate lists (Verlet lists): per node, the faces whose enlarged capture box held
-  // it at the last build, ascending, own faces as ~face; faces of the node's elements are
-  // left out. Valid while the node and face ids are those of the build and nothing has
-  // moved more than half the skin from where it was then.
+  // Candidate lists (Verlet lists): for each node with at least one candidate (active),
+  // the faces whose enlarged capture box held it at the last build, ascending: first the
+  // candidates, then its own faces (faces of the node's elements are left out). Valid
+  // while the node and face ids are those of the build and nothing has moved more than
+  // half the skin from where it was then.
   bool built = false;
   double skin = 0;                    // m, at the last build
   std::vector<std::int64_t> node_gid; // node ids at the last build
   std::vector<std::int64_t> face_gid; // face ids at the last build
   std::vector<double> node_ref;       // 3 per node: position at the last build
   std::vector<double> box_ref;        // 6 per face: capture box at the last build
-  std::vector<int> list_start, list;  // per node: its candidates (CSR)
+  std::vector<int> active;            // nodes with candidates, ascending
+  std::vector<int> list_start;        // per active node: its first candidate (+ end)
+  std::vector<int> own_start;         // per active node: its first own face
+  std::vector<int> list;              // face indices
   std::int64_t builds = 0;            // lists built since the workspace was made
 };
 
