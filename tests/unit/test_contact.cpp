@@ -84,8 +84,7 @@ TEST(Contact, ProjectionMatchesBruteForceOnWarpedFaces) {
   }
 }
 
-// The vectorised set_captures() rounds exactly as set_capture(): same bits for warped,
-// degenerate and mixed-size faces, any count (not a multiple of the lane width).
+// set_captures() gives set_capture()'s bits for warped, degenerate and mixed-size faces.
 TEST(Contact, SetCapturesMatchesSetCaptureBitwise) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);

@@ -300,7 +300,8 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
   }
   {
     ScopedPhase t(timers, Phase::transfer);
-    exchange_->from_owners({nd.force[0], nd.force[1], nd.force[2]});
+    force_arrays_.assign({nd.force[0], nd.force[1], nd.force[2]}); // keeps its capacity
+    exchange_->from_owners(force_arrays_);
   }
 }
 

@@ -140,6 +140,7 @@ private:
   SearchWorkspace search_;
   Migration node_plan_, face_plan_, force_plan_;
   std::unique_ptr<NodeExchange> exchange_;
+  std::vector<double*> force_arrays_; // the force arrays, for exchange_
   ContactStats stats_;
 };
 

@@ -54,72 +54,7 @@ FacePlane set_capture(ContactFaceItem& f) {
 }
 
 void set_captures(std::span<ContactFaceItem> faces, std::span<Vec3> centres) {
-  // face_plane() and capture_box() lane by lane, operation for operation: with no
-  // contraction of multiply-adds (the build's default) every lane rounds as they do.
-  constexpr int W = 8;
-  const std::size_t n = faces.size();
-  for (std::size_t f0 = 0; f0 < n; f0 += W) {
-    const auto m = static_cast<int>(std::min<std::size_t>(W, n - f0));
-    alignas(64) double x[4][3][W], d[W];
-    for (int k = 0; k < W; ++k) {
-      const auto& fc = faces[f0 + static_cast<std::size_t>(std::min(k, m - 1))];
-      for (int a = 0; a < 4; ++a)
-        for (int i = 0; i < 3; ++i) x[a][i][k] = fc.x[a][i];
-      d[k] = fc.depth;
-    }
-    alignas(64) double c[3][W], nv[3][W], off[W], warp[W], lo[3][W], hi[3][W];
-#pragma omp simd
-    for (int k = 0; k < W; ++k) {
-      double ck[3];
-      for (int i = 0; i < 3; ++i)
-        ck[i] = 0.25 * (x[0][i][k] + x[1][i][k] + x[2][i][k] + x[3][i][k]);
-      const double u[3] = {x[2][0][k] - x[0][0][k], x[2][1][k] - x[0][1][k],
-                           x[2][2][k] - x[0][2][k]};
-      const double v[3] = {x[3][0][k] - x[1][0][k], x[3][1][k] - x[1][1][k],
-                           x[3][2][k] - x[1][2][k]};
-      const double cr[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
-                            u[0] * v[1] - u[1] * v[0]};
-      const double len = std::sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
-      const double inv = 1 / len;
-      double nk[3];
-      for (int i = 0; i < 3; ++i) nk[i] = len > 0 ? cr[i] * inv : 0.0;
-      const double size = std::sqrt(0.5 * len);
-      double wk = 0;
-      for (int a = 0; a < 4; ++a) {
-        const double h = std::abs((x[a][0][k] - ck[0]) * nk[0] + (x[a][1][k] - ck[1]) * nk[1] +
-                                  (x[a][2][k] - ck[2]) * nk[2]);
-        wk = wk < h ? h : wk;
-      }
-      const double pad = 0.05 * size;
-      const double depth2 = -2 * d[k];
-      for (int i = 0; i < 3; ++i) {
-        const double back = nk[i] * depth2;
-        double l = 1e300, h = -1e300;
-        for (int a = 0; a < 4; ++a) {
-          const double p = x[a][i][k], q = p + back;
-          l = std::min(l, std::min(p, q));
-          h = std::max(h, std::max(p, q));
-        }
-        lo[i][k] = l - pad;
-        hi[i][k] = h + pad;
-        c[i][k] = ck[i];
-        nv[i][k] = nk[i];
-      }
-      off[k] = ck[0] * nk[0] + ck[1] * nk[1] + ck[2] * nk[2];
-      warp[k] = wk;
-    }
-    for (int k = 0; k < m; ++k) {
-      auto& fc = faces[f0 + static_cast<std::size_t>(k)];
-      for (int i = 0; i < 3; ++i) {
-        fc.normal[i] = nv[i][k];
-        fc.lo[i] = lo[i][k];
-        fc.hi[i] = hi[i][k];
-      }
-      fc.offset = off[k];
-      fc.warp = warp[k];
-      centres[f0 + static_cast<std::size_t>(k)] = {c[0][k], c[1][k], c[2][k]};
-    }
-  }
+  for (std::size_t f = 0; f < faces.size(); ++f) centres[f] = set_capture(faces[f]).centre;
 }
 
 namespace {

@@ -180,14 +180,13 @@ NodeExchange::NodeExchange(const FeDecomposition& d, const Comm& comm) : d_(d), 
 void NodeExchange::from_owners(const std::vector<double*>& arrays) {
   if (d_.neighbors.empty()) return;
   const std::size_t k = arrays.size();
-  Requests req;
   // Per neighbour: we send the shared nodes we own, receive those it owns, both in
   // ascending gid, so the two sides agree on the layout without telling each other.
   std::size_t off = 0;
   for (const auto& nb : d_.neighbors) {
     std::size_t nr = 0;
     for (int i : nb.shared) nr += d_.node_owner[i] == nb.rank;
-    comm_.irecv(std::span<double>(recv_.data() + off, nr * k), nb.rank, 12, req);
+    comm_.irecv(std::span<double>(recv_.data() + off, nr * k), nb.rank, 12, requests_);
     off += nb.shared.size() * k;
   }
   off = 0;
@@ -196,10 +195,10 @@ void NodeExchange::from_owners(const std::vector<double*>& arrays) {
     for (int i : nb.shared)
       if (d_.node_owner[i] == d_.rank)
         for (std::size_t c = 0; c < k; ++c) send_[off + ns++] = arrays[c][i];
-    comm_.isend(std::span<const double>(send_.data() + off, ns), nb.rank, 12, req);
+    comm_.isend(std::span<const double>(send_.data() + off, ns), nb.rank, 12, requests_);
     off += nb.shared.size() * k;
   }
-  req.wait();
+  requests_.wait();
   off = 0;
   for (const auto& nb : d_.neighbors) {
     std::size_t j = 0;

@@ -82,6 +82,7 @@ private:
   const FeDecomposition& d_;
   const Comm& comm_;
   std::vector<double> send_, recv_;
+  Requests requests_; // reused, so an exchange allocates nothing
 };
 
 // Sums the corner slots of every local node (the gather): out[i][n] = sum over the
