@@ -62,6 +62,27 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
     my_face_slot_.emplace_back(static_cast<int>(b), static_cast<int>(e));
   }
   my_face_rank_.assign(my_face_gid_.size(), comm.rank());
+  // The fields of the items that never change (ids, owners, penalty data), set once.
+  node_out_.resize(my_nodes_.size());
+  for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
+    node_out_[k] = {};
+    node_out_[k].gid = fe.node_gid[static_cast<std::size_t>(my_nodes_[k])];
+    node_out_[k].owner = comm.rank();
+  }
+  face_local_.resize(my_face_gid_.size());
+  for (std::size_t f = 0; f < face_local_.size(); ++f) {
+    auto& it = face_local_[f];
+    it = {};
+    it.gid = my_face_gid_[f];
+    for (int a = 0; a < 4; ++a) {
+      const auto l = static_cast<std::size_t>(my_face_nodes_[f][a]);
+      it.node[a] = fe.node_gid[l];
+      it.owner[a] = fe.node_owner[l];
+      it.opposite[a] = fe.node_gid[static_cast<std::size_t>(my_face_opposite_[f][a])];
+    }
+    it.stiffness = my_face_stiffness_[f];
+    it.depth = my_face_depth_[f];
+  }
   last_face_.assign(fe.node_gid.size(), -1);
   allowance_.assign(fe.node_gid.size(), 0.0);
   exchange_ = std::make_unique<NodeExchange>(fe, comm);
@@ -75,42 +96,38 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
   ++stats_.cycles;
   auto predicted = [&](int l, int i) { return nd.x[i][l] + dt * nd.v[i][l]; };
 
-  // Items leaving the FE decomposition: owned contact nodes, faces of owned elements.
-  node_out_.resize(my_nodes_.size());
-  for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
-    const int l = my_nodes_[k];
-    auto& it = node_out_[k];
-    it.gid = fe_.node_gid[static_cast<std::size_t>(l)];
-    it.owner = comm_.rank();
-    for (int i = 0; i < 3; ++i) {
-      it.x[i] = predicted(l, i);
-      it.v[i] = nd.v[i][l];
-    }
-    it.mass = nd.mass[l];
-    it.last_face = last_face_[static_cast<std::size_t>(l)];
-    it.allowance = allowance_[static_cast<std::size_t>(l)];
-  }
-  node_out_.insert(node_out_.end(), extra_.begin(), extra_.end());
+  // Items leaving the FE decomposition: owned contact nodes, faces of owned elements
+  // (their constant fields were set at construction). Packing is part of the transfer.
   const std::size_t nf = my_face_gid_.size();
   std::vector<ContactFaceItem>& faces = face_local_;
-  faces.resize(nf);
-  for (std::size_t f = 0; f < nf; ++f) {
-    auto& it = faces[f];
-    it.gid = my_face_gid_[f];
-    for (int a = 0; a < 4; ++a) {
-      const int l = my_face_nodes_[f][a];
-      it.node[a] = fe_.node_gid[static_cast<std::size_t>(l)];
-      it.owner[a] = fe_.node_owner[static_cast<std::size_t>(l)];
+  {
+    ScopedPhase t(timers, Phase::transfer);
+    node_out_.resize(my_nodes_.size());
+    for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
+      const int l = my_nodes_[k];
+      auto& it = node_out_[k];
       for (int i = 0; i < 3; ++i) {
-        it.x[a][i] = predicted(l, i);
-        it.v[a][i] = nd.v[i][l];
+        it.x[i] = predicted(l, i);
+        it.v[i] = nd.v[i][l];
       }
-      it.mass[a] = nd.mass[l];
+      it.mass = nd.mass[l];
+      it.last_face = last_face_[static_cast<std::size_t>(l)];
+      it.allowance = allowance_[static_cast<std::size_t>(l)];
     }
-    for (int a = 0; a < 4; ++a)
-      it.opposite[a] = fe_.node_gid[static_cast<std::size_t>(my_face_opposite_[f][a])];
-    it.stiffness = my_face_stiffness_[f];
-    it.depth = my_face_depth_[f];
+    node_out_.insert(node_out_.end(), extra_.begin(), extra_.end());
+    face_centre_.resize(nf);
+    for (std::size_t f = 0; f < nf; ++f) {
+      auto& it = faces[f];
+      for (int a = 0; a < 4; ++a) {
+        const int l = my_face_nodes_[f][a];
+        for (int i = 0; i < 3; ++i) {
+          it.x[a][i] = predicted(l, i);
+          it.v[a][i] = nd.v[i][l];
+        }
+        it.mass[a] = nd.mass[l];
+      }
+    }
+    set_captures(faces, face_centre_);
   }
 
   // Rebalance: RCB of node positions and face centroids, unit weights.
@@ -154,34 +171,63 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       node_dest_[k] = rcb_.owner({node_out_[k].x[0], node_out_[k].x[1], node_out_[k].x[2]});
     // Faces go to every rank their capture box touches (ghosts), as copies.
     face_dest_.clear();
-    face_out_.clear();
+    face_src_.clear();
+    bool one_copy_each = true; // then copy k is face k
     for (std::size_t f = 0; f < nf; ++f) {
       // Faces of eroded elements have left the surface.
       const auto [fb, fe] = my_face_slot_[f];
-      if (blocks_[static_cast<std::size_t>(fb)].alive[static_cast<std::size_t>(fe)] == 0.0)
+      if (blocks_[static_cast<std::size_t>(fb)].alive[static_cast<std::size_t>(fe)] == 0.0) {
+        one_copy_each = false;
         continue;
-      const FacePlane plane = face_plane(faces[f]);
-      const Box3 box = capture_box(faces[f], plane);
-      my_face_rank_[f] = rcb_.owner(plane.centre);
-      rcb_.overlapping(box, ranks_);
+      }
+      const auto& fc = faces[f];
+      my_face_rank_[f] = rcb_.owner(face_centre_[f]);
+      rcb_.overlapping({{fc.lo[0], fc.lo[1], fc.lo[2]}, {fc.hi[0], fc.hi[1], fc.hi[2]}}, ranks_);
+      one_copy_each &= ranks_.size() == 1;
       for (int r : ranks_) {
-        face_out_.push_back(faces[f]);
+        face_src_.push_back(static_cast<int>(f));
         face_dest_.push_back(r);
       }
     }
-    node_plan_.build(comm_, node_dest_);
-    face_plan_.build(comm_, face_dest_);
-    node_plan_.forward(node_out_, node_in_);
-    face_plan_.forward(face_out_, face_in_);
+    // The plans depend only on the destinations: rebuilt when some rank's have changed
+    // (one reduction instead of two all-to-alls of counts).
+    const bool changed = !plans_built_ || node_dest_ != node_dest_built_ ||
+                         face_dest_ != face_dest_built_ || face_src_ != face_src_built_;
+    if (comm_.max(static_cast<std::int64_t>(changed)) != 0) {
+      node_plan_.build(comm_, node_dest_);
+      face_plan_.build(comm_, face_dest_);
+      node_dest_built_ = node_dest_;
+      face_dest_built_ = face_dest_;
+      face_src_built_ = face_src_;
+      plans_built_ = true;
+      ++stats_.plan_builds;
+    }
+    // Where every item stays on this rank, the search reads the local items in place.
+    if (node_plan_.stays()) {
+      search_nodes_ = &node_out_;
+    } else {
+      node_plan_.forward(node_out_, node_in_);
+      search_nodes_ = &node_in_;
+    }
+    if (face_plan_.stays() && one_copy_each) {
+      search_faces_ = &face_local_;
+    } else {
+      face_out_.resize(face_src_.size());
+      for (std::size_t k = 0; k < face_src_.size(); ++k)
+        face_out_[k] = faces[static_cast<std::size_t>(face_src_[k])];
+      face_plan_.forward(face_out_, face_in_);
+      search_faces_ = &face_in_;
+    }
     stats_.bytes_sent += static_cast<double>(node_out_.size() * sizeof(ContactNodeItem) +
-                                             face_out_.size() * sizeof(ContactFaceItem));
+                                             face_src_.size() * sizeof(ContactFaceItem));
   }
 
   {
     ScopedPhase t(timers, Phase::contact_search);
     SearchOptions opt;
     opt.dt = dt;
-    find_contacts(node_in_, face_in_, opt, search_, pairs_);
+    find_contacts(*search_nodes_, *search_faces_, opt, search_, pairs_);
+    stats_.list_builds = search_.builds;
   }
 }
 
@@ -192,12 +238,13 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
     ScopedPhase t(timers, Phase::contact_force);
     force_out_.clear();
     force_dest_.clear();
-    penalty_forces(node_in_, face_in_, pairs_, {config_.friction, dt}, force_out_, force_dest_);
+    penalty_forces(*search_nodes_, *search_faces_, pairs_, {config_.friction, dt}, force_out_,
+                   force_dest_);
     double deepest = 0;
     for (const auto& p : pairs_) deepest = std::max(deepest, -p.gap);
     // Load of this rank: nodes searched plus faces held; one reduction for the balance
     // test, the pair count and the deepest penetration.
-    double red[4] = {static_cast<double>(node_in_.size() + face_in_.size()), 0,
+    double red[4] = {static_cast<double>(search_nodes_->size() + search_faces_->size()), 0,
                      static_cast<double>(pairs_.size()), deepest};
     red[1] = red[0];
     double mx[2] = {red[0], red[3]};
@@ -214,7 +261,7 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
   {
     ScopedPhase t(timers, Phase::transfer);
     force_plan_.build(comm_, force_dest_);
-    force_plan_.forward(force_out_, force_in_);
+    if (!force_plan_.stays()) force_plan_.forward(force_out_, force_in_);
     stats_.bytes_sent += static_cast<double>(force_out_.size() * sizeof(ContactForceItem));
   }
 
@@ -222,17 +269,17 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
     ScopedPhase t(timers, Phase::contact_force);
     // Owners add the contributions to each node in ascending (node, pair node): the sum
     // no longer depends on where the pairs were found.
-    std::sort(force_in_.begin(), force_in_.end(),
-              [](const ContactForceItem& a, const ContactForceItem& b) {
-                return a.target != b.target ? a.target < b.target : a.slave < b.slave;
-              });
+    std::vector<ContactForceItem>& items = force_plan_.stays() ? force_out_ : force_in_;
+    std::sort(items.begin(), items.end(), [](const ContactForceItem& a, const ContactForceItem& b) {
+      return a.target != b.target ? a.target < b.target : a.slave < b.slave;
+    });
     for (int l : my_nodes_) {
       last_face_[static_cast<std::size_t>(l)] = -1;
       allowance_[static_cast<std::size_t>(l)] = 0;
     }
     extra_force_.assign(extra_.size(), {0.0, 0.0, 0.0});
     extra_face_.assign(extra_.size(), -1);
-    for (const auto& it : force_in_) {
+    for (const auto& it : items) {
       if (it.target >= extra_offset_) {
         const auto e = static_cast<std::size_t>(
             std::lower_bound(extra_.begin(), extra_.end(), it.target,

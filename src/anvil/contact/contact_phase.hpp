@@ -29,12 +29,14 @@ namespace anvil {
 
 struct ContactStats {
   std::int64_t cycles = 0;
-  std::int64_t rebalances = 0; // RCB recomputations
-  std::int64_t pairs = 0;      // node-face pairs in the last cycle (all ranks)
-  double imbalance = 1;        // last cycle's max/mean contact work per rank
-  double imbalance_max = 1;    // the largest seen
-  double bytes_sent = 0;       // this rank, all cycles (transfers and forces)
-  double max_penetration = 0;  // largest gap behind a face, over all cycles, m
+  std::int64_t rebalances = 0;  // RCB recomputations
+  std::int64_t pairs = 0;       // node-face pairs in the last cycle (all ranks)
+  double imbalance = 1;         // last cycle's max/mean contact work per rank
+  double imbalance_max = 1;     // the largest seen
+  double bytes_sent = 0;        // this rank, all cycles (transfers and forces)
+  double max_penetration = 0;   // largest gap behind a face, over all cycles, m
+  std::int64_t list_builds = 0; // this rank's candidate-list builds (SearchWorkspace)
+  std::int64_t plan_builds = 0; // node and face migration plans built (destinations changed)
 };
 
 // FE-side view of the nodes the contact phase reads and writes.
@@ -83,8 +85,8 @@ public:
   const Rcb& rcb() const { return rcb_; }
   // Items this rank held in the contact decomposition at the last detect(): its own
   // nodes, and the faces it held (owned by centroid plus ghosts).
-  std::size_t nodes_held() const { return node_in_.size(); }
-  std::size_t faces_held() const { return face_in_.size(); }
+  std::size_t nodes_held() const { return search_nodes_->size(); }
+  std::size_t faces_held() const { return search_faces_->size(); }
   // RCB owner rank of each face of each owned element, -1 where the element has none
   // (first exterior face by side), per block and element (for the contact_rank field).
   std::vector<std::vector<int>> element_contact_rank(const std::vector<HexBlock>& blocks) const;
@@ -123,7 +125,15 @@ private:
   std::vector<std::int64_t> pid_;
   std::vector<ContactNodeItem> node_out_, node_in_;
   std::vector<ContactFaceItem> face_local_, face_out_, face_in_; // per face, per copy, received
-  std::vector<int> node_dest_, face_dest_, ranks_;
+  std::vector<Vec3> face_centre_;                             // per face: centre of its mean plane
+  std::vector<int> node_dest_, face_dest_, face_src_, ranks_; // face_src_: face of each copy
+  // The destinations the plans were built for (reused while nobody's have changed).
+  std::vector<int> node_dest_built_, face_dest_built_, face_src_built_;
+  bool plans_built_ = false;
+  // What the search and the forces read: the received items, or the local ones in place
+  // where every item stays on this rank.
+  const std::vector<ContactNodeItem>* search_nodes_ = &node_in_;
+  const std::vector<ContactFaceItem>* search_faces_ = &face_in_;
   std::vector<ContactPair> pairs_;
   std::vector<ContactForceItem> force_out_, force_in_;
   std::vector<int> force_dest_;

@@ -26,56 +26,84 @@ FacePlane face_plane(const ContactFaceItem& f) {
 Box3 capture_box(const ContactFaceItem& f, const FacePlane& p) {
   const Vec3 back = p.normal * (-2 * f.depth);
   const double pad = 0.05 * p.size;
-  Box3 b{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
-  for (int a = 0; a < 4; ++a)
-    for (int i = 0; i < 3; ++i) {
-      const double v = f.x[a][i];
-      b.lo[i] = std::min({b.lo[i], v, v + back[i]});
-      b.hi[i] = std::max({b.hi[i], v, v + back[i]});
-    }
+  Box3 b;
   for (int i = 0; i < 3; ++i) {
-    b.lo[i] -= pad;
-    b.hi[i] += pad;
+    double lo = 1e300, hi = -1e300;
+    for (int a = 0; a < 4; ++a) {
+      const double v = f.x[a][i], w = v + back[i];
+      lo = std::min(lo, std::min(v, w));
+      hi = std::max(hi, std::max(v, w));
+    }
+    b.lo[i] = lo - pad;
+    b.hi[i] = hi + pad;
   }
   return b;
 }
 
-void find_contacts(const std::vector<ContactNodeItem>& nodes,
-                   const std::vector<ContactFaceItem>& faces, const SearchOptions& opt,
-                   SearchWorkspace& w, std::vector<ContactPair>& pairs) {
-  pairs.clear();
-  if (nodes.empty() || faces.empty()) return;
-  const std::size_t nf = faces.size();
-
-  w.box.resize(6 * nf);
-  w.extent.resize(nf);
-  w.plane.resize(5 * nf);
-  for (std::size_t f = 0; f < nf; ++f) {
-    // Mean plane (unit normal from the diagonals) and how far the warped face strays from
-    // it: cheap tests that discard most candidates before the projection.
-    const FacePlane fp = face_plane(faces[f]);
-    const Box3 cb = capture_box(faces[f], fp);
-    double* b = &w.box[6 * f];
-    for (int i = 0; i < 3; ++i) {
-      b[i] = cb.lo[i];
-      b[3 + i] = cb.hi[i];
-    }
-    w.extent[f] = std::max({b[3] - b[0], b[4] - b[1], b[5] - b[2]});
-    double* pl = &w.plane[5 * f];
-    pl[0] = fp.normal.x;
-    pl[1] = fp.normal.y;
-    pl[2] = fp.normal.z;
-    pl[3] = dot(fp.centre, fp.normal);
-    pl[4] = fp.warp;
+FacePlane set_capture(ContactFaceItem& f) {
+  const FacePlane p = face_plane(f);
+  const Box3 b = capture_box(f, p);
+  for (int i = 0; i < 3; ++i) {
+    f.normal[i] = p.normal[i];
+    f.lo[i] = b.lo[i];
+    f.hi[i] = b.hi[i];
   }
-  // Cells the size of the median capture box: a typical face lands in at most 2 x 2 x 2
-  // cells, the few large ones (a crushing block's) in more, and a node's cell lists only
-  // the faces near it.
+  f.offset = dot(p.centre, p.normal);
+  f.warp = p.warp;
+  return p;
+}
+
+void set_captures(std::span<ContactFaceItem> faces, std::span<Vec3> centres) {
+  for (std::size_t f = 0; f < faces.size(); ++f) centres[f] = set_capture(faces[f]).centre;
+}
+
+namespace {
+
+// True when the candidate lists of the last build still hold every face whose capture box
+// holds each node: the same nodes and faces, none moved more than half the skin. (A node
+// in a box now was then within half a skin of a box side that was itself within half a
+// skin of where it is now. 0.45 rather than 0.5 leaves room for rounding.)
+bool lists_valid(const std::vector<ContactNodeItem>& nodes,
+                 const std::vector<ContactFaceItem>& faces, const SearchWorkspace& w) {
+  if (!w.built || nodes.size() != w.node_gid.size() || faces.size() != w.face_gid.size())
+    return false;
+  const double half = 0.45 * w.skin;
+  bool ok = true;
+  for (std::size_t n = 0; n < nodes.size(); ++n) {
+    const double* r = &w.node_ref[3 * n];
+    ok &= nodes[n].gid == w.node_gid[n];
+    for (int i = 0; i < 3; ++i) ok &= std::abs(nodes[n].x[i] - r[i]) <= half;
+  }
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    ok &= faces[f].gid == w.face_gid[f];
+    const double* r = &w.box_ref[6 * f];
+    for (int i = 0; i < 3; ++i)
+      ok &=
+          (std::abs(faces[f].lo[i] - r[i]) <= half) & (std::abs(faces[f].hi[i] - r[3 + i]) <= half);
+  }
+  return ok; // false also when anything is not a number
+}
+
+// Builds the candidate lists by binning: the enlarged capture boxes are bucket-sorted on a
+// uniform grid, and each node scans the faces of its cell.
+void build_lists(const std::vector<ContactNodeItem>& nodes,
+                 const std::vector<ContactFaceItem>& faces, const SearchOptions& opt,
+                 SearchWorkspace& w) {
+  const std::size_t nf = faces.size();
+  w.extent.resize(nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    const auto& fc = faces[f];
+    w.extent[f] = std::max({fc.hi[0] - fc.lo[0], fc.hi[1] - fc.lo[1], fc.hi[2] - fc.lo[2]});
+  }
   std::nth_element(w.extent.begin(), w.extent.begin() + static_cast<std::ptrdiff_t>(nf / 2),
                    w.extent.end());
-  double cell = 1.0 * w.extent[nf / 2];
-  // Grid over the nodes' bounding box; cells no smaller than the largest capture box, so
-  // a face lands in at most 2 x 2 x 2 cells, and never more cells than 8 per item.
+  const double median = w.extent[nf / 2];
+  w.skin = opt.skin * median;
+  // Cells the size of the median enlarged capture box: a typical face lands in at most
+  // 2 x 2 x 2 cells, the few large ones (a crushing block's) in more, and a node's cell
+  // lists only the faces near it.
+  double cell = median + 2 * w.skin;
+  // Grid over the nodes' bounding box, never more cells than 8 per item.
   double lo[3], hi[3];
   for (int i = 0; i < 3; ++i) {
     lo[i] = hi[i] = nodes[0].x[i];
@@ -100,28 +128,31 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
   };
   const std::size_t ncell = static_cast<std::size_t>(dims[0]) * dims[1] * dims[2];
   w.cell_start.assign(ncell + 1, 0);
-  // Two passes (count, fill) over the cells each face's box covers, clipped to the grid;
+  // Two passes (count, fill) over the cells each enlarged box covers, clipped to the grid;
   // faces entirely outside the nodes' box are skipped.
   auto for_cells = [&](std::size_t f, auto&& fn) {
-    const double* b = &w.box[6 * f];
-    for (int i = 0; i < 3; ++i)
+    double b[6];
+    for (int i = 0; i < 3; ++i) {
+      b[i] = faces[f].lo[i] - w.skin;
+      b[3 + i] = faces[f].hi[i] + w.skin;
       if (b[3 + i] < lo[i] || b[i] > hi[i]) return;
+    }
     const int i0 = index(0, b[0]), i1 = index(0, b[3]), j0 = index(1, b[1]), j1 = index(1, b[4]);
     const int k0 = index(2, b[2]), k1 = index(2, b[5]);
     for (int k = k0; k <= k1; ++k)
       for (int j = j0; j <= j1; ++j)
         for (int i = i0; i <= i1; ++i)
-          fn((static_cast<std::size_t>(k) * dims[1] + j) * dims[0] + i);
+          fn((static_cast<std::size_t>(k) * dims[1] + j) * dims[0] + i, b);
   };
-  for (std::size_t f = 0; f < nf; ++f) for_cells(f, [&](std::size_t c) { ++w.cell_start[c + 1]; });
+  for (std::size_t f = 0; f < nf; ++f)
+    for_cells(f, [&](std::size_t c, const double*) { ++w.cell_start[c + 1]; });
   for (std::size_t c = 0; c < ncell; ++c) w.cell_start[c + 1] += w.cell_start[c];
   w.entries.resize(static_cast<std::size_t>(w.cell_start[ncell]));
   w.cursor.assign(w.cell_start.begin(), w.cell_start.end() - 1);
   for (std::size_t f = 0; f < nf; ++f)
-    for_cells(f, [&](std::size_t c) {
+    for_cells(f, [&](std::size_t c, const double* b) {
       // Each entry carries its face's box, so the scan of a cell is one contiguous stream.
       auto& en = w.entries[static_cast<std::size_t>(w.cursor[c]++)];
-      const double* b = &w.box[6 * f];
       for (int i = 0; i < 3; ++i) {
         en.lo[i] = b[i];
         en.hi[i] = b[3 + i];
@@ -129,14 +160,71 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
       en.face = static_cast<int>(f);
     });
 
-  const double tol = 1 + opt.parametric_tolerance;
-  // Node ids of every face and its element's other nodes, packed for the hot loop.
-  w.ids.resize(8 * nf);
-  for (std::size_t f = 0; f < nf; ++f)
-    for (int a = 0; a < 4; ++a) {
-      w.ids[8 * f + a] = faces[f].node[a];
-      w.ids[8 * f + 4 + a] = faces[f].opposite[a];
+  // The lists: for each node with at least one candidate (the active nodes), the faces of
+  // its cell whose enlarged box holds it, in ascending face index (the fill pass runs
+  // over the faces in order), first the candidates, then its own faces; faces of elements
+  // it belongs to are left out. A node with no candidate cannot pair before the next build.
+  w.active.clear();
+  w.list_start.clear();
+  w.own_start.clear();
+  w.list.clear();
+  for (std::size_t n = 0; n < nodes.size(); ++n) {
+    const auto& nd = nodes[n];
+    const std::size_t c =
+        (static_cast<std::size_t>(index(2, nd.x[2])) * dims[1] + index(1, nd.x[1])) * dims[0] +
+        index(0, nd.x[0]);
+    const std::size_t first = w.list.size();
+    w.own.clear();
+    for (int k = w.cell_start[c]; k < w.cell_start[c + 1]; ++k) {
+      const auto& en = w.entries[static_cast<std::size_t>(k)];
+      const bool outside = (nd.x[0] < en.lo[0]) | (nd.x[0] > en.hi[0]) | (nd.x[1] < en.lo[1]) |
+                           (nd.x[1] > en.hi[1]) | (nd.x[2] < en.lo[2]) | (nd.x[2] > en.hi[2]);
+      if (outside) continue;
+      const auto& fc = faces[static_cast<std::size_t>(en.face)];
+      if (std::find(fc.node, fc.node + 4, nd.gid) != fc.node + 4)
+        w.own.push_back(en.face);
+      else if (std::find(fc.opposite, fc.opposite + 4, nd.gid) == fc.opposite + 4)
+        w.list.push_back(en.face);
     }
+    if (w.list.size() == first) continue;
+    w.active.push_back(static_cast<int>(n));
+    w.list_start.push_back(static_cast<int>(first));
+    w.own_start.push_back(static_cast<int>(w.list.size()));
+    w.list.insert(w.list.end(), w.own.begin(), w.own.end());
+  }
+  w.list_start.push_back(static_cast<int>(w.list.size()));
+
+  w.node_gid.resize(nodes.size());
+  w.node_ref.resize(3 * nodes.size());
+  for (std::size_t n = 0; n < nodes.size(); ++n) {
+    w.node_gid[n] = nodes[n].gid;
+    for (int i = 0; i < 3; ++i) w.node_ref[3 * n + i] = nodes[n].x[i];
+  }
+  w.face_gid.resize(nf);
+  for (std::size_t f = 0; f < nf; ++f) w.face_gid[f] = faces[f].gid;
+  w.box_ref.resize(6 * nf);
+  for (std::size_t f = 0; f < nf; ++f)
+    for (int i = 0; i < 3; ++i) {
+      w.box_ref[6 * f + i] = faces[f].lo[i];
+      w.box_ref[6 * f + 3 + i] = faces[f].hi[i];
+    }
+  w.built = true;
+  ++w.builds;
+}
+
+} // namespace
+
+void find_contacts(const std::vector<ContactNodeItem>& nodes,
+                   const std::vector<ContactFaceItem>& faces, const SearchOptions& opt,
+                   SearchWorkspace& w, std::vector<ContactPair>& pairs) {
+  pairs.clear();
+  if (nodes.empty() || faces.empty()) {
+    w.built = false;
+    return;
+  }
+  if (!lists_valid(nodes, faces, w)) build_lists(nodes, faces, opt, w);
+
+  const double tol = 1 + opt.parametric_tolerance;
   std::vector<int>& own = w.own;
   std::vector<int>& cand = w.cand;
   auto by_gid = [&](int a, int b) {
@@ -152,34 +240,31 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
   auto faces_oppose = [&](const std::vector<int>& mine, const Vec3& fn) {
     if (mine.empty()) return true;
     for (int g : mine) {
-      const double* q = &w.plane[5 * static_cast<std::size_t>(g)];
+      const double* q = faces[static_cast<std::size_t>(g)].normal;
       if (q[0] * fn.x + q[1] * fn.y + q[2] * fn.z < -0.3) return true;
     }
     return false;
   };
-  for (std::size_t n = 0; n < nodes.size(); ++n) {
+  auto holds = [&](int f, const Vec3& p) {
+    const auto& fc = faces[static_cast<std::size_t>(f)];
+    return !((p.x < fc.lo[0]) | (p.x > fc.hi[0]) | (p.y < fc.lo[1]) | (p.y > fc.hi[1]) |
+             (p.z < fc.lo[2]) | (p.z > fc.hi[2]));
+  };
+  for (std::size_t k = 0; k < w.active.size(); ++k) {
+    const auto n = static_cast<std::size_t>(w.active[k]);
     const auto& nd = nodes[n];
     const Vec3 p{nd.x[0], nd.x[1], nd.x[2]};
-    const std::size_t c =
-        (static_cast<std::size_t>(index(2, p.z)) * dims[1] + index(1, p.y)) * dims[0] +
-        index(0, p.x);
-    // Pass 1: the faces of the node's cell whose capture box holds it, split into its own
-    // faces and the others (minus those of elements the node belongs to).
-    own.clear();
+    // Pass 1: the candidates whose capture box holds the node, then, if there are any, the
+    // node's own faces whose box holds it.
     cand.clear();
-    for (int k = w.cell_start[c]; k < w.cell_start[c + 1]; ++k) {
-      const auto& en = w.entries[static_cast<std::size_t>(k)];
-      const bool outside = (p.x < en.lo[0]) | (p.x > en.hi[0]) | (p.y < en.lo[1]) |
-                           (p.y > en.hi[1]) | (p.z < en.lo[2]) | (p.z > en.hi[2]);
-      if (outside) continue;
-      const int f = en.face;
-      const std::int64_t* id = &w.ids[8 * static_cast<std::size_t>(f)];
-      if (id[0] == nd.gid || id[1] == nd.gid || id[2] == nd.gid || id[3] == nd.gid)
-        own.push_back(f);
-      else if (id[4] != nd.gid && id[5] != nd.gid && id[6] != nd.gid && id[7] != nd.gid)
-        cand.push_back(f);
-    }
+    for (int j = w.list_start[k]; j < w.own_start[k]; ++j)
+      if (holds(w.list[static_cast<std::size_t>(j)], p))
+        cand.push_back(w.list[static_cast<std::size_t>(j)]);
     if (cand.empty()) continue;
+    own.clear();
+    for (int j = w.own_start[k]; j < w.list_start[k + 1]; ++j)
+      if (holds(w.list[static_cast<std::size_t>(j)], p))
+        own.push_back(w.list[static_cast<std::size_t>(j)]);
     // The node's own faces (all of them are here: their capture boxes hold the node),
     // deduplicated (a face can sit in several cells? no: one cell per node, but ghosts of
     // the same face never coexist on a rank; kept for safety).
@@ -194,11 +279,10 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
       // The surfaces must face each other (a node just outside a convex edge can be
       // "behind" the side face there while it is in front of the top face), and the node
       // must be behind the face's mean plane, not deeper than a tracked pair may go.
-      const double* pl = &w.plane[5 * static_cast<std::size_t>(f)];
-      const Vec3 fn{pl[0], pl[1], pl[2]};
+      const Vec3 fn{fc.normal[0], fc.normal[1], fc.normal[2]};
       if (!faces_oppose(own, fn)) continue;
-      const double side = dot(p, fn) - pl[3];
-      if (side > pl[4] || side < -(2 * fc.depth + pl[4])) continue;
+      const double side = dot(p, fn) - fc.offset;
+      if (side > fc.warp || side < -(2 * fc.depth + fc.warp)) continue;
       const std::array<Vec3, 4> x = {
           Vec3{fc.x[0][0], fc.x[0][1], fc.x[0][2]}, Vec3{fc.x[1][0], fc.x[1][1], fc.x[1][2]},
           Vec3{fc.x[2][0], fc.x[2][1], fc.x[2][2]}, Vec3{fc.x[3][0], fc.x[3][1], fc.x[3][2]}};
@@ -227,7 +311,7 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
         const Vec3 p0{nd.x[0] - opt.dt * nd.v[0], nd.x[1] - opt.dt * nd.v[1],
                       nd.x[2] - opt.dt * nd.v[2]};
         const double len0 = norm(n0);
-        if (len0 > 0 && dot(p0 - c0, n0) < -(pl[4] + 1e-3 * fc.depth) * len0) continue;
+        if (len0 > 0 && dot(p0 - c0, n0) < -(fc.warp + 1e-3 * fc.depth) * len0) continue;
       }
       // Least penetration wins; equal penetrations go to the lower face id.
       if (!found || q.gap > best.gap || (q.gap == best.gap && fc.gid < best_gid)) {

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "anvil/core/vec3.hpp"
@@ -40,6 +41,12 @@ struct ContactFaceItem {
   double mass[4];           // nodal masses
   double stiffness;         // penalty stiffness, N/m
   double depth; // largest penetration accepted for a new pair (twice for a tracked one), m
+  // Set by set_capture() from x and depth, once per cycle where the face is made, and
+  // travelling with its copies: the mean plane and the capture box (below).
+  double normal[3];    // unit normal of the mean plane
+  double offset;       // normal . centre, m
+  double warp;         // largest distance of a corner from the mean plane, m
+  double lo[3], hi[3]; // capture box, m
 };
 
 struct ContactPair {
@@ -71,24 +78,49 @@ FacePlane face_plane(const ContactFaceItem& face);
 // touches.
 Box3 capture_box(const ContactFaceItem& face, const FacePlane& plane);
 
+// Computes the face's mean plane and capture box from its corners and depth and stores
+// them in the item (the search reads them from there); returns the plane.
+FacePlane set_capture(ContactFaceItem& face);
+// set_capture() for every face; the centre of each face's mean plane goes to centres[f].
+void set_captures(std::span<ContactFaceItem> faces, std::span<Vec3> centres);
+
 struct SearchOptions {
   double dt = 0; // the step just predicted: x - dt v is the start of the step (0: no check)
   double parametric_tolerance = 0.02; // the foot may lie this far outside [-1, 1]^2
+  // Skin of the candidate lists, as a fraction of the median capture-box size: a list
+  // holds the faces whose capture box, enlarged by the skin, held the node when it was
+  // built, and stays valid until a node or a capture-box side has moved half the skin.
+  // Only the cost depends on it: every cycle tests the exact boxes of the candidates.
+  double skin = 0.1;
 };
 
-// Scratch space kept between cycles (no allocation in steady state).
+// Scratch space and candidate lists kept between cycles (no allocation in steady state).
 struct SearchWorkspace {
   struct CellEntry {
-    double lo[3], hi[3]; // the face's capture box
+    double lo[3], hi[3]; // the face's capture box, enlarged by the skin
     int face;
   };
   std::vector<int> cell_start, cursor; // per cell: first entry; fill cursors
   std::vector<CellEntry> entries;      // faces binned by cell
-  std::vector<double> box;             // 6 per face: capture box
   std::vector<double> extent;          // largest side of each capture box
-  std::vector<double> plane;           // 5 per face: unit normal, offset, warp
   std::vector<int> own, cand;          // a node's own faces and its candidates
-  std::vector<std::int64_t> ids;       // 8 per face: its nodes and its element's other nodes
+
+  // Candidate lists (Verlet lists): for each node with at least one candidate (active),
+  // the faces whose enlarged capture box held it at the last build, ascending: first the
+  // candidates, then its own faces (faces of the node's elements are left out). Valid
+  // while the node and face ids are those of the build and nothing has moved more than
+  // half the skin from where it was then.
+  bool built = false;
+  double skin = 0;                    // m, at the last build
+  std::vector<std::int64_t> node_gid; // node ids at the last build
+  std::vector<std::int64_t> face_gid; // face ids at the last build
+  std::vector<double> node_ref;       // 3 per node: position at the last build
+  std::vector<double> box_ref;        // 6 per face: capture box at the last build
+  std::vector<int> active;            // nodes with candidates, ascending
+  std::vector<int> list_start;        // per active node: its first candidate (+ end)
+  std::vector<int> own_start;         // per active node: its first own face
+  std::vector<int> list;              // face indices
+  std::int64_t builds = 0;            // lists built since the workspace was made
 };
 
 // Finds, for every node, the face it penetrates (if any): pairs in ascending node index.

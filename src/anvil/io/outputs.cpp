@@ -409,6 +409,7 @@ void Outputs::write_summary(int status, const std::string& message) {
   const Sample s = have_sample_ ? last_sample_ : sim_.sample();
   const ContactStats contact_stats = sim_.contact() ? sim_.contact()->stats() : ContactStats{};
   const double bytes_max = comm.max(contact_stats.bytes_sent);
+  const std::int64_t list_builds_max = comm.max(contact_stats.list_builds);
   const std::int64_t eroded = comm.sum(sim_.eroded_local());
   const sph::SphStats sph_stats = sim_.sph() ? sim_.sph()->stats() : sph::SphStats{};
   double sph_seconds[4] = {sph_stats.seconds_compute, sph_stats.seconds_ghosts,
@@ -466,6 +467,8 @@ void Outputs::write_summary(int status, const std::string& message) {
                     {"load_imbalance_last", contact_stats.imbalance},
                     {"load_imbalance_max", contact_stats.imbalance_max},
                     {"max_penetration", contact_stats.max_penetration},
+                    {"candidate_list_builds_max", list_builds_max},
+                    {"plan_builds", contact_stats.plan_builds},
                     {"bytes_sent_per_rank_per_cycle_max",
                      bytes_max / static_cast<double>(contact_stats.cycles)}};
   }

@@ -37,6 +37,9 @@ public:
 
   std::size_t send_count() const { return order_.size(); } // items held before (dest.size())
   std::size_t recv_count() const { return recv_total_; }   // items held after forward()
+  // True when every item stays on this rank and none arrives: forward() and reverse() are
+  // then plain copies in the same order, which a caller may skip.
+  bool stays() const { return comm_ != nullptr && peers_.empty(); }
   // Items received from `rank`, and where they start in the received layout.
   std::size_t recv_count(int rank) const { return static_cast<std::size_t>(rcount_[rank]); }
   std::size_t recv_offset(int rank) const { return static_cast<std::size_t>(rdispl_[rank]); }

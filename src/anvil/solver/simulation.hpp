@@ -102,6 +102,8 @@ public:
   const FeDecomposition& fe() const { return fe_; }
   const PhaseTimers& timers() const { return timers_; }
   const ContactPhase* contact() const { return contact_.get(); }
+  // Mutable access for tests that drive the contact phase on the current state.
+  ContactPhase* contact() { return contact_.get(); }
   // The SPH decomposition and its particles (null without particles).
   const sph::SphPhase* sph() const { return sph_.get(); }
   // Mutable access for tests that set initial fields no deck key expresses (a mode
