@@ -27,7 +27,9 @@ run 3 "$anvil" run deck.yaml -o stopped -q --restart stopped/checkpoint.anvil
 # A real SIGTERM, mid-run: mpirun passes it to the ranks, which checkpoint and stop.
 run 2 "$anvil" run deck.yaml -o killed -q 2>/dev/null &
 pid=$!
-for _ in $(seq 1 200); do
+# Wait for the first periodic checkpoint (20% into the run), however loaded the machine:
+# a signal that came before the handlers are installed would kill the run outright.
+for _ in $(seq 1 4000); do
   [ -f killed/checkpoint.anvil ] && break
   sleep 0.05
 done
