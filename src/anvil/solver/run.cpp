@@ -61,7 +61,18 @@ int run(const Config& config, const RunOptions& options, const Comm& comm) {
     OutputState st = out.state();
     st.next_checkpoint = next_checkpoint;
     const Checkpoint c = capture(sim, st);
-    if (comm.rank() == 0) write_checkpoint(checkpoint_path, c);
+    // Rank 0 writes; a failure (disk full, directory gone) stops every rank with its
+    // message instead of leaving the others waiting in the next collective.
+    std::string error;
+    if (comm.rank() == 0) {
+      try {
+        write_checkpoint(checkpoint_path, c);
+      } catch (const InputError& e) {
+        error = e.what();
+      }
+    }
+    comm.broadcast(error, 0);
+    if (!error.empty()) throw InputError(error);
   };
 
   StopSignals signals;
