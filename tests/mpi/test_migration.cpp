@@ -6,9 +6,6 @@
 // nothing; a destination out of range throws on every rank.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-#include <new>
-
 #include <cstring>
 #include <limits>
 #include <vector>
@@ -17,20 +14,7 @@
 #include "anvil/parallel/comm.hpp"
 #include "anvil/parallel/migration.hpp"
 
-// Counts C++ allocations of this executable (MPI's own mallocs are not counted): the
-// steady-state tests below check that moves and repartitions make none.
-std::size_t g_allocations = 0;
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
+#include "allocation_counter.hpp"
 
 namespace {
 

@@ -8,9 +8,6 @@
 // one with fewer iterations and moves few points; the statistics JSON.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-#include <new>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -25,20 +22,7 @@
 #include "anvil/parallel/rcb.hpp"
 #include "anvil/parallel/rcb_statistics.hpp"
 
-// Counts C++ allocations of this executable (MPI's own mallocs are not counted): the
-// steady-state tests below check that moves and repartitions make none.
-std::size_t g_allocations = 0;
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
+#include "allocation_counter.hpp"
 
 namespace {
 

@@ -7,26 +7,11 @@
 // (test_cycle_allocations measures the whole step of an FE model in contact.)
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-#include <new>
-
 #include "anvil/parallel/comm.hpp"
 #include "anvil/solver/simulation.hpp"
 #include "test_support.hpp"
 
-// Counts C++ allocations of this executable (MPI's own mallocs are not counted).
-std::size_t g_allocations = 0;
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
+#include "allocation_counter.hpp"
 
 namespace {
 

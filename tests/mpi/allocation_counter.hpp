@@ -1,0 +1,22 @@
+// Counts the C++ allocations of a test executable (MPI's own mallocs are not counted):
+// replaces the global operator new and delete. Include it in exactly one source file of
+// an executable; tests read g_allocations before and after the code they measure.
+#pragma once
+
+#include <cstddef>
+#include <cstdlib>
+#include <new>
+
+std::size_t g_allocations = 0;
+
+void* operator new(std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
