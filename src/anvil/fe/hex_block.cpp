@@ -112,8 +112,9 @@ void gather(const int* const (&conn)[8], const double* packed, int e, int ahead,
     std::ptrdiff_t off[W];
     _Pragma("GCC unroll 8") for (int k = 0; k < W; ++k) off[k] =
         node_stride * static_cast<std::ptrdiff_t>(idx[k]);
-    // Prefetch the corner's node some elements ahead (one line per node).
-    __builtin_prefetch(packed + node_stride * conn[a][ahead]);
+    // Prefetch the corner's nodes some elements ahead (one line per node and lane).
+    _Pragma("GCC unroll 8") for (int k = 0; k < W; ++k)
+        __builtin_prefetch(packed + node_stride * static_cast<std::ptrdiff_t>(conn[a][ahead + k]));
     _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) {
       vdouble x, v;
       simd::gather_pairs(packed + 2 * i, off, x, v);
@@ -258,8 +259,8 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
     // rotate the old stress into the new frame.
     for (int l = 0; l < nc; l += width) {
       const int e = e0 + l;
-      gather(conn, packed, e, std::min(e + prefetch_ahead, n - 1), 0.5 * dt, scratch(s_x0) + l,
-             scratch(s_v0) + l, t);
+      gather(conn, packed, e, std::min(e + prefetch_ahead, padded_size(n) - width), 0.5 * dt,
+             scratch(s_x0) + l, scratch(s_v0) + l, t);
       simd::stage_barrier();
       // 12 B(x(n-1/2)) one direction at a time, consumed at once: 12 V and 12 V L^T.
       vdouble L[3][3], vol12;
