@@ -4,6 +4,7 @@
 // what keeps results independent of the partition.
 #pragma once
 
+#include <cstddef>
 #include <experimental/simd>
 #if defined(__AVX__)
 #include <immintrin.h>
@@ -25,10 +26,48 @@ inline vdouble gather(const double* p, const Index* idx) {
   return vdouble([&](auto l) { return p[idx[l]]; });
 }
 
+// Loads two values per lane from consecutive addresses: first[l] = p[off[l]],
+// second[l] = p[off[l] + 1] (an interleaved pair such as a node's x_i and v_i). With AVX:
+// four 128-bit loads and two unpacks instead of eight scalar loads and inserts.
+inline void gather_pairs(const double* p, const std::ptrdiff_t* off, vdouble& first,
+                         vdouble& second) {
+#if defined(__AVX__)
+  if constexpr (width == 4) {
+    const __m256d a = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(p + off[0])),
+                                           _mm_loadu_pd(p + off[2]), 1); // f0 s0 f2 s2
+    const __m256d b = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(p + off[1])),
+                                           _mm_loadu_pd(p + off[3]), 1); // f1 s1 f3 s3
+    first = vdouble(_mm256_unpacklo_pd(a, b));
+    second = vdouble(_mm256_unpackhi_pd(a, b));
+    return;
+  }
+#endif
+  first = vdouble([&](auto l) { return p[off[l]]; });
+  second = vdouble([&](auto l) { return p[off[l] + 1]; });
+}
+
+// A compiler barrier: values stored to memory before it are read back from memory after
+// it. The kernels use it to end a stage, so that the next one does not keep the previous
+// stage's results in registers (and spill them) but reads them as memory operands.
+inline void stage_barrier() {
+  asm volatile("" ::: "memory");
+}
+
+// Unaligned load and store. With AVX, through the intrinsics: the generic copy_from
+// sometimes went through a stack temporary (a load, a spill and a reload).
 inline vdouble load(const double* p) {
+#if defined(__AVX__)
+  if constexpr (width == 4) return vdouble(_mm256_loadu_pd(p));
+#endif
   return vdouble(p, stdx::element_aligned);
 }
 inline void store(const vdouble& v, double* p) {
+#if defined(__AVX__)
+  if constexpr (width == 4) {
+    _mm256_storeu_pd(p, static_cast<__m256d>(v));
+    return;
+  }
+#endif
   v.copy_to(p, stdx::element_aligned);
 }
 

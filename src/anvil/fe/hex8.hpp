@@ -65,22 +65,40 @@ static_assert([] {
 // the same polynomial as eq. 79, rearranged. Every pair is an edge of the hexahedron
 // that does not touch node a, so the twelve edge sums are formed once and shared by the
 // eight nodes (each edge serves four of them): 36 additions and 8 x 3 x 6 products.
+//
+// The kernel evaluates it in pieces (edge_sums, then gradient12 one coordinate direction
+// at a time, without the factor 1/12) so that few values are live at once; gradient()
+// is the same arithmetic in one piece.
 template <class V>
-ANVIL_HEX8_INLINE void gradient(const V (&x)[8][3], V (&B)[8][3]) {
-  V s[12][3];
+ANVIL_HEX8_INLINE void edge_sums(const V (&x)[8][3], V (&s)[12][3]) {
   _Pragma("GCC unroll 12") for (int e = 0; e < 12; ++e)
       _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) s[e][i] =
           x[edge_nodes[e][0]][i] + x[edge_nodes[e][1]][i];
-  _Pragma("GCC unroll 8") for (int a = 0; a < 8; ++a) {
-    const int e23 = gradient_edges.e[a][0], e34 = gradient_edges.e[a][1];
-    const int e26 = gradient_edges.e[a][2], e56 = gradient_edges.e[a][3];
-    const int e48 = gradient_edges.e[a][4], e58 = gradient_edges.e[a][5];
-    _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) {
-      const int j = (i + 1) % 3, k = (i + 2) % 3;
-      B[a][i] = (s[e34][j] * s[e23][k] - s[e23][j] * s[e34][k] + s[e26][j] * s[e56][k] -
-                 s[e56][j] * s[e26][k] - s[e48][j] * s[e58][k] + s[e58][j] * s[e48][k]) *
-                (1.0 / 12.0);
-    }
+}
+
+// 12 B_ia from the edge sums of the two other directions: sj(e) = s_e (i + 1),
+// sk(e) = s_e (i + 2) (mod 3). Every product is sj(.) * sk(.), so a caller that holds the
+// twelve sk in registers needs one instruction per product.
+template <class V, class SJ, class SK>
+ANVIL_HEX8_INLINE V gradient12(int a, const SJ& sj, const SK& sk) {
+  const int e23 = gradient_edges.e[a][0], e34 = gradient_edges.e[a][1];
+  const int e26 = gradient_edges.e[a][2], e56 = gradient_edges.e[a][3];
+  const int e48 = gradient_edges.e[a][4], e58 = gradient_edges.e[a][5];
+  return V(sj(e34) * sk(e23) - sj(e23) * sk(e34) + sj(e26) * sk(e56) - sj(e56) * sk(e26) -
+           sj(e48) * sk(e58) + sj(e58) * sk(e48));
+}
+
+template <class V>
+ANVIL_HEX8_INLINE void gradient(const V (&x)[8][3], V (&B)[8][3]) {
+  V s[12][3];
+  edge_sums(x, s);
+  _Pragma("GCC unroll 8") for (int a = 0; a < 8; ++a)
+      _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3, k = (i + 2) % 3;
+    B[a][i] = gradient12<V>(
+                  a, [&](int e) -> const V& { return s[e][j]; },
+                  [&](int e) -> const V& { return s[e][k]; }) *
+              (1.0 / 12.0);
   }
 }
 

@@ -16,7 +16,7 @@ namespace {
 
 using simd::padded_size;
 
-// Scratch layout inside HexWorkspace: one array of `chunk` values per entry.
+// Chunk scratch inside HexWorkspace: one array of `chunk` values per entry.
 enum Slot : int {
   s_d0,
   s_d1,
@@ -42,43 +42,125 @@ enum Slot : int {
   s_count = s_v0 + 24
 };
 
-constexpr int prefetch_ahead = 32; // elements
-
-struct Gathered {
-  vdouble x[8][3], v[8][3];
+// Stage scratch of one vector of elements, after the chunk scratch: `width` values per
+// entry. A stage writes here and the next reads it back after simd::stage_barrier(), as
+// memory operands, instead of keeping everything live (x, v and B alone are 72 vectors
+// against 16 registers).
+enum Tmp : int {
+  t_edge0 = 0,         // 36 edge sums (3 edge + i)
+  t_b0 = t_edge0 + 36, // 24 gradient entries 12 B_ia (3 a + i), stage C
+  t_xm0 = t_b0 + 24,   // 8 mid-step x coordinates, stage A
+  t_count = t_xm0 + 8
 };
 
-// Loads the corner positions and velocities of elements e..e+width-1 from the nodes and
-// keeps a copy in the chunk scratch (at lane offset l) for the second pass.
-void gather(const HexBlock& b, const NodalView& n, int e, Gathered& g, double* xs, double* vs,
-            int l) {
-  constexpr int C = HexWorkspace::chunk;
-  for (int a = 0; a < 8; ++a) {
-    // The corner's node indices once, for all six gathers (x and v share them).
-    std::ptrdiff_t idx[width];
-    for (int k = 0; k < width; ++k) idx[k] = b.conn[a][e + k];
-    // Prefetch the corner's node some elements ahead (a few per cent on 100k elements).
-    const std::ptrdiff_t ahead = b.conn[a][std::min(e + prefetch_ahead, b.size() - 1)];
-    for (int i = 0; i < 3; ++i) {
-      __builtin_prefetch(n.x[i] + ahead);
-      __builtin_prefetch(n.v[i] + ahead);
+constexpr int prefetch_ahead = 32; // elements
+
+// Nodal positions and velocities packed per node (x0 v0 x1 v1 x2 v2, padded to a cache
+// line), so that a corner's six values come from one line in three 128-bit loads.
+constexpr int node_stride = 8;
+
+// Packs nodes [lo, hi) of the nodal arrays into p (node k at p + node_stride k).
+void pack_nodes(const NodalView& n, int lo, int hi, double* __restrict p) {
+  const double* __restrict x0 = n.x[0];
+  const double* __restrict x1 = n.x[1];
+  const double* __restrict x2 = n.x[2];
+  const double* __restrict v0 = n.v[0];
+  const double* __restrict v1 = n.v[1];
+  const double* __restrict v2 = n.v[2];
+  int k = lo;
+#if defined(__AVX__)
+  if constexpr (width == 4) // four nodes at a time: six loads, six unpacks, twelve stores
+    for (; k + 4 <= hi; k += 4) {
+      double* q = p + node_stride * static_cast<std::size_t>(k);
+      const __m256d x[3] = {_mm256_loadu_pd(x0 + k), _mm256_loadu_pd(x1 + k),
+                            _mm256_loadu_pd(x2 + k)};
+      const __m256d v[3] = {_mm256_loadu_pd(v0 + k), _mm256_loadu_pd(v1 + k),
+                            _mm256_loadu_pd(v2 + k)};
+      for (int i = 0; i < 3; ++i) {
+        const __m256d lo_pairs = _mm256_unpacklo_pd(x[i], v[i]); // nodes 0 and 2
+        const __m256d hi_pairs = _mm256_unpackhi_pd(x[i], v[i]); // nodes 1 and 3
+        _mm_storeu_pd(q + 2 * i, _mm256_castpd256_pd128(lo_pairs));
+        _mm_storeu_pd(q + node_stride + 2 * i, _mm256_castpd256_pd128(hi_pairs));
+        _mm_storeu_pd(q + 2 * node_stride + 2 * i, _mm256_extractf128_pd(lo_pairs, 1));
+        _mm_storeu_pd(q + 3 * node_stride + 2 * i, _mm256_extractf128_pd(hi_pairs, 1));
+      }
     }
-    for (int i = 0; i < 3; ++i) {
-      g.x[a][i] = simd::gather(n.x[i], idx);
-      g.v[a][i] = simd::gather(n.v[i], idx);
-      simd::store(g.x[a][i], xs + (3 * a + i) * C + l);
-      simd::store(g.v[a][i], vs + (3 * a + i) * C + l);
-    }
+#endif
+  for (; k < hi; ++k) {
+    double* q = p + node_stride * static_cast<std::size_t>(k);
+    q[0] = x0[k];
+    q[1] = v0[k];
+    q[2] = x1[k];
+    q[3] = v1[k];
+    q[4] = x2[k];
+    q[5] = v2[k];
   }
 }
 
-void reload(Gathered& g, const double* xs, const double* vs, int l) {
+// Stage A1: loads the corner positions and velocities of elements e..e+width-1 from the
+// packed nodes, keeps them in the chunk scratch (xs, vs: lane offset included) for stage
+// C, and writes the edge sums of the mid-step positions x - h v (and their x
+// coordinates) to the stage scratch t. conn: the block's eight corner index arrays;
+// ahead: the element to prefetch for.
+void gather(const int* const (&conn)[8], const double* packed, int e, int ahead, double h,
+            double* __restrict xs, double* __restrict vs, double* __restrict t) {
   constexpr int C = HexWorkspace::chunk;
-  for (int a = 0; a < 8; ++a)
-    for (int i = 0; i < 3; ++i) {
-      g.x[a][i] = simd::load(xs + (3 * a + i) * C + l);
-      g.v[a][i] = simd::load(vs + (3 * a + i) * C + l);
+  constexpr int W = width;
+  vdouble xm[8][3];
+  _Pragma("GCC unroll 8") for (int a = 0; a < 8; ++a) {
+    const int* idx = conn[a] + e;
+    std::ptrdiff_t off[W];
+    _Pragma("GCC unroll 8") for (int k = 0; k < W; ++k) off[k] =
+        node_stride * static_cast<std::ptrdiff_t>(idx[k]);
+    // Prefetch the corner's nodes some elements ahead (one line per node and lane).
+    _Pragma("GCC unroll 8") for (int k = 0; k < W; ++k)
+        __builtin_prefetch(packed + node_stride * static_cast<std::ptrdiff_t>(conn[a][ahead + k]));
+    _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) {
+      vdouble x, v;
+      simd::gather_pairs(packed + 2 * i, off, x, v);
+      simd::store(x, xs + (3 * a + i) * C);
+      simd::store(v, vs + (3 * a + i) * C);
+      xm[a][i] = x - h * v;
     }
+    simd::store(xm[a][0], t + (t_xm0 + a) * W);
+  }
+  vdouble s[12][3];
+  hex8::edge_sums(xm, s);
+  _Pragma("GCC unroll 12") for (int k = 0; k < 12; ++k)
+      _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i)
+          simd::store(s[k][i], t + (t_edge0 + 3 * k + i) * W);
+}
+
+// Edge sums of the positions in the chunk scratch (stage C; xs at the lane offset), one
+// direction at a time (eight positions live, each loaded once).
+void edge_sums(const double* __restrict xs, double* __restrict t) {
+  constexpr int C = HexWorkspace::chunk;
+  _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) {
+    vdouble x[8];
+    _Pragma("GCC unroll 8") for (int a = 0; a < 8; ++a) x[a] = simd::load(xs + (3 * a + i) * C);
+    _Pragma("GCC unroll 12") for (int k = 0; k < 12; ++k) simd::store(
+        x[hex8::edge_nodes[k][0]] + x[hex8::edge_nodes[k][1]], t + (t_edge0 + 3 * k + i) * width);
+    simd::stage_barrier();
+  }
+}
+
+// The gradient 12 B from the edge sums in t, one direction i at a time: the twelve
+// edge sums of direction i + 2 in registers, those of i + 1 as memory operands. Calls
+// use(a, i, 12 B_ia) for each entry as soon as it is formed.
+template <class Use>
+[[gnu::always_inline]] inline void gradient_by_direction(const double* t, Use&& use) {
+  constexpr int W = width;
+  _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3, k = (i + 2) % 3;
+    vdouble sk[12];
+    _Pragma("GCC unroll 12") for (int m = 0; m < 12; ++m) sk[m] =
+        simd::load(t + (t_edge0 + 3 * m + k) * W);
+    _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a)
+        use(a, i,
+            hex8::gradient12<vdouble>(
+                a, [&](int m) { return simd::load(t + (t_edge0 + 3 * m + j) * W); },
+                [&](int m) -> const vdouble& { return sk[m]; }));
+  }
 }
 
 } // namespace
@@ -89,10 +171,20 @@ int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array
   const auto p = static_cast<std::size_t>(padded_size(n));
   gid.assign(ids.begin(), ids.end());
   corner_base = base;
+  node_begin = 0;
+  node_end = 0;
   for (int a = 0; a < 8; ++a) {
     conn[a].resize(p);
     for (std::size_t e = 0; e < p; ++e)
       conn[a][e] = n > 0 ? corners[std::min<std::size_t>(e, n - 1)][a] : 0;
+  }
+  if (n > 0) {
+    node_begin = conn[0][0];
+    for (const auto& c : conn)
+      for (int k : c) {
+        node_begin = std::min(node_begin, k);
+        node_end = std::max(node_end, k + 1);
+      }
   }
   volume.assign(p, 0.0);
   alive.assign(p, 1.0);
@@ -117,7 +209,9 @@ int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array
   return bad;
 }
 
-HexWorkspace::HexWorkspace() : buf_(static_cast<std::size_t>(s_count) * chunk, 0.0) {}
+HexWorkspace::HexWorkspace()
+    : buf_(static_cast<std::size_t>(s_count) * chunk + static_cast<std::size_t>(t_count) * width,
+           0.0) {}
 
 void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corners,
                 HexWorkspace& work, HexResult& result) {
@@ -134,7 +228,16 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
   bool stream = true;
   for (double* f : corners.f)
     stream = stream && reinterpret_cast<std::uintptr_t>(f + b.corner_base) % 32 == 0;
-  Gathered g;
+  // Positions and velocities of the block's nodes, packed per node.
+  const std::size_t packed_size = node_stride * static_cast<std::size_t>(b.node_end);
+  if (work.nodes_.size() < packed_size) work.nodes_.resize(packed_size); // first calls only
+  pack_nodes(nodes, b.node_begin, b.node_end, work.nodes_.data());
+  const double* packed = work.nodes_.data();
+  const int* conn[8];
+  for (int a = 0; a < 8; ++a) conn[a] = b.conn[a].data();
+  double* t = work.buf_.data() + static_cast<std::size_t>(s_count) * C; // stage scratch
+  constexpr int W = width;
+  auto tmp = [t](int k) { return simd::load(t + k * W); };
   // The smallest stable step: the element's if it is smaller, or equal with a smaller id.
   auto take_step = [&](double dte, std::int64_t id) {
     if (dte < result.dt_stable || (dte == result.dt_stable && id < result.stable_gid)) {
@@ -144,6 +247,10 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
   };
   const vdouble lane([](auto l) { return static_cast<double>(l); });
   vdouble best_dt = 1e300, best_e = -1.0; // per lane: smallest step so far and its element
+  const double* xs = scratch(s_x0);
+  const double* vs = scratch(s_v0);
+  auto xc = [&](int a, int i, int l) { return simd::load(xs + (3 * a + i) * C + l); };
+  auto vc = [&](int a, int i, int l) { return simd::load(vs + (3 * a + i) * C + l); };
 
   for (int e0 = 0; e0 < n; e0 += C) {
     const int nc = padded_size(std::min(C, n - e0)); // lanes in this chunk, whole vectors
@@ -152,21 +259,37 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
     // rotate the old stress into the new frame.
     for (int l = 0; l < nc; l += width) {
       const int e = e0 + l;
-      gather(b, nodes, e, g, scratch(s_x0), scratch(s_v0), l);
-      vdouble xm[8][3], B[8][3];
-      for (int a = 0; a < 8; ++a)
-        for (int i = 0; i < 3; ++i) xm[a][i] = g.x[a][i] - (0.5 * dt) * g.v[a][i];
-      hex8::gradient(xm, B);
-      const vdouble vol = hex8::volume(xm, B);
+      gather(conn, packed, e, std::min(e + prefetch_ahead, padded_size(n) - width), 0.5 * dt,
+             scratch(s_x0) + l, scratch(s_v0) + l, t);
+      simd::stage_barrier();
+      // 12 B(x(n-1/2)) one direction at a time, consumed at once: 12 V and 12 V L^T.
+      vdouble L[3][3], vol12;
+      gradient_by_direction(t, [&](int a, int i, const vdouble& B) {
+        _Pragma("GCC unroll 12") for (int r = 0; r < 3; ++r) L[r][i] =
+            a == 0 ? vc(a, r, l) * B : L[r][i] + vc(a, r, l) * B;
+        if (i == 0) vol12 = a == 0 ? tmp(t_xm0 + a) * B : vol12 + tmp(t_xm0 + a) * B;
+      });
+      const vdouble vol = vol12 * (1.0 / 12.0);
       const vdouble inv = 1.0 / vol;
-      vdouble d[6], w[3], Q[3][3], s[6];
-      hex8::velocity_gradient(g.v, B, inv, d, w);
+      const vdouble inv12 = inv * (1.0 / 12.0);
+      for (auto& row : L)
+        for (auto& x : row) x *= inv12;
+      // Rate of deformation d (xx, yy, zz, xy, yz, xz) and the spin's axial vector w.
+      const vdouble d[6] = {L[0][0],
+                            L[1][1],
+                            L[2][2],
+                            0.5 * (L[0][1] + L[1][0]),
+                            0.5 * (L[1][2] + L[2][1]),
+                            0.5 * (L[0][2] + L[2][0])};
+      const vdouble w[3] = {0.5 * (L[2][1] - L[1][2]), 0.5 * (L[0][2] - L[2][0]),
+                            0.5 * (L[1][0] - L[0][1])};
+      vdouble Q[3][3], s[6];
       hex8::hughes_winget(w, dt, Q);
-      for (int k = 0; k < 6; ++k) s[k] = simd::load(&b.stress[k][e]);
+      _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) s[k] = simd::load(&b.stress[k][e]);
       hex8::rotate_symmetric(Q, s);
       const vdouble power =
           s[0] * d[0] + s[1] * d[1] + s[2] * d[2] + 2.0 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
-      for (int k = 0; k < 6; ++k) {
+      _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) {
         simd::store(s[k], &b.stress[k][e]);
         simd::store(d[k], scratch(s_d0 + k) + l);
       }
@@ -174,15 +297,17 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       simd::store(power, scratch(s_power_old) + l);
       simd::store(vol, scratch(s_volume_mid) + l);
       if (stiff) // the stiffness form rotates its hourglass forces with Q
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) simd::store(Q[i][j], scratch(s_q0 + 3 * i + j) + l);
+        _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i)
+            _Pragma("GCC unroll 12") for (int j = 0; j < 3; ++j)
+                simd::store(Q[i][j], scratch(s_q0 + 3 * i + j) + l);
+      simd::stage_barrier();
     }
 
     // Stage B: constitutive update of the whole chunk through the batch interface.
     MaterialBatch batch;
     batch.n = nc;
     batch.dt = dt;
-    for (int k = 0; k < 6; ++k) {
+    _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) {
       batch.d[k] = scratch(s_d0 + k);
       batch.stress[k] = b.stress[k].data() + e0;
     }
@@ -196,23 +321,38 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
     // the stable time step.
     for (int l = 0; l < nc; l += width) {
       const int e = e0 + l;
-      reload(g, scratch(s_x0), scratch(s_v0), l);
-      vdouble B[8][3];
-      hex8::gradient(g.x, B);
-      const vdouble vol = hex8::volume(g.x, B);
+      // C1: 12 B(x(n)) into the stage scratch, with G_ij = sum_b v_ib B_jb on the way.
+      edge_sums(xs + l, t);
+      simd::stage_barrier();
+      vdouble G[3][3];
+      gradient_by_direction(t, [&](int a, int i, const vdouble& B) {
+        simd::store(B, t + (t_b0 + 3 * a + i) * W);
+        _Pragma("GCC unroll 12") for (int r = 0; r < 3; ++r) G[r][i] =
+            a == 0 ? vc(a, r, l) * B : G[r][i] + vc(a, r, l) * B;
+      });
+      simd::stage_barrier();
+      auto Bt = [&](int a, int i) { return tmp(t_b0 + 3 * a + i); }; // 12 B_ia
+      vdouble vol12 = xc(0, 0, l) * Bt(0, 0), bb144 = Bt(0, 0) * Bt(0, 0);
+      _Pragma("GCC unroll 12") for (int a = 1; a < 8; ++a) vol12 += xc(a, 0, l) * Bt(a, 0);
+      _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a)
+          _Pragma("GCC unroll 12") for (int i = (a == 0 ? 1 : 0); i < 3; ++i) bb144 +=
+          Bt(a, i) * Bt(a, i);
+      for (auto& row : G)
+        for (auto& x : row) x *= 1.0 / 12.0;
+      const vdouble vol = vol12 * (1.0 / 12.0);
       const vdouble inv = 1.0 / vol;
       const vdouble mass = simd::load(&b.mass[e]);
       const vdouble rho = mass * inv;
       const vdouble c = simd::load(scratch(s_wave_speed) + l);
       vdouble d[6], s[6];
-      for (int k = 0; k < 6; ++k) {
+      _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) {
         d[k] = simd::load(scratch(s_d0 + k) + l);
         s[k] = simd::load(&b.stress[k][e]);
       }
       const vdouble trd = d[0] + d[1] + d[2];
       // Characteristic length: the element's stable-step length V / sqrt(2 B:B) scaled
       // by sqrt(3), which is the edge of a cube (and needs no cube root).
-      const vdouble bb = hex8::gradient_norm2(B);
+      const vdouble bb = bb144 * (1.0 / 144.0);
       const vdouble inv_sqrt_bb = 1.0 / stdx::sqrt(2.0 * bb);
       const vdouble lc = vol * inv_sqrt_bb;
       const vdouble len = 1.7320508075688772 * lc;
@@ -227,33 +367,27 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       //   f_ia = -(sigma_ij - q delta_ij - P_ij) B_ja - sum_al Q_i,al Gamma_al,a,
       //   P_ij = sum_al Q_i,al h_al,j.
       vdouble h[4][3], vg[3][4];
-      for (int i = 0; i < 3; ++i) {
+      _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) {
         vdouble col[8], out[4];
-        for (int a = 0; a < 8; ++a) col[a] = g.x[a][i];
+        _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a) col[a] = xc(a, i, l);
         hex8::gamma_sums(col, out);
-        for (int al = 0; al < 4; ++al) h[al][i] = out[al] * inv;
-        for (int a = 0; a < 8; ++a) col[a] = g.v[a][i];
+        _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al) h[al][i] = out[al] * inv;
+        _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a) col[a] = vc(a, i, l);
         hex8::gamma_sums(col, vg[i]);
       }
-      vdouble G[3][3];
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-          vdouble t = g.v[0][i] * B[0][j];
-          for (int a = 1; a < 8; ++a) t += g.v[a][i] * B[a][j];
-          G[i][j] = t;
-        }
       vdouble Qh[3][4];
       vdouble hg_power = 0.0;
       const vdouble kv = (0.25 * hg) * rho * c * len * len;
       const vdouble ks = (hg * M / 3.0) * bb * inv;
-      for (int al = 0; al < 4; ++al) {
+      _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al) {
         vdouble qa[3];
-        for (int i = 0; i < 3; ++i)
-          qa[i] = vg[i][al] - (G[i][0] * h[al][0] + G[i][1] * h[al][1] + G[i][2] * h[al][2]);
+        _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) qa[i] =
+            vg[i][al] - (G[i][0] * h[al][0] + G[i][1] * h[al][1] + G[i][2] * h[al][2]);
         if (stiff) {
           vdouble old[3];
-          for (int i = 0; i < 3; ++i) old[i] = simd::load(&b.hourglass_force[3 * al + i][e]);
-          for (int i = 0; i < 3; ++i) {
+          _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) old[i] =
+              simd::load(&b.hourglass_force[3 * al + i][e]);
+          _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) {
             const vdouble rot = simd::load(scratch(s_q0 + 3 * i) + l) * old[0] +
                                 simd::load(scratch(s_q0 + 3 * i + 1) + l) * old[1] +
                                 simd::load(scratch(s_q0 + 3 * i + 2) + l) * old[2];
@@ -262,18 +396,20 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
             hg_power += 0.5 * (rot + Qh[i][al]) * qa[i];
           }
         } else {
-          for (int i = 0; i < 3; ++i) {
+          _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) {
             Qh[i][al] = kv * qa[i];
             hg_power += Qh[i][al] * qa[i];
           }
         }
       }
-      // S = sigma - q I - P (not symmetric once P is in).
+      // -S/12 with S = sigma - q I - P (not symmetric once P is in): the corner forces
+      // below are -S B - (hourglass) and the gradient in the scratch is 12 B.
       vdouble S[3][3] = {{s[0] - q, s[3], s[5]}, {s[3], s[1] - q, s[4]}, {s[5], s[4], s[2] - q}};
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          S[i][j] -=
-              Qh[i][0] * h[0][j] + Qh[i][1] * h[1][j] + Qh[i][2] * h[2][j] + Qh[i][3] * h[3][j];
+      _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i)
+          _Pragma("GCC unroll 12") for (int j = 0; j < 3; ++j) S[i][j] =
+              (S[i][j] - (Qh[i][0] * h[0][j] + Qh[i][1] * h[1][j] + Qh[i][2] * h[2][j] +
+                          Qh[i][3] * h[3][j])) *
+              (-1.0 / 12.0);
 
       // Energies over the step just taken (dt = 0 on the first cycle).
       const vdouble power_new =
@@ -297,7 +433,7 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       // arithmetic may have produced non-finite values).
       if (any_dead) {
         stdx::where(dead, dte) = 1e300;
-        for (int k = 0; k < 6; ++k) {
+        _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) {
           vdouble sk = simd::load(&b.stress[k][e]);
           stdx::where(dead, sk) = 0.0;
           simd::store(sk, &b.stress[k][e]);
@@ -308,11 +444,11 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       // component at a time (the hourglass part of all eight corners comes from four
       // values), with their sum kept for the finiteness check.
       vdouble check = dte;
-      for (int i = 0; i < 3; ++i) {
+      _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) {
         vdouble hgf[8], fa[8];
         hex8::gamma_spread(Qh[i], hgf);
-        for (int a = 0; a < 8; ++a) {
-          fa[a] = -(S[i][0] * B[a][0] + S[i][1] * B[a][1] + S[i][2] * B[a][2] + hgf[a]);
+        _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a) {
+          fa[a] = S[i][0] * Bt(a, 0) + S[i][1] * Bt(a, 1) + S[i][2] * Bt(a, 2) - hgf[a];
           if (any_dead) stdx::where(dead, fa[a]) = 0.0;
           check += fa[a];
         }

@@ -63,6 +63,8 @@ struct HexBlock {
   std::vector<double> hourglass_energy;                // J
   std::size_t corner_base = 0;                         // corner (e, a) of this block lives at slot
                                                        // corner_base + 8 e + a (element-major)
+  int node_begin = 0, node_end = 0;                    // the local nodes the corners refer to
+                                                       // lie in [node_begin, node_end)
 
   int size() const { return static_cast<int>(gid.size()); }
 
@@ -120,7 +122,9 @@ public:
 private:
   friend void hex_forces(HexBlock&, const NodalView&, double, CornerView, HexWorkspace&,
                          HexResult&);
-  std::vector<double> buf_;
+  std::vector<double, CacheAligned<double>> buf_;   // chunk and stage scratch
+  std::vector<double, CacheAligned<double>> nodes_; // x and v, 8 per node (grows to the
+                                                    // largest block's node range)
 };
 
 // Cycle step 1 for one block: updates stress and state from the velocities over the
