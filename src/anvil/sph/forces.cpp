@@ -24,7 +24,8 @@ inline double lane_sum(const vdouble& v) {
 
 // kernel_fast for `width` pairs at once (the same operations per lane).
 template <KernelType K, int D>
-inline void kernel_simd(const vdouble& r, const vdouble& h, vdouble& w, vdouble& dwr) {
+[[gnu::always_inline]] inline void kernel_simd(const vdouble& r, const vdouble& h, vdouble& w,
+                                               vdouble& dwr) {
   const vdouble ih = 1.0 / h, q = r * ih;
   const vdouble ihd = D == 1 ? ih : (D == 2 ? ih * ih : ih * ih * ih);
   const vdouble s = kernel_norm<K, D>() * ihd;
@@ -155,16 +156,15 @@ inline vdouble valid_lanes(std::int64_t k0, std::int64_t k_end) {
   return v;
 }
 
-// A pair's kernel value and gradient grad_i W_ij = dW/dr (x_i - x_j) / r at the mean
-// smoothing length hb, from dx = x_i - x_j and r2 = |dx|^2. Both passes evaluate it with
-// the same operations (pass 2 recomputes it: cheaper than storing and streaming it back).
+// A pair's kernel value wk and dwr = (1/r) dW/dr at the mean smoothing length hb, from
+// r2 = |x_i - x_j|^2 (grad_i W_ij = dwr (x_i - x_j)). Pass 1 evaluates it and keeps dwr
+// (and wk for the artificial stress) per entry for pass 2, which forms the gradient from
+// its own dx with the same operations.
 template <KernelType K, int D>
-inline void pair_kernel(const vdouble (&dx)[3], const vdouble& r2, const vdouble& hb, vdouble& wk,
-                        vdouble (&g)[3]) {
+[[gnu::always_inline]] inline void pair_kernel(const vdouble& r2, const vdouble& hb, vdouble& wk,
+                                               vdouble& dwr) {
   const vdouble r = stdx::max(stdx::sqrt(r2), 1e-9 * hb);
-  vdouble dwr;
   kernel_simd<K, D>(r, hb, wk, dwr);
-  for (int a = 0; a < 3; ++a) g[a] = dwr * dx[a];
 }
 
 // Monaghan's f_ij^n = (W(r_ij) / W(dp))^n of a pair, 0 where the pair's mean epsilon is
@@ -206,6 +206,8 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
   const double* rdp = rd->x;
   constexpr int stride = sizeof(NeighbourRead1) / sizeof(double);
   const NeighbourList& nl = w.nl;
+  bool keep_w = false; // pass 2 needs W for the artificial stress
+  for (const auto& st : sets) keep_w = keep_w || st.epsilon > 0;
   for (std::size_t i = 0; i < n; ++i) {
     const NeighbourRead1& pi = rd[i];
     const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
@@ -227,8 +229,11 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
       vdouble dx[3];
       for (int a = 0; a < 3; ++a) dx[a] = xi[a] - q0[a];
       const vdouble hb = 0.5 * (pi.h + q0[3]);
-      vdouble wk, g[3];
-      pair_kernel<K, D>(dx, dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2], hb, wk, g);
+      vdouble wk, dwr;
+      pair_kernel<K, D>(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2], hb, wk, dwr);
+      const vdouble g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
+      simd::store(dwr, w.dwr.data() + k0);
+      if (keep_w) simd::store(wk, w.wk.data() + k0);
       // Volume weights V_j = m_j / rho_j: consistent across density jumps (a gas
       // interface, particles of different sets).
       const vdouble vj = q1[3];
@@ -326,6 +331,10 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
     r.volume = p.mass[i] / p.rho[i];
   }
   filter_neighbours(w.read1.data()->x, sizeof(NeighbourRead1) / sizeof(double), candidates, w.nl);
+  w.dwr.resize(static_cast<std::size_t>(w.nl.start[n]));
+  bool any_epsilon = false;
+  for (const auto& st : sets) any_epsilon = any_epsilon || st.epsilon > 0;
+  if (any_epsilon) w.wk.resize(w.dwr.size());
   const int dim = sets.empty() ? 3 : sets[0].dimensions;
   if (kernel == KernelType::cubic_spline) {
     if (dim == 1)
@@ -439,11 +448,11 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
       }
       const vdouble hb = 0.5 * (pi[R2::h] + qx[3]);
       const vdouble r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
-      vdouble wk, g[3];
-      pair_kernel<K, D>(dx, r2, hb, wk, g);
-      const vdouble fn = any_epsilon
-                             ? artificial_factor<K, D>(wk, hb, si, sets, p.set, idx, same_as)
-                             : vdouble(0.0);
+      const vdouble dwr = simd::load(w.dwr.data() + k0);
+      const vdouble g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
+      const vdouble fn = any_epsilon ? artificial_factor<K, D>(simd::load(w.wk.data() + k0), hb, si,
+                                                               sets, p.set, idx, same_as)
+                                     : vdouble(0.0);
       const vdouble vr = dv[0] * dx[0] + dv[1] * dx[1] + dv[2] * dx[2];
       vdouble visc = 0.0;
       const auto approaching = vr < 0.0;

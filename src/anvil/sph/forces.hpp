@@ -119,6 +119,7 @@ struct SphWorkspace {
   std::vector<NeighbourRead1> read1;
   std::vector<NeighbourRead2> read2;
   NeighbourList nl;                // this step's neighbours (filtered candidates)
+  std::vector<double> dwr, wk;     // per entry of nl: (1/r) dW/dr and (artificial stress) W
   std::vector<double> d[6];        // rate of deformation of own particles
   std::vector<double> binv;        // B^-1 of own particles, 9 per particle (row-major)
   std::vector<double> power_old;   // rotated old stress : D
@@ -127,8 +128,8 @@ struct SphWorkspace {
 
 // Pass 1 over own particles, over the interval dt (the previous step): selects this
 // step's neighbours among the candidate lists (work.nl: the candidates within the
-// kernel's support at the current positions and h). The candidates must hold every pair
-// within the support.
+// kernel's support at the current positions and h) and keeps each entry's kernel
+// derivative for pass 2. The candidates must hold every pair within the support.
 void sph_kinematics(const SphView& v, std::span<const SetParams> sets, KernelType kernel,
                     const NeighbourList& candidates, double dt, SphWorkspace& work);
 

@@ -252,6 +252,11 @@ void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
     const double mean = static_cast<double>(global_count_) / comm_.size();
     stats_.imbalance = mean > 0 ? red[0] / mean : 1.0;
     stats_.imbalance_max = std::max(stats_.imbalance_max, stats_.imbalance);
+    // The candidate lists hold every pair closer than radius_ at the build; a pair within
+    // the support now (r < h_i + h_j <= 2 h_max) was closer than 2 h_max + 2 d_max then.
+    // The margin covers the round-off of these sums. Every rank decides alike (the
+    // inputs are reduced); the results do not depend on the decision (neighbours.hpp).
+    const bool moved_far = !(2 * red[2] + 2 * std::sqrt(red[3]) < (1 - 1e-9) * radius_);
     if (stats_.imbalance > threshold_) {
       const auto t0 = PhaseTimers::clock::now();
       {
@@ -273,7 +278,14 @@ void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
       }
       stats_.seconds_migrate += seconds_since(t1);
       rebuild = true;
-    } else if (red[1] > 0) {
+    } else if (moved_far) {
+      rebuild = true;
+    }
+    // Particles that left their box move to the rank whose box holds them on a rebuild
+    // only (as LAMMPS moves atoms on re-neighbouring steps): until then the ghost plan
+    // still brings every neighbour of an escaped particle to its rank, since the
+    // particle was inside the box at the build.
+    if (rebuild && red[1] > 0 && !(stats_.imbalance > threshold_)) {
       const auto t1 = PhaseTimers::clock::now();
       ScopedPhase tr(timers, Phase::transfer);
       dest_.resize(n);
@@ -282,15 +294,9 @@ void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
       migrate(dest_);
       ++stats_.migrations;
       stats_.seconds_migrate += seconds_since(t1);
-      rebuild = true;
     }
     n = p_.size();
     hmax_ = red[2];
-    // The candidate lists hold every pair closer than radius_ at the build; a pair within
-    // the support now (r < h_i + h_j <= 2 h_max) was closer than 2 h_max + 2 d_max then.
-    // The margin covers the round-off of these sums. Every rank decides alike (the
-    // inputs are reduced); the results do not depend on the decision (neighbours.hpp).
-    if (!(2 * hmax_ + 2 * std::sqrt(red[3]) < (1 - 1e-9) * radius_)) rebuild = true;
   }
 
   // (2) Ghosts: on a rebuild, copies of the particles within the candidate radius of

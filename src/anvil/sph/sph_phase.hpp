@@ -1,14 +1,15 @@
 // The paper's SPH decomposition (cycle step 2): particles live on their own dynamic RCB
-// decomposition, independent of the FE mesh's. Each rank holds the particles inside its
-// RCB box (ascending global id) for the whole cycle: the particle phase, the velocity
-// and position updates and contact all work on them where they are.
+// decomposition, independent of the FE mesh's. Each rank holds the particles that were
+// inside its RCB box at the last list rebuild (ascending global id) for the whole cycle:
+// the particle phase, the velocity and position updates and contact all work on them
+// where they are.
 //
 // Every cycle: (1) upkeep: one reduction tells the largest particle count (the RCB is
 // recut incrementally when max/mean exceeds the threshold, and every particle migrates
-// to its new owner), whether any particle left its box (those migrate to the rank whose
-// box now holds them), the largest h and the largest displacement since the candidate
-// lists were built; (2) ghosts: on a rebuild (after a move, or when a particle may have
-// come within the support of one its lists miss) every particle whose box of the
+// to its new owner), whether any particle left its box (on a rebuild those migrate to
+// the rank whose box now holds them), the largest h and the largest displacement since
+// the candidate lists were built; (2) ghosts: on a rebuild (after a recut, or when a
+// particle may have come within the support of one its lists miss) every particle whose box of the
 // candidate radius (2 h_max plus a skin) reaches beyond its rank's box is copied to each
 // rank whose box it overlaps (Rcb::overlapping), by a Migration plan kept until the next
 // rebuild; every cycle the copies' state moves along it; (3) on a rebuild, candidate
