@@ -4,6 +4,7 @@
 // what keeps results independent of the partition.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <experimental/simd>
 #if defined(__AVX__)
@@ -108,6 +109,79 @@ inline void stream_fence() {
 #if defined(__SSE__)
   _mm_sfence();
 #endif
+}
+
+// Gathers four consecutive doubles from `width` records and transposes them:
+// out[a][l] = p[stride * idx[l] + a], a = 0..3 (stride in doubles; each record's four
+// values 32-byte aligned). Moves values, no arithmetic. With AVX: four vector loads and
+// eight shuffles instead of sixteen scalar loads.
+inline void gather4(const double* p, int stride, const int* idx, vdouble (&out)[4]) {
+#if defined(__AVX__)
+  if constexpr (width == 4) {
+    const __m256d r0 = _mm256_load_pd(p + static_cast<std::ptrdiff_t>(stride) * idx[0]);
+    const __m256d r1 = _mm256_load_pd(p + static_cast<std::ptrdiff_t>(stride) * idx[1]);
+    const __m256d r2 = _mm256_load_pd(p + static_cast<std::ptrdiff_t>(stride) * idx[2]);
+    const __m256d r3 = _mm256_load_pd(p + static_cast<std::ptrdiff_t>(stride) * idx[3]);
+    const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
+    const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+    out[0] = vdouble(_mm256_permute2f128_pd(t0, t2, 0x20));
+    out[1] = vdouble(_mm256_permute2f128_pd(t1, t3, 0x20));
+    out[2] = vdouble(_mm256_permute2f128_pd(t0, t2, 0x31));
+    out[3] = vdouble(_mm256_permute2f128_pd(t1, t3, 0x31));
+    return;
+  }
+#endif
+  for (int a = 0; a < 4; ++a)
+    out[a] = vdouble([&](auto l) { return p[static_cast<std::ptrdiff_t>(stride) * idx[l] + a]; });
+}
+
+// Bit l set when lane l's sign bit is set (x < y exactly when x - y is negative, for
+// finite values).
+inline unsigned negative_lanes(const vdouble& v) {
+#if defined(__AVX__)
+  if constexpr (width == 4)
+    return static_cast<unsigned>(_mm256_movemask_pd(static_cast<__m256d>(v)));
+#endif
+  unsigned bits = 0;
+  for (int l = 0; l < width; ++l) bits |= std::signbit(static_cast<double>(v[l])) ? 1u << l : 0u;
+  return bits;
+}
+
+// Appends the entries idx[l] whose bit l is set to dst, in lane order, and returns how
+// many (dst must have room for `width` entries: all are written).
+inline int compress_store(unsigned bits, const int* idx, int* dst) {
+#if defined(__AVX__)
+  if constexpr (width == 4) {
+    // One byte shuffle per mask value: the selected 32-bit lanes moved to the front.
+    alignas(16) static constexpr unsigned char lut[16][16] = {
+        {0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3},
+        {0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3},
+        {4, 5, 6, 7, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3},
+        {0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 0, 1, 2, 3},
+        {8, 9, 10, 11, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3},
+        {0, 1, 2, 3, 8, 9, 10, 11, 0, 1, 2, 3, 0, 1, 2, 3},
+        {4, 5, 6, 7, 8, 9, 10, 11, 0, 1, 2, 3, 0, 1, 2, 3},
+        {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 0, 1, 2, 3},
+        {12, 13, 14, 15, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3},
+        {0, 1, 2, 3, 12, 13, 14, 15, 0, 1, 2, 3, 0, 1, 2, 3},
+        {4, 5, 6, 7, 12, 13, 14, 15, 0, 1, 2, 3, 0, 1, 2, 3},
+        {0, 1, 2, 3, 4, 5, 6, 7, 12, 13, 14, 15, 0, 1, 2, 3},
+        {8, 9, 10, 11, 12, 13, 14, 15, 0, 1, 2, 3, 0, 1, 2, 3},
+        {0, 1, 2, 3, 8, 9, 10, 11, 12, 13, 14, 15, 0, 1, 2, 3},
+        {4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 0, 1, 2, 3},
+        {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15}};
+    const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(idx));
+    const __m128i s = _mm_load_si128(reinterpret_cast<const __m128i*>(lut[bits & 15u]));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(dst), _mm_shuffle_epi8(v, s));
+    return __builtin_popcount(bits & 15u);
+  }
+#endif
+  int c = 0;
+  for (int l = 0; l < width; ++l) {
+    dst[c] = idx[l];
+    c += (bits >> l) & 1u;
+  }
+  return c;
 }
 
 // v <- (m ? v : other) per lane; the scalar overload lets one template serve a vector

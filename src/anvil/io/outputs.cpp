@@ -477,6 +477,7 @@ void Outputs::write_summary(int status, const std::string& message) {
     j["sph"] = {{"cycles", sph_stats.cycles},
                 {"rebalances", sph_stats.rebalances},
                 {"migrations", sph_stats.migrations},
+                {"list_builds", sph_stats.list_builds},
                 {"count_imbalance_last", sph_stats.imbalance},
                 {"count_imbalance_max", sph_stats.imbalance_max},
                 {"seconds_compute", sph_seconds[0]},

@@ -1,6 +1,7 @@
 #include "anvil/sph/forces.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "anvil/core/simd.hpp"
@@ -23,7 +24,8 @@ inline double lane_sum(const vdouble& v) {
 
 // kernel_fast for `width` pairs at once (the same operations per lane).
 template <KernelType K, int D>
-inline void kernel_simd(const vdouble& r, const vdouble& h, vdouble& w, vdouble& dwr) {
+[[gnu::always_inline]] inline void kernel_simd(const vdouble& r, const vdouble& h, vdouble& w,
+                                               vdouble& dwr) {
   const vdouble ih = 1.0 / h, q = r * ih;
   const vdouble ihd = D == 1 ? ih : (D == 2 ? ih * ih : ih * ih * ih);
   const vdouble s = kernel_norm<K, D>() * ihd;
@@ -137,79 +139,110 @@ bool invert3(const double B[3][3], double inv[3][3], double tol) {
   return true;
 }
 
+// The same value of a set parameter for every set (then a pair's mean is that value,
+// bit for bit, and needs no per-lane lookup).
+template <class F>
+bool uniform(std::span<const SetParams> sets, F field) {
+  for (const auto& st : sets)
+    if (field(st) != field(sets[0])) return false;
+  return true;
+}
+
+// Lane l: 1 where entry k0 + l is inside the row (k_end its end), else 0.
+inline vdouble valid_lanes(std::int64_t k0, std::int64_t k_end) {
+  const vdouble lane([](auto l) { return static_cast<double>(l); });
+  vdouble v = 0.0;
+  stdx::where(lane < static_cast<double>(k_end - k0), v) = 1.0;
+  return v;
+}
+
+// A pair's kernel value wk and dwr = (1/r) dW/dr at the mean smoothing length hb, from
+// r2 = |x_i - x_j|^2 (grad_i W_ij = dwr (x_i - x_j)). Pass 1 evaluates it and keeps dwr
+// (and wk for the artificial stress) per entry for pass 2, which forms the gradient from
+// its own dx with the same operations.
+template <KernelType K, int D>
+[[gnu::always_inline]] inline void pair_kernel(const vdouble& r2, const vdouble& hb, vdouble& wk,
+                                               vdouble& dwr) {
+  const vdouble r = stdx::max(stdx::sqrt(r2), 1e-9 * hb);
+  kernel_simd<K, D>(r, hb, wk, dwr);
+}
+
+// Monaghan's f_ij^n = (W(r_ij) / W(dp))^n of a pair, 0 where the pair's mean epsilon is
+// 0 (sets: the particles' set params; same: every set has the same epsilon, w_spacing
+// and exponent).
+template <KernelType K, int D>
+inline vdouble artificial_factor(const vdouble& wk, const vdouble& hb, const SetParams& si,
+                                 std::span<const SetParams> sets, const int* set, const int* idx,
+                                 bool same) {
+  auto mean = [&](auto field) {
+    return same ? vdouble(field(si))
+                : 0.5 * (field(si) + vdouble([&](auto l) {
+                           return field(sets[static_cast<std::size_t>(set[idx[l]])]);
+                         }));
+  };
+  vdouble fn = 0.0;
+  const vdouble eps = mean([](const SetParams& st) { return st.epsilon; });
+  if (stdx::any_of(eps > 0.0)) {
+    const vdouble ws = mean([](const SetParams& st) { return st.w_spacing; });
+    const vdouble ex = mean([](const SetParams& st) { return st.exponent; });
+    const vdouble hd = D == 1 ? hb : (D == 2 ? hb * hb : hb * hb * hb);
+    const vdouble t = wk * hd / (kernel_norm<K, D>() * ws);
+    const vdouble t2 = t * t;
+    vdouble f = t2 * t2;
+    if (stdx::any_of(ex != 4.0))
+      f = vdouble([&](auto l) { return ex[l] == 4.0 ? f[l] : std::pow(t[l], ex[l]); });
+    stdx::where(eps > 0.0, fn) = f;
+  }
+  return fn;
+}
+
 // Pass 1's pair loop for one kernel (the kernel is a template parameter so that the
 // loop has no per-pair branch on it).
 template <KernelType K, int D>
-void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, const NeighbourList& nl,
-                      double dt, SphWorkspace& w) {
+void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double dt,
+                      SphWorkspace& w) {
   const std::size_t n = p.n_local;
   const NeighbourRead1* rd = w.read1.data();
-  bool any_epsilon = false;
-  for (const auto& st : sets) any_epsilon = any_epsilon || st.epsilon > 0;
+  const double* rdp = rd->x;
+  constexpr int stride = sizeof(NeighbourRead1) / sizeof(double);
+  const NeighbourList& nl = w.nl;
+  bool keep_w = false; // pass 2 needs W for the artificial stress
+  for (const auto& st : sets) keep_w = keep_w || st.epsilon > 0;
   for (std::size_t i = 0; i < n; ++i) {
     const NeighbourRead1& pi = rd[i];
-    const SetParams& si = sets[static_cast<std::size_t>(pi.set)];
+    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
     // The pairs, `width` at a time (lane l takes the entries k0 + l): each lane sums its
     // entries in list order and the lanes are added in lane order at the end, so the
-    // sums depend only on the list, which is the same on every rank.
+    // sums depend only on the list, which is the same on every rank. Entries past the
+    // row's end are i itself: zero distance, so zero gradient and no contribution to the
+    // gradient sums (the summation density masks them).
     vdouble Lv[3][3], Bv[3][3], sum_mw = 0.0;
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) Lv[a][b] = Bv[a][b] = 0.0;
     const vdouble xi[3] = {pi.x[0], pi.x[1], pi.x[2]}, vi[3] = {pi.v[0], pi.v[1], pi.v[2]};
-    const std::int64_t k_end = nl.start[i + 1];
-    for (std::int64_t k0 = nl.start[i]; k0 < k_end; k0 += width) {
-      int idx[width];
-      for (int l = 0; l < width; ++l)
-        idx[l] = k0 + l < k_end ? nl.index[static_cast<std::size_t>(k0 + l)] : static_cast<int>(i);
-      auto get = [&](auto field) { return vdouble([&](auto l) { return field(rd[idx[l]]); }); };
-      const vdouble valid([&](auto l) { return k0 + static_cast<int>(l) < k_end ? 1.0 : 0.0; });
+    const std::int64_t k_begin = nl.start[i], k_end = k_begin + nl.len[i];
+    for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
+      const int* idx = nl.index.data() + k0;
+      vdouble q0[4], q1[4];
+      simd::gather4(rdp, stride, idx, q0);     // x, h
+      simd::gather4(rdp + 4, stride, idx, q1); // v, volume
       vdouble dx[3];
-      for (int a = 0; a < 3; ++a)
-        dx[a] = xi[a] - get([a](const NeighbourRead1& r) { return r.x[a]; });
-      const vdouble hb = 0.5 * (pi.h + get([](const NeighbourRead1& r) { return r.h; }));
-      const vdouble r =
-          stdx::max(stdx::sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]), 1e-9 * hb);
+      for (int a = 0; a < 3; ++a) dx[a] = xi[a] - q0[a];
+      const vdouble hb = 0.5 * (pi.h + q0[3]);
       vdouble wk, dwr;
-      kernel_simd<K, D>(r, hb, wk, dwr);
+      pair_kernel<K, D>(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2], hb, wk, dwr);
       const vdouble g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
-      vdouble fn = 0.0;
-      if (any_epsilon) {
-        const vdouble eps = 0.5 * (si.epsilon + get([&](const NeighbourRead1& q) {
-                                     return sets[static_cast<std::size_t>(q.set)].epsilon;
-                                   }));
-        if (stdx::any_of(eps > 0.0)) {
-          const vdouble ws = 0.5 * (si.w_spacing + get([&](const NeighbourRead1& q) {
-                                      return sets[static_cast<std::size_t>(q.set)].w_spacing;
-                                    }));
-          const vdouble ex = 0.5 * (si.exponent + get([&](const NeighbourRead1& q) {
-                                      return sets[static_cast<std::size_t>(q.set)].exponent;
-                                    }));
-          const vdouble hd = D == 1 ? hb : (D == 2 ? hb * hb : hb * hb * hb);
-          const vdouble t = wk * hd / (kernel_norm<K, D>() * ws);
-          const vdouble t2 = t * t;
-          vdouble f = t2 * t2;
-          if (stdx::any_of(ex != 4.0))
-            f = vdouble([&](auto l) { return ex[l] == 4.0 ? f[l] : std::pow(t[l], ex[l]); });
-          fn = 0.0;
-          stdx::where(eps > 0.0, fn) = f;
-        }
-      }
-      for (int l = 0; l < width && k0 + l < k_end; ++l) {
-        double* pd = &w.pair[4 * static_cast<std::size_t>(k0 + l)];
-        pd[0] = g[0][l];
-        pd[1] = g[1][l];
-        pd[2] = g[2][l];
-        pd[3] = fn[l];
-      }
+      simd::store(dwr, w.dwr.data() + k0);
+      if (keep_w) simd::store(wk, w.wk.data() + k0);
       // Volume weights V_j = m_j / rho_j: consistent across density jumps (a gas
-      // interface, particles of different sets). Padding lanes weigh nothing.
-      const vdouble vj = valid * get([](const NeighbourRead1& q) { return q.volume; });
+      // interface, particles of different sets).
+      const vdouble vj = q1[3];
       vdouble dv[3];
-      for (int a = 0; a < 3; ++a)
-        dv[a] = vj * (get([a](const NeighbourRead1& q) { return q.v[a]; }) - vi[a]);
+      for (int a = 0; a < 3; ++a) dv[a] = vj * (q1[a] - vi[a]);
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) Lv[a][b] += dv[a] * g[b];
-      if (si.summation) sum_mw += valid * get([](const NeighbourRead1& q) { return q.mass; }) * wk;
+      if (si.summation)
+        sum_mw += valid_lanes(k0, k_end) * vdouble([&](auto l) { return p.mass[idx[l]]; }) * wk;
       if (si.corrected)
         for (int a = 0; a < 3; ++a)
           for (int b = 0; b < 3; ++b) Bv[a][b] -= (vj * dx[a]) * g[b];
@@ -256,7 +289,7 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, const N
     // integrated rate drifts from it, and the pressure with it; docs/sph.md, Sod).
     const double tr = (d[0] + d[1] + d[2]) * dt;
     if (si.summation) {
-      p.rho[i] = lane_sum(sum_mw) + pi.mass * self_weight<K, D>(pi.h);
+      p.rho[i] = lane_sum(sum_mw) + p.mass[i] * self_weight<K, D>(pi.h);
     } else {
       p.rho[i] = p.rho[i] * (1 - 0.5 * tr) / (1 + 0.5 * tr);
     }
@@ -279,9 +312,8 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, const N
 } // namespace
 
 void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelType kernel,
-                    const NeighbourList& nl, double dt, SphWorkspace& w) {
+                    const NeighbourList& candidates, double dt, SphWorkspace& w) {
   const std::size_t n = p.n_local;
-  w.pair.resize(4 * nl.pairs());
   for (auto& d : w.d) d.resize(n);
   w.power_old.resize(n);
   w.energy_pred.resize(n);
@@ -295,24 +327,27 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
       r.x[a] = p.x[a][i];
       r.v[a] = p.v[a][i];
     }
-    r.volume = p.mass[i] / p.rho[i];
-    r.mass = p.mass[i];
     r.h = p.h[i];
-    r.set = p.set[i];
+    r.volume = p.mass[i] / p.rho[i];
   }
+  filter_neighbours(w.read1.data()->x, sizeof(NeighbourRead1) / sizeof(double), candidates, w.nl);
+  w.dwr.resize(static_cast<std::size_t>(w.nl.start[n]));
+  bool any_epsilon = false;
+  for (const auto& st : sets) any_epsilon = any_epsilon || st.epsilon > 0;
+  if (any_epsilon) w.wk.resize(w.dwr.size());
   const int dim = sets.empty() ? 3 : sets[0].dimensions;
   if (kernel == KernelType::cubic_spline) {
     if (dim == 1)
-      kinematics_pairs<KernelType::cubic_spline, 1>(p, sets, nl, dt, w);
+      kinematics_pairs<KernelType::cubic_spline, 1>(p, sets, dt, w);
     else if (dim == 2)
-      kinematics_pairs<KernelType::cubic_spline, 2>(p, sets, nl, dt, w);
+      kinematics_pairs<KernelType::cubic_spline, 2>(p, sets, dt, w);
     else
-      kinematics_pairs<KernelType::cubic_spline, 3>(p, sets, nl, dt, w);
+      kinematics_pairs<KernelType::cubic_spline, 3>(p, sets, dt, w);
   } else {
     if (dim == 2)
-      kinematics_pairs<KernelType::wendland_c2, 2>(p, sets, nl, dt, w);
+      kinematics_pairs<KernelType::wendland_c2, 2>(p, sets, dt, w);
     else
-      kinematics_pairs<KernelType::wendland_c2, 3>(p, sets, nl, dt, w);
+      kinematics_pairs<KernelType::wendland_c2, 3>(p, sets, dt, w);
   }
 
   // Constitutive update through the batch interface, one run of a set's particles at a
@@ -372,76 +407,99 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
 namespace {
 
 // Pass 2's pair loop; Corr: some set normalises its gradient (P is not symmetric).
-template <bool Corr>
-void forces_pairs(const SphView& p, const NeighbourList& nl, SphWorkspace& w, SphResult& res) {
+template <KernelType K, int D, bool Corr>
+void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspace& w,
+                  SphResult& res) {
+  using R2 = NeighbourRead2;
   const std::size_t n = p.n_local;
-  const NeighbourRead2* rd = w.read2.data();
+  const NeighbourList& nl = w.nl;
+  const R2* rd = w.read2.data();
+  const double* rdp = rd->a;
+  constexpr int stride = sizeof(R2) / sizeof(double);
+  const bool same_visc = uniform(sets, [](const SetParams& st) {
+    return std::array<double, 2>{st.alpha, st.beta};
+  });
+  bool any_epsilon = false;
+  for (const auto& st : sets) any_epsilon = any_epsilon || st.epsilon > 0;
+  const bool same_as = uniform(sets, [](const SetParams& st) {
+    return std::array<double, 3>{st.epsilon, st.w_spacing, st.exponent};
+  });
   for (std::size_t i = 0; i < n; ++i) {
-    const NeighbourRead2& pi = rd[i];
+    const double* pi = rd[i].a;
+    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
     // The pairs `width` at a time, lanes summed in lane order at the end (see pass 1).
+    // Entries past the row's end (i itself) have zero gradients and no approach: they
+    // add nothing.
     vdouble accv[3] = {0.0, 0.0, 0.0}, dev = 0.0, mumv = 0.0;
-    const std::int64_t k_end = nl.start[i + 1];
-    for (std::int64_t k0 = nl.start[i]; k0 < k_end; k0 += width) {
-      int idx[width];
-      for (int l = 0; l < width; ++l)
-        idx[l] = k0 + l < k_end ? nl.index[static_cast<std::size_t>(k0 + l)] : static_cast<int>(i);
-      auto get = [&](auto field) { return vdouble([&](auto l) { return field(rd[idx[l]]); }); };
-      auto pair = [&](int c) {
-        return vdouble([&](auto l) {
-          return k0 + static_cast<int>(l) < k_end ? w.pair[4 * static_cast<std::size_t>(k0 + l) + c]
-                                                  : 0.0;
-        });
-      };
-      const vdouble g[3] = {pair(0), pair(1), pair(2)};
-      const vdouble fn = pair(3);
+    const std::int64_t k_begin = nl.start[i], k_end = k_begin + nl.len[i];
+    for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
+      const int* idx = nl.index.data() + k0;
+      vdouble qx[4], qv[4], qr[4], qs[4], qt[4], qu[4] = {0.0, 0.0, 0.0, 0.0};
+      simd::gather4(rdp + R2::x, stride, idx, qx);                      // x, h
+      simd::gather4(rdp + R2::v, stride, idx, qv);                      // v, c
+      simd::gather4(rdp + R2::rho, stride, idx, qr);                    // rho, 1/rho, m, has_r
+      simd::gather4(rdp + R2::S, stride, idx, qs);                      // S0..S3
+      simd::gather4(rdp + R2::S + 4, stride, idx, qt);                  // S4..S7
+      if constexpr (Corr) simd::gather4(rdp + R2::S8, stride, idx, qu); // S8, R4, R5
       vdouble dx[3], dv[3];
       for (int a = 0; a < 3; ++a) {
-        dx[a] = pi.x[a] - get([a](const NeighbourRead2& q) { return q.x[a]; });
-        dv[a] = pi.v[a] - get([a](const NeighbourRead2& q) { return q.v[a]; });
+        dx[a] = pi[R2::x + a] - qx[a];
+        dv[a] = pi[R2::v + a] - qv[a];
       }
+      const vdouble hb = 0.5 * (pi[R2::h] + qx[3]);
+      const vdouble r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
+      const vdouble dwr = simd::load(w.dwr.data() + k0);
+      const vdouble g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
+      const vdouble fn = any_epsilon ? artificial_factor<K, D>(simd::load(w.wk.data() + k0), hb, si,
+                                                               sets, p.set, idx, same_as)
+                                     : vdouble(0.0);
       const vdouble vr = dv[0] * dx[0] + dv[1] * dx[1] + dv[2] * dx[2];
       vdouble visc = 0.0;
       const auto approaching = vr < 0.0;
       if (stdx::any_of(approaching)) {
-        const vdouble hb = 0.5 * (pi.h + get([](const NeighbourRead2& q) { return q.h; }));
-        const vdouble r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
         const vdouble mu = hb * vr / (r2 + 0.01 * hb * hb);
-        const vdouble cb = 0.5 * (pi.c + get([](const NeighbourRead2& q) { return q.c; }));
+        const vdouble cb = 0.5 * (pi[R2::c] + qv[3]);
+        vdouble qa[4];
+        if (same_visc) {
+          qa[0] = pi[R2::alpha];
+          qa[1] = pi[R2::beta];
+        } else {
+          simd::gather4(rdp + R2::alpha, stride, idx, qa);
+        }
         // Pi_ij = (-alpha c mu + beta mu^2) / rho_ij with rho_ij = (rho_i + rho_j) / 2.
-        const vdouble pv =
-            (-(pi.alpha + get([](const NeighbourRead2& q) { return q.alpha; })) * cb * mu +
-             (pi.beta + get([](const NeighbourRead2& q) { return q.beta; })) * mu * mu) /
-            (pi.rho + get([](const NeighbourRead2& q) { return q.rho; }));
+        const vdouble pv = (-(pi[R2::alpha] + qa[0]) * cb * mu + (pi[R2::beta] + qa[1]) * mu * mu) /
+                           (pi[R2::rho] + qr[0]);
         stdx::where(approaching, visc) = pv;
         stdx::where(approaching, mumv) = stdx::max(mumv, -mu);
       }
-      const vdouble irr = pi.inv_rho * get([](const NeighbourRead2& q) { return q.inv_rho; });
+      const vdouble irr = pi[R2::inv_rho] * qr[1];
       // T = (P_i + P_j + f^n (R_i + R_j)) / (rho_i rho_j) - Pi I; T[6..8] (yx zy zx)
       // differ from T[3..5] only where a gradient is normalised (Corr).
       constexpr int nt = Corr ? 9 : 6;
+      const vdouble Sj[9] = {qs[0], qs[1], qs[2], qs[3], qt[0], qt[1], qt[2], qt[3], qu[0]};
       vdouble T[nt];
-      for (int c = 0; c < nt; ++c)
-        T[c] = (pi.S[c] + get([c](const NeighbourRead2& q) { return q.S[c]; })) * irr;
+      for (int c = 0; c < nt; ++c) T[c] = (pi[R2::S + c] + Sj[c]) * irr;
       vdouble rg = 0.0;
-      if (stdx::any_of(fn > 0.0) && (pi.has_r || stdx::any_of(get([](const NeighbourRead2& q) {
-                                                                return q.has_r ? 1.0 : 0.0;
-                                                              }) > 0.0))) {
+      if (stdx::any_of(fn > 0.0) && (pi[R2::has_r] != 0.0 || stdx::any_of(qr[3] > 0.0))) {
+        vdouble qR[4];
+        simd::gather4(rdp + R2::R, stride, idx, qR);
+        if constexpr (!Corr) simd::gather4(rdp + R2::S8, stride, idx, qu);
+        const vdouble Rj[6] = {qR[0], qR[1], qR[2], qR[3], qu[1], qu[2]};
+        const double Ri[6] = {pi[R2::R],     pi[R2::R + 1], pi[R2::R + 2],
+                              pi[R2::R + 3], pi[R2::R45],   pi[R2::R45 + 1]};
         const vdouble fi = fn * irr;
-        for (int c = 0; c < 6; ++c)
-          T[c] += fi * (pi.R[c] + get([c](const NeighbourRead2& q) { return q.R[c]; }));
+        for (int c = 0; c < 6; ++c) T[c] += fi * (Ri[c] + Rj[c]);
         if constexpr (Corr)
-          for (int c = 6; c < 9; ++c)
-            T[c] += fi * (pi.R[c - 3] + get([c](const NeighbourRead2& q) { return q.R[c - 3]; }));
+          for (int c = 6; c < 9; ++c) T[c] += fi * (Ri[c - 3] + Rj[c - 3]);
         // The artificial stress's own work on particle i (the stress's is in pass 1).
-        rg = fi * (dv[0] * (pi.R[0] * g[0] + pi.R[3] * g[1] + pi.R[5] * g[2]) +
-                   dv[1] * (pi.R[3] * g[0] + pi.R[1] * g[1] + pi.R[4] * g[2]) +
-                   dv[2] * (pi.R[5] * g[0] + pi.R[4] * g[1] + pi.R[2] * g[2]));
+        rg = fi * (dv[0] * (Ri[0] * g[0] + Ri[3] * g[1] + Ri[5] * g[2]) +
+                   dv[1] * (Ri[3] * g[0] + Ri[1] * g[1] + Ri[4] * g[2]) +
+                   dv[2] * (Ri[5] * g[0] + Ri[4] * g[1] + Ri[2] * g[2]));
       }
       T[0] -= visc;
       T[1] -= visc;
       T[2] -= visc;
-      // Padding lanes have zero kernel gradients: they add nothing.
-      const vdouble mj = get([](const NeighbourRead2& q) { return q.mass; });
+      const vdouble mj = qr[2];
       const int yx = Corr ? 6 : 3, zy = Corr ? 7 : 4, zx = Corr ? 8 : 5;
       accv[0] += mj * (T[0] * g[0] + T[3] * g[1] + T[5] * g[2]);
       accv[1] += mj * (T[yx] * g[0] + T[1] * g[1] + T[4] * g[2]);
@@ -454,16 +512,17 @@ void forces_pairs(const SphView& p, const NeighbourList& nl, SphWorkspace& w, Sp
     const double de = lane_sum(dev);
     double mu_max = 0;
     for (int l = 0; l < width; ++l) mu_max = std::max(mu_max, static_cast<double>(mumv[l]));
-    for (int a = 0; a < 3; ++a) p.force[a][i] = pi.mass * acc[a];
+    for (int a = 0; a < 3; ++a) p.force[a][i] = pi[R2::mass] * acc[a];
     p.energy_rate[i] = de;
-    const double ci = pi.c;
-    const double dt = courant * pi.h / (ci + 1.2 * (pi.alpha * ci + pi.beta * mu_max));
+    const double ci = pi[R2::c];
+    const double dt =
+        courant * pi[R2::h] / (ci + 1.2 * (pi[R2::alpha] * ci + pi[R2::beta] * mu_max));
     if (dt < res.dt_stable || (dt == res.dt_stable && p.gid[i] < res.stable_gid)) {
       res.dt_stable = dt;
       res.stable_gid = p.gid[i];
     }
     const bool finite = std::isfinite(acc[0]) && std::isfinite(acc[1]) && std::isfinite(acc[2]) &&
-                        std::isfinite(p.stress[0][i]) && std::isfinite(pi.rho);
+                        std::isfinite(p.stress[0][i]) && std::isfinite(pi[R2::rho]);
     if (!finite && (res.nonfinite_gid < 0 || p.gid[i] < res.nonfinite_gid))
       res.nonfinite_gid = p.gid[i];
   }
@@ -471,37 +530,57 @@ void forces_pairs(const SphView& p, const NeighbourList& nl, SphWorkspace& w, Sp
 
 } // namespace
 
-void sph_forces(const SphView& p, std::span<const SetParams> sets, const NeighbourList& nl,
+void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType kernel,
                 SphWorkspace& w, SphResult& res) {
+  using R2 = NeighbourRead2;
   w.read2.resize(p.n_all);
   for (std::size_t i = 0; i < p.n_all; ++i) {
-    NeighbourRead2& r = w.read2[i];
+    double* r = w.read2[i].a;
     const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
     for (int a = 0; a < 3; ++a) {
-      r.x[a] = p.x[a][i];
-      r.v[a] = p.v[a][i];
+      r[R2::x + a] = p.x[a][i];
+      r[R2::v + a] = p.v[a][i];
     }
-    r.mass = p.mass[i];
-    r.rho = p.rho[i];
-    r.inv_rho = 1 / p.rho[i];
-    r.h = p.h[i];
-    r.c = p.wave_speed[i];
-    r.alpha = si.alpha;
-    r.beta = si.beta;
+    r[R2::h] = p.h[i];
+    r[R2::c] = p.wave_speed[i];
+    r[R2::rho] = p.rho[i];
+    r[R2::inv_rho] = 1 / p.rho[i];
+    r[R2::mass] = p.mass[i];
+    for (int c = 0; c < 8; ++c) r[R2::S + c] = p.S[c][i];
+    r[R2::S8] = p.S[8][i];
     int any = 0;
-    for (int c = 0; c < 9; ++c) r.S[c] = p.S[c][i];
-    for (int c = 0; c < 6; ++c) {
-      r.R[c] = p.R[c][i];
-      any |= p.R[c][i] != 0.0;
-    }
-    r.has_r = any;
+    for (int c = 0; c < 6; ++c) any |= p.R[c][i] != 0.0;
+    for (int c = 0; c < 4; ++c) r[R2::R + c] = p.R[c][i];
+    r[R2::R45] = p.R[4][i];
+    r[R2::R45 + 1] = p.R[5][i];
+    r[R2::has_r] = any ? 1.0 : 0.0;
+    r[R2::alpha] = si.alpha;
+    r[R2::beta] = si.beta;
+    r[R2::S8 + 3] = r[R2::beta + 1] = r[R2::beta + 2] = 0; // unused
   }
   bool any_corrected = false;
   for (const auto& st : sets) any_corrected = any_corrected || st.corrected;
-  if (any_corrected)
-    forces_pairs<true>(p, nl, w, res);
-  else
-    forces_pairs<false>(p, nl, w, res);
+  const int dim = sets.empty() ? 3 : sets[0].dimensions;
+  auto run = [&]<KernelType K, int D>() {
+    if (any_corrected)
+      forces_pairs<K, D, true>(p, sets, w, res);
+    else
+      forces_pairs<K, D, false>(p, sets, w, res);
+  };
+  using enum KernelType;
+  if (kernel == cubic_spline) {
+    if (dim == 1)
+      run.template operator()<cubic_spline, 1>();
+    else if (dim == 2)
+      run.template operator()<cubic_spline, 2>();
+    else
+      run.template operator()<cubic_spline, 3>();
+  } else {
+    if (dim == 2)
+      run.template operator()<wendland_c2, 2>();
+    else
+      run.template operator()<wendland_c2, 3>();
+  }
 }
 
 } // namespace anvil::sph

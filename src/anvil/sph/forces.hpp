@@ -25,9 +25,9 @@
 //
 // W is evaluated at the mean smoothing length h_ij = (h_i + h_j)/2, so grad_i W_ij =
 // -grad_j W_ji and the pair forces cancel exactly (momentum is conserved to round-off).
-// Every sum over neighbours is a function of the neighbour list alone (see neighbours.hpp
-// for its order): the pair loops run simd::width entries at a time, lane l summing the
-// entries l, l + width, ... in list order, and the lanes are added in lane order.
+// Every sum over neighbours is a function of the neighbour list alone (ascending global
+// id, neighbours.hpp): the pair loops run simd::width entries at a time, lane l summing
+// the entries l, l + width, ... in list order, and the lanes are added in lane order.
 #pragma once
 
 #include <cmath>
@@ -97,41 +97,44 @@ struct SphResult {
   std::int64_t nonfinite_gid = -1; // smallest gid with a non-finite force or state, or -1
 };
 
-// What one pass reads of a neighbour, packed per particle (one or a few cache lines
-// instead of one per array): built for own and ghost particles at the start of a pass.
-struct NeighbourRead1 {
-  double x[3], v[3];
-  double volume; // m / rho
-  double mass;
-  double h;
-  int set;
+// What one pass reads of a neighbour, packed per particle in groups of four doubles
+// (simd::gather4 loads a group of `width` neighbours and transposes it: vector loads
+// instead of lane-by-lane gathers): built for own and ghost particles at the start of a
+// pass.
+struct alignas(64) NeighbourRead1 {
+  double x[3], h;
+  double v[3], volume; // m / rho
 };
-struct NeighbourRead2 {
-  double x[3], v[3];
-  double mass, rho, inv_rho, h, c;
-  double alpha, beta; // the particle's set's viscosity coefficients
-  double S[9], R[6];
-  int has_r; // R is not zero
+// Pass 2's record, by offsets (groups of four): the common path reads the first five
+// groups, a normalised gradient the sixth, the artificial stress the sixth and seventh,
+// sets of different viscosity the eighth.
+struct alignas(64) NeighbourRead2 {
+  static constexpr int x = 0, h = 3, v = 4, c = 7, rho = 8, inv_rho = 9, mass = 10, has_r = 11,
+                       S = 12, S8 = 20, R45 = 21, R = 24, alpha = 28, beta = 29;
+  double a[32];
 };
 
 // Scratch kept between cycles (the cycle allocates nothing in steady state).
 struct SphWorkspace {
   std::vector<NeighbourRead1> read1;
   std::vector<NeighbourRead2> read2;
-  std::vector<double> pair;        // per neighbour entry: grad W (3), f^n
+  NeighbourList nl;                // this step's neighbours (filtered candidates)
+  std::vector<double> dwr, wk;     // per entry of nl: (1/r) dW/dr and (artificial stress) W
   std::vector<double> d[6];        // rate of deformation of own particles
   std::vector<double> binv;        // B^-1 of own particles, 9 per particle (row-major)
   std::vector<double> power_old;   // rotated old stress : D
   std::vector<double> energy_pred; // e predicted at the new state (equations of state)
 };
 
-// Pass 1 over own particles, over the interval dt (the previous step). Also fills the
-// pair data (kernel gradients) that pass 2 reuses.
+// Pass 1 over own particles, over the interval dt (the previous step): selects this
+// step's neighbours among the candidate lists (work.nl: the candidates within the
+// kernel's support at the current positions and h) and keeps each entry's kernel
+// derivative for pass 2. The candidates must hold every pair within the support.
 void sph_kinematics(const SphView& v, std::span<const SetParams> sets, KernelType kernel,
-                    const NeighbourList& nl, double dt, SphWorkspace& work);
+                    const NeighbourList& candidates, double dt, SphWorkspace& work);
 
-// Pass 2 over own particles: forces at t(n), energy rates, stable step.
-void sph_forces(const SphView& v, std::span<const SetParams> sets, const NeighbourList& nl,
+// Pass 2 over own particles, over work.nl: forces at t(n), energy rates, stable step.
+void sph_forces(const SphView& v, std::span<const SetParams> sets, KernelType kernel,
                 SphWorkspace& work, SphResult& result);
 
 // Smoothing length at density rho: h0 (rho0 / rho)^(1/d) (constant mass in the support).

@@ -8,41 +8,19 @@
 
 namespace anvil::sph {
 
-namespace {
-
-// Entries of each cell in ascending gid. The input order is made of a few ascending runs
-// (own particles, then the ghosts of each sending rank), so insertion sort is near linear.
-void sort_cells_by_gid(std::span<const std::int64_t> gid, std::span<const int> start,
-                       std::vector<int>& order) {
-  for (std::size_t c = 0; c + 1 < start.size(); ++c) {
-    for (int k = start[c] + 1; k < start[c + 1]; ++k) {
-      const int p = order[static_cast<std::size_t>(k)];
-      const std::int64_t g = gid[static_cast<std::size_t>(p)];
-      int m = k - 1;
-      while (m >= start[c] &&
-             gid[static_cast<std::size_t>(order[static_cast<std::size_t>(m)])] > g) {
-        order[static_cast<std::size_t>(m + 1)] = order[static_cast<std::size_t>(m)];
-        --m;
-      }
-      order[static_cast<std::size_t>(m + 1)] = p;
-    }
-  }
-}
-
-} // namespace
-
-void find_neighbours(std::span<const double> x, std::span<const double> y,
-                     std::span<const double> z, std::span<const double> h,
-                     std::span<const std::int64_t> gid, std::size_t n_query, double cell,
-                     NeighbourWorkspace& w, NeighbourList& out) {
+void find_candidates(std::span<const double> x, std::span<const double> y,
+                     std::span<const double> z, std::span<const std::int64_t> gid,
+                     std::size_t n_query, double radius, NeighbourWorkspace& w,
+                     NeighbourList& out) {
   const std::size_t n = x.size();
   out.start.assign(n_query + 1, 0);
+  out.len.assign(n_query, 0);
   out.count = 0;
   if (n == 0 || n_query == 0) return;
-  // Cells of half the search radius: a particle's candidates lie in the 5 x 5 x 5 cells
+  // Cells of half the radius: a particle's candidates lie in the 5 x 5 x 5 cells
   // around its own (about 40% fewer than in 3 x 3 x 3 cells of the full radius).
   constexpr int reach = 2;
-  const double inv = reach / cell;
+  const double inv = reach / radius;
   // Integer cell coordinates on the global lattice and their bounding box.
   std::int64_t lo[3] = {std::numeric_limits<std::int64_t>::max(),
                         std::numeric_limits<std::int64_t>::max(),
@@ -74,7 +52,7 @@ void find_neighbours(std::span<const double> x, std::span<const double> y,
   w.order.resize(n);
   const bool dense = cells <= 8.0 * static_cast<double>(n) + 4096.0;
   if (dense) {
-    // Counting sort by cell (stable), then gid order inside each cell.
+    // Counting sort by cell (stable).
     const auto ncell = static_cast<std::size_t>(cells);
     w.cell_start.assign(ncell + 1, 0);
     for (std::size_t i = 0; i < n; ++i) ++w.cell_start[static_cast<std::size_t>(w.key[i]) + 1];
@@ -86,31 +64,27 @@ void find_neighbours(std::span<const double> x, std::span<const double> y,
     }
     for (std::size_t c = ncell; c > 0; --c) w.cell_start[c] = w.cell_start[c - 1];
     w.cell_start[0] = 0;
-    sort_cells_by_gid(gid, w.cell_start, w.order);
   } else {
-    // Sparse (particles spread far apart): sort by (cell, gid).
+    // Sparse (particles spread far apart): sort by cell.
     for (std::size_t i = 0; i < n; ++i) w.order[i] = static_cast<int>(i);
     std::sort(w.order.begin(), w.order.end(), [&](int a, int b) {
       const auto ka = w.key[static_cast<std::size_t>(a)], kb = w.key[static_cast<std::size_t>(b)];
-      return ka != kb ? ka < kb
-                      : gid[static_cast<std::size_t>(a)] < gid[static_cast<std::size_t>(b)];
+      return ka != kb ? ka < kb : a < b;
     });
     w.sorted_key.resize(n);
     for (std::size_t k = 0; k < n; ++k)
       w.sorted_key[k] = w.key[static_cast<std::size_t>(w.order[k])];
   }
-  // Positions and h in cell order: the candidate scans below read contiguous memory,
-  // `width` at a time (the padding is far away: never a neighbour).
+  // Positions in cell order: the candidate scans below read contiguous memory, `width`
+  // at a time (the padding is far away: never a candidate).
   w.xs.assign(n + simd::width, 1e300);
   w.ys.assign(n + simd::width, 1e300);
   w.zs.assign(n + simd::width, 1e300);
-  w.hs.assign(n + simd::width, 0.0);
   for (std::size_t k = 0; k < n; ++k) {
     const auto p = static_cast<std::size_t>(w.order[k]);
     w.xs[k] = x[p];
     w.ys[k] = y[p];
     w.zs[k] = z[p];
-    w.hs[k] = h[p];
   }
   // Range of sorted entries in the cells key-2 .. key+2 (a row along x).
   auto row = [&](std::int64_t key, int& b, int& e) {
@@ -125,20 +99,20 @@ void find_neighbours(std::span<const double> x, std::span<const double> y,
     }
   };
   const std::int64_t sy = dims[0], sz = dims[0] * dims[1];
-  // Entries are appended without a branch (written always, the count advanced by the
-  // test), into storage that only grows.
+  const double r2max = radius * radius;
   std::size_t pos = 0;
   for (std::size_t i = 0; i < n_query; ++i) {
-    const double xi = x[i], yi = y[i], zi = z[i], hi_ = h[i];
+    const double xi = x[i], yi = y[i], zi = z[i];
     const std::int64_t k0 = w.key[i];
+    const std::size_t row_begin = pos;
     for (int dz = -reach; dz <= reach; ++dz)
       for (int dy = -reach; dy <= reach; ++dy) {
         int b, e;
         row(k0 + dz * sz + dy * sy, b, e);
         const int m = e - b;
         if (m <= 0) continue;
-        if (pos + static_cast<std::size_t>(m) + simd::width > out.index.size())
-          out.index.resize(2 * (pos + static_cast<std::size_t>(m)) + simd::width);
+        if (pos + static_cast<std::size_t>(m) + 2 * simd::width > out.index.size())
+          out.index.resize(2 * (pos + static_cast<std::size_t>(m)) + 2 * simd::width);
         // The distance test `width` candidates at a time over the row's contiguous copies
         // (padded past the end with far-away points), then the accepted entries in order,
         // appended without a branch (written always, the count advanced by the test).
@@ -148,8 +122,7 @@ void find_neighbours(std::span<const double> x, std::span<const double> y,
           const simd::vdouble dx_ = xi - simd::load(w.xs.data() + k);
           const simd::vdouble dy_ = yi - simd::load(w.ys.data() + k);
           const simd::vdouble dz_ = zi - simd::load(w.zs.data() + k);
-          const simd::vdouble s = hi_ + simd::load(w.hs.data() + k);
-          const auto in = dx_ * dx_ + dy_ * dy_ + dz_ * dz_ < s * s;
+          const auto in = dx_ * dx_ + dy_ * dy_ + dz_ * dz_ < r2max;
           const int lanes = std::min(simd::width, e - k);
           for (int l = 0; l < lanes; ++l) {
             const int j = w.order[static_cast<std::size_t>(k + l)];
@@ -158,9 +131,52 @@ void find_neighbours(std::span<const double> x, std::span<const double> y,
           }
         }
       }
+    // Ascending gid (the rows come out in cell order), then padded with i.
+    int* row_ptr = out.index.data() + row_begin;
+    std::sort(row_ptr, out.index.data() + pos, [&](int a, int b) {
+      return gid[static_cast<std::size_t>(a)] < gid[static_cast<std::size_t>(b)];
+    });
+    out.len[i] = static_cast<int>(pos - row_begin);
+    out.count += pos - row_begin;
+    if (pos + simd::width > out.index.size()) out.index.resize(2 * pos + 2 * simd::width);
+    while (pos % simd::width != 0) out.index[pos++] = static_cast<int>(i);
     out.start[i + 1] = static_cast<std::int64_t>(pos);
   }
-  out.count = pos;
+}
+
+void filter_neighbours(const double* xh, int stride, const NeighbourList& cand,
+                       NeighbourList& out) {
+  const std::size_t n = cand.len.size();
+  out.start.resize(n + 1);
+  out.len.resize(n);
+  out.start[0] = 0;
+  // Never more entries than the candidates' (rows padded alike), plus one vector of slack
+  // for the compressing stores.
+  const std::size_t need = static_cast<std::size_t>(cand.start[n]) + simd::width;
+  if (out.index.size() < need) out.index.resize(need);
+  int* dst = out.index.data();
+  std::size_t pos = 0, count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* ri = xh + static_cast<std::ptrdiff_t>(stride) * static_cast<std::ptrdiff_t>(i);
+    const double xi = ri[0], yi = ri[1], zi = ri[2], hi_ = ri[3];
+    const std::size_t row_begin = pos;
+    const int* src = cand.index.data() + cand.start[i];
+    const int m = cand.len[i];
+    for (int k = 0; k < m; k += simd::width) {
+      simd::vdouble q[4];
+      simd::gather4(xh, stride, src + k, q);
+      const simd::vdouble dx = xi - q[0], dy = yi - q[1], dz = zi - q[2], s = hi_ + q[3];
+      unsigned bits = simd::negative_lanes((dx * dx + dy * dy + dz * dz) - s * s);
+      // Entries past the row's end are the padding (i itself): never selected.
+      if (m - k < simd::width) bits &= (1u << (m - k)) - 1u;
+      pos += static_cast<std::size_t>(simd::compress_store(bits, src + k, dst + pos));
+    }
+    out.len[i] = static_cast<int>(pos - row_begin);
+    count += pos - row_begin;
+    while (pos % simd::width != 0) dst[pos++] = static_cast<int>(i);
+    out.start[i + 1] = static_cast<std::int64_t>(pos);
+  }
+  out.count = count;
 }
 
 } // namespace anvil::sph

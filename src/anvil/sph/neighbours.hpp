@@ -1,15 +1,19 @@
-// Cell-list neighbour search for SPH, knowing nothing of MPI. Two particles are
-// neighbours when r < h_i + h_j (the support 2 h_ij of the kernel at the mean smoothing
-// length). Cells are cubes of edge cell / 2 (`cell` >= the largest h_i + h_j) on a
-// lattice anchored at the origin, cell index floor(2 x / cell): the same cells on every
-// rank.
+// Neighbour search for SPH, knowing nothing of MPI, in two stages:
 //
-// Order (the determinism rule, DESIGN.md section 3). A particle's neighbours are listed
-// by the 125 cells around its own in a fixed order (z, then y, then x offsets, -2..2)
-// and, inside a cell, in ascending global id. The order is therefore a function of the global
-// positions, ids and cell size only, not of which rank holds which particle or of the
-// order of the arrays: every rank that holds a particle and all of its neighbours (own
-// or ghost copies with the same bits) sums its neighbour terms in the same order.
+//  - candidates (Verlet lists): every particle within a fixed radius (the support plus a
+//    skin) at the positions of the build, by cell lists: cubes of edge radius / 2 on a
+//    lattice anchored at the origin, the 5 x 5 x 5 cells around a particle's own. Built
+//    only when the particles have moved too far for the lists to hold every pair within
+//    the support (the caller decides: sph_phase.cpp).
+//  - neighbours, every step: the candidates j with r_ij < h_i + h_j (the support 2 h_ij
+//    of the kernel at the mean smoothing length) at the current positions, the exact test
+//    on the current positions and h.
+//
+// Order (the determinism rule, DESIGN.md section 3): a particle's candidates, and so its
+// neighbours, are listed in ascending global id. A neighbour list is therefore a function
+// of the current global positions, h and ids alone: not of which rank holds which
+// particle, of the order of the arrays, of the skin or of when the candidates were built
+// (so a restart, which builds them afresh, continues with the same bits).
 #pragma once
 
 #include <cstdint>
@@ -18,13 +22,14 @@
 
 namespace anvil::sph {
 
-// Neighbour lists in compressed rows: particle i's neighbours are
-// index[start[i] .. start[i+1]), indices into the arrays given to the search (index may
-// be longer than the list: it keeps its size between calls).
+// Lists in padded rows: particle i's list is index[start[i] .. start[i] + len[i]); rows
+// start at multiples of simd::width and are padded to a whole number of vectors with i
+// itself (index is longer than the lists: it keeps its size between calls).
 struct NeighbourList {
-  std::vector<std::int64_t> start;
-  std::vector<int> index; // storage: only the first count() entries are the list
-  std::size_t count = 0;
+  std::vector<std::int64_t> start; // n_query + 1 row starts (the last: the end)
+  std::vector<int> len;            // entries of each row, padding excluded
+  std::vector<int> index;          // storage, padded rows
+  std::size_t count = 0;           // sum of len
   std::size_t pairs() const { return count; }
 };
 
@@ -33,16 +38,22 @@ struct NeighbourWorkspace {
   std::vector<std::int64_t> key;        // cell of each particle (dense index or packed)
   std::vector<int> cell_start;          // dense grid: first entry per cell (+1 at the end)
   std::vector<int> order;               // particles sorted by cell, then gid
-  std::vector<double> xs, ys, zs, hs;   // their positions and h in that order
+  std::vector<double> xs, ys, zs;       // their positions in that order
   std::vector<std::int64_t> sorted_key; // sparse fallback: keys in that order
 };
 
-// Finds the neighbours of particles [0, n_query) among all n = x.size() particles (the
-// query particles included; a particle is not its own neighbour). x, y, z, h, gid have
-// n entries; cell >= max over pairs of h_i + h_j and identical on every rank.
-void find_neighbours(std::span<const double> x, std::span<const double> y,
-                     std::span<const double> z, std::span<const double> h,
-                     std::span<const std::int64_t> gid, std::size_t n_query, double cell,
-                     NeighbourWorkspace& work, NeighbourList& out);
+// Candidate lists of particles [0, n_query) among all n = x.size() particles (the query
+// particles included; a particle is not its own candidate): every j with
+// |x_i - x_j| < radius, rows in ascending gid. x, y, z, gid have n entries.
+void find_candidates(std::span<const double> x, std::span<const double> y,
+                     std::span<const double> z, std::span<const std::int64_t> gid,
+                     std::size_t n_query, double radius, NeighbourWorkspace& work,
+                     NeighbourList& out);
+
+// The neighbours among the candidates: the entries j of row i with r_ij < h_i + h_j at
+// the current positions, in the candidates' order. xh holds each particle's x, y, z, h
+// at xh + stride * k (stride in doubles, 32-byte aligned): the records pass 1 reads.
+void filter_neighbours(const double* xh, int stride, const NeighbourList& candidates,
+                       NeighbourList& out);
 
 } // namespace anvil::sph

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include <fmt/format.h>
@@ -122,6 +123,7 @@ int SphPhase::find(std::int64_t gid) const {
 
 // Moves every field of every own particle to dest[i], then restores ascending gid.
 void SphPhase::migrate(std::span<const int> dest) {
+  lists_valid_ = false; // local indices change
   move_plan_.build(comm_, dest);
   const std::size_t nr = move_plan_.recv_count();
   auto move = [&](auto& field) {
@@ -225,21 +227,36 @@ void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
   const int me = comm_.rank();
   std::size_t n = p_.size();
 
-  // (1) Upkeep: one reduction of the largest count, the escape flag and the largest h.
+  // (1) Upkeep: one reduction of the largest count, the escape flag, the largest h and
+  // the largest displacement since the candidate lists were built.
+  bool rebuild = false;
   {
     ScopedPhase t(timers, Phase::sph);
     const Box3 box = rcb_.box(me);
-    double escaped = 0, hmax = 0;
+    double escaped = 0, hmax = 0, d2max = 0;
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3 x{p_.x[0][i], p_.x[1][i], p_.x[2][i]};
       escaped = box.contains(x) ? escaped : 1.0;
       hmax = std::max(hmax, p_.h[i]);
     }
-    double red[3] = {static_cast<double>(n), escaped, hmax};
-    comm_.max(std::span<double>(red, 3));
+    if (lists_valid_ && x_build_[0].size() == n)
+      for (std::size_t i = 0; i < n; ++i) {
+        const double dx = p_.x[0][i] - x_build_[0][i], dy = p_.x[1][i] - x_build_[1][i],
+                     dz = p_.x[2][i] - x_build_[2][i];
+        d2max = std::max(d2max, dx * dx + dy * dy + dz * dz);
+      }
+    else
+      d2max = std::numeric_limits<double>::infinity();
+    double red[4] = {static_cast<double>(n), escaped, hmax, d2max};
+    comm_.max(std::span<double>(red, 4));
     const double mean = static_cast<double>(global_count_) / comm_.size();
     stats_.imbalance = mean > 0 ? red[0] / mean : 1.0;
     stats_.imbalance_max = std::max(stats_.imbalance_max, stats_.imbalance);
+    // The candidate lists hold every pair closer than radius_ at the build; a pair within
+    // the support now (r < h_i + h_j <= 2 h_max) was closer than 2 h_max + 2 d_max then.
+    // The margin covers the round-off of these sums. Every rank decides alike (the
+    // inputs are reduced); the results do not depend on the decision (neighbours.hpp).
+    const bool moved_far = !(2 * red[2] + 2 * std::sqrt(red[3]) < (1 - 1e-9) * radius_);
     if (stats_.imbalance > threshold_) {
       const auto t0 = PhaseTimers::clock::now();
       {
@@ -260,7 +277,15 @@ void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
         migrate(dest_);
       }
       stats_.seconds_migrate += seconds_since(t1);
-    } else if (red[1] > 0) {
+      rebuild = true;
+    } else if (moved_far) {
+      rebuild = true;
+    }
+    // Particles that left their box move to the rank whose box holds them on a rebuild
+    // only (as LAMMPS moves atoms on re-neighbouring steps): until then the ghost plan
+    // still brings every neighbour of an escaped particle to its rank, since the
+    // particle was inside the box at the build.
+    if (rebuild && red[1] > 0 && !(stats_.imbalance > threshold_)) {
       const auto t1 = PhaseTimers::clock::now();
       ScopedPhase tr(timers, Phase::transfer);
       dest_.resize(n);
@@ -274,29 +299,33 @@ void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
     hmax_ = red[2];
   }
 
-  // (2) Ghosts: copies of the particles whose support box leaves this rank's box.
+  // (2) Ghosts: on a rebuild, copies of the particles within the candidate radius of
+  // another rank's box (a plan kept until the next rebuild); every cycle, their state.
   {
     const auto t0 = PhaseTimers::clock::now();
     ScopedPhase t(timers, Phase::transfer);
-    const double reach = support_factor * hmax_;
-    const Box3 box = rcb_.box(me);
-    ghost_src_.clear();
-    ghost_dest_.clear();
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec3 x{p_.x[0][i], p_.x[1][i], p_.x[2][i]};
-      const Box3 b{{x.x - reach, x.y - reach, x.z - reach},
-                   {x.x + reach, x.y + reach, x.z + reach}};
-      if (b.lo.x > box.lo.x && b.lo.y > box.lo.y && b.lo.z > box.lo.z && b.hi.x < box.hi.x &&
-          b.hi.y < box.hi.y && b.hi.z < box.hi.z)
-        continue;
-      rcb_.overlapping(b, ranks_);
-      for (int r : ranks_)
-        if (r != me) {
-          ghost_src_.push_back(static_cast<int>(i));
-          ghost_dest_.push_back(r);
-        }
+    if (rebuild) {
+      radius_ = 2 * support_factor * hmax_ / 2 * (1 + skin);
+      const double reach = radius_ * (1 + 1e-9);
+      const Box3 box = rcb_.box(me);
+      ghost_src_.clear();
+      ghost_dest_.clear();
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 x{p_.x[0][i], p_.x[1][i], p_.x[2][i]};
+        const Box3 b{{x.x - reach, x.y - reach, x.z - reach},
+                     {x.x + reach, x.y + reach, x.z + reach}};
+        if (b.lo.x > box.lo.x && b.lo.y > box.lo.y && b.lo.z > box.lo.z && b.hi.x < box.hi.x &&
+            b.hi.y < box.hi.y && b.hi.z < box.hi.z)
+          continue;
+        rcb_.overlapping(b, ranks_);
+        for (int r : ranks_)
+          if (r != me) {
+            ghost_src_.push_back(static_cast<int>(i));
+            ghost_dest_.push_back(r);
+          }
+      }
+      ghost_plan_.build(comm_, ghost_dest_);
     }
-    ghost_plan_.build(comm_, ghost_dest_);
     exchange_ghosts_in();
     stats_.ghosts = static_cast<std::int64_t>(in_recv_.size());
     stats_.seconds_ghosts += seconds_since(t0);
@@ -335,10 +364,14 @@ void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
   {
     const auto t0 = PhaseTimers::clock::now();
     ScopedPhase t(timers, Phase::sph);
-    find_neighbours(p_.x[0], p_.x[1], p_.x[2], p_.h, p_.gid, n, 2 * support_factor * hmax_ / 2,
-                    nwork_, nlist_);
-    stats_.pairs = static_cast<std::int64_t>(nlist_.pairs());
-    sph_kinematics(view, sets_, kernel_, nlist_, dt_prev, work_);
+    if (rebuild) {
+      find_candidates(p_.x[0], p_.x[1], p_.x[2], p_.gid, n, radius_, nwork_, candidates_);
+      for (int d = 0; d < 3; ++d) x_build_[d].assign(p_.x[d].begin(), p_.x[d].begin() + n);
+      lists_valid_ = true;
+      ++stats_.list_builds;
+    }
+    sph_kinematics(view, sets_, kernel_, candidates_, dt_prev, work_);
+    stats_.pairs = static_cast<std::int64_t>(work_.nl.pairs());
     stats_.seconds_compute += seconds_since(t0);
   }
   // (5) The ghosts' new state.
@@ -353,7 +386,7 @@ void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
     const auto t0 = PhaseTimers::clock::now();
     ScopedPhase t(timers, Phase::sph);
     result_ = SphResult{};
-    sph_forces(view, sets_, nlist_, work_, result_);
+    sph_forces(view, sets_, kernel_, work_, result_);
     resize_neighbour_fields(n);
     for (std::size_t i = 0; i < n; ++i)
       p_.h[i] = smoothing_length(sets_[static_cast<std::size_t>(p_.set[i])], p_.rho[i]);

@@ -1,21 +1,27 @@
 // The paper's SPH decomposition (cycle step 2): particles live on their own dynamic RCB
-// decomposition, independent of the FE mesh's. Each rank holds the particles inside its
-// RCB box (ascending global id) for the whole cycle: the particle phase, the velocity
-// and position updates and contact all work on them where they are.
+// decomposition, independent of the FE mesh's. Each rank holds the particles that were
+// inside its RCB box at the last list rebuild (ascending global id) for the whole cycle:
+// the particle phase, the velocity and position updates and contact all work on them
+// where they are.
 //
 // Every cycle: (1) upkeep: one reduction tells the largest particle count (the RCB is
 // recut incrementally when max/mean exceeds the threshold, and every particle migrates
-// to its new owner) and whether any particle left its box (those migrate to the rank
-// whose box now holds them); (2) ghosts: every particle whose support box (radius
-// 2 h_max) reaches beyond its rank's box is copied to each rank whose box it overlaps
-// (Rcb::overlapping), with a Migration plan reused for the second exchange of the
-// cycle; (3) neighbours by cell lists; (4) pass 1 (kinematics, stresses) on own
-// particles; (5) the ghosts' new stresses, densities and wave speeds; (6) pass 2
-// (forces). Ghost copies hold the same bits as their originals and every neighbour sum
-// runs in an order fixed by global positions and ids, so the results do not depend on
-// the number of ranks (DESIGN.md section 3).
+// to its new owner), whether any particle left its box (on a rebuild those migrate to
+// the rank whose box now holds them), the largest h and the largest displacement since
+// the candidate lists were built; (2) ghosts: on a rebuild (after a recut, or when a
+// particle may have come within the support of one its lists miss) every particle whose box of the
+// candidate radius (2 h_max plus a skin) reaches beyond its rank's box is copied to each
+// rank whose box it overlaps (Rcb::overlapping), by a Migration plan kept until the next
+// rebuild; every cycle the copies' state moves along it; (3) on a rebuild, candidate
+// lists by cell lists; (4) pass 1 (the neighbours among the candidates, kinematics,
+// stresses) on own particles; (5) the ghosts' new stresses, densities and wave speeds
+// along the same plan; (6) pass 2 (forces). Ghost copies hold the same bits as their
+// originals and every neighbour sum runs in ascending global id over exactly the pairs
+// within the support, so the results depend neither on the number of ranks (DESIGN.md
+// section 3) nor on when the lists were built.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -39,6 +45,7 @@ struct SphStats {
   std::int64_t migrations = 0;  // cycles on which escaped particles moved
   std::int64_t ghosts = 0;      // ghost copies received, this rank, last cycle
   std::int64_t pairs = 0;       // neighbour entries of own particles, this rank, last cycle
+  std::int64_t list_builds = 0; // cycles on which the candidate lists and ghost plan were built
   double imbalance = 1;         // last cycle's max/mean particle count
   double imbalance_max = 1;     // the largest seen
   double seconds_rebalance = 0; // this rank: RCB recuts
@@ -142,7 +149,15 @@ private:
   std::vector<int> tmp_i_;
   std::vector<std::uint8_t> tmp_u_;
   NeighbourWorkspace nwork_;
-  NeighbourList nlist_;
+  // Candidate (Verlet) lists, kept with the ghost plan until a particle could have come
+  // within the support of one it does not list: every pair closer than radius_ =
+  // 2 h_max (1 + skin) at the build (positions x_build_ of the own particles). The
+  // results do not depend on when they were built (neighbours.hpp).
+  static constexpr double skin = 0.2;
+  NeighbourList candidates_;
+  std::array<std::vector<double>, 3> x_build_;
+  double radius_ = 0;
+  bool lists_valid_ = false;
   SphWorkspace work_;
   SphResult result_;
   SphStats stats_;
