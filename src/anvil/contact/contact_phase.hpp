@@ -14,6 +14,7 @@
 #include <span>
 #include <vector>
 
+#include "anvil/contact/capture.hpp"
 #include "anvil/contact/penalty.hpp"
 #include "anvil/contact/search.hpp"
 #include "anvil/contact/surface.hpp"
@@ -115,6 +116,19 @@ private:
   std::vector<std::pair<std::int64_t, int>> my_face_element_; // (element gid, side)
   std::vector<std::pair<int, int>> my_face_slot_;             // (block, element index) of each face
   std::vector<int> my_face_rank_; // contact rank of the centroid, last cycle
+  // The surface's points on this rank: the owned contact nodes and the corners of the
+  // faces above (local node indices, ascending), with their predicted positions, computed
+  // once a cycle; the nodes' and the faces' corners as indices into them.
+  std::vector<int> surf_local_;
+  std::vector<double> xs_[3];
+  std::vector<int> node_point_;   // per owned contact node
+  std::vector<int> corner_[4];    // per face, padded to whole vectors: its corners' points
+  std::vector<double> depth_pad_; // per face, padded: its depth
+  FaceCaptures cap_;              // per face: mean plane and capture box of this cycle
+  // True when every node and face stays on this rank (one copy each): the search then
+  // reads the boxes from cap_ and the items in place, and only the faces in some
+  // candidate list get their positions, velocities and plane packed (pack_face).
+  bool in_place_ = false;
 
   Rcb rcb_;
   bool partitioned_ = false;
@@ -125,8 +139,7 @@ private:
   std::vector<std::int64_t> pid_;
   std::vector<ContactNodeItem> node_out_, node_in_;
   std::vector<ContactFaceItem> face_local_, face_out_, face_in_; // per face, per copy, received
-  std::vector<Vec3> face_centre_;                             // per face: centre of its mean plane
-  std::vector<int> node_dest_, face_dest_, face_src_, ranks_; // face_src_: face of each copy
+  std::vector<int> node_dest_, face_dest_, face_src_, ranks_;    // face_src_: face of each copy
   // The destinations the plans were built for (reused while nobody's have changed).
   std::vector<int> node_dest_built_, face_dest_built_, face_src_built_;
   bool plans_built_ = false;
@@ -141,6 +154,10 @@ private:
   Migration node_plan_, face_plan_, force_plan_;
   std::unique_ptr<NodeExchange> exchange_;
   ContactStats stats_;
+
+  // Writes this cycle's corners (predicted positions, velocities, masses), plane and
+  // capture box into face_local_[f].
+  void pack_face(std::size_t f, const ContactNodes& nodes);
 };
 
 } // namespace anvil
