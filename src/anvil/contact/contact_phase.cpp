@@ -281,8 +281,9 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       face_plan_.forward(face_out_, face_in_);
       search_faces_ = &face_in_;
     }
-    stats_.bytes_sent += static_cast<double>(node_out_.size() * sizeof(ContactNodeItem) +
-                                             face_src_.size() * sizeof(ContactFaceItem));
+    // Only what goes to another rank: items kept here are no traffic.
+    stats_.bytes_sent += static_cast<double>(node_plan_.sent_elsewhere() * sizeof(ContactNodeItem) +
+                                             face_plan_.sent_elsewhere() * sizeof(ContactFaceItem));
   }
 
   SearchOptions opt;
@@ -342,7 +343,8 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
     ScopedPhase t(timers, Phase::transfer);
     force_plan_.build(comm_, force_dest_);
     if (!force_plan_.stays()) force_plan_.forward(force_out_, force_in_);
-    stats_.bytes_sent += static_cast<double>(force_out_.size() * sizeof(ContactForceItem));
+    stats_.bytes_sent +=
+        static_cast<double>(force_plan_.sent_elsewhere() * sizeof(ContactForceItem));
   }
 
   {

@@ -30,11 +30,11 @@ namespace anvil {
 
 struct ContactStats {
   std::int64_t cycles = 0;
-  std::int64_t rebalances = 0;  // RCB recomputations
-  std::int64_t pairs = 0;       // node-face pairs in the last cycle (all ranks)
-  double imbalance = 1;         // last cycle's max/mean contact work per rank
-  double imbalance_max = 1;     // the largest seen
-  double bytes_sent = 0;        // this rank, all cycles (transfers and forces)
+  std::int64_t rebalances = 0; // RCB recomputations
+  std::int64_t pairs = 0;      // node-face pairs in the last cycle (all ranks)
+  double imbalance = 1;        // last cycle's max/mean contact work per rank
+  double imbalance_max = 1;    // the largest seen
+  double bytes_sent = 0; // this rank, all cycles: items sent to other ranks (transfers, forces)
   double max_penetration = 0;   // largest gap behind a face, over all cycles, m
   std::int64_t list_builds = 0; // this rank's candidate-list builds (SearchWorkspace)
   std::int64_t plan_builds = 0; // node and face migration plans built (destinations changed)
