@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstddef>
+#include <span>
 #include <vector>
 
 namespace anvil {
@@ -30,5 +31,8 @@ struct FaceCorners {
   std::size_t n;
 };
 void compute_captures(const FaceCorners& faces, FaceCaptures& out);
+// The same for the faces listed in `which` only (any order, each once); the other
+// entries of out keep their values.
+void compute_captures(const FaceCorners& faces, std::span<const int> which, FaceCaptures& out);
 
 } // namespace anvil

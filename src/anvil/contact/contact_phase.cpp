@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "anvil/core/simd.hpp"
 
@@ -134,6 +135,79 @@ void ContactPhase::pack_face(std::size_t f, const ContactNodes& nd) {
   it.warp = cap_.warp[f];
 }
 
+FaceCorners ContactPhase::corners() const {
+  return {{xs_[0].data(), xs_[1].data(), xs_[2].data()},
+          {corner_[0].data(), corner_[1].data(), corner_[2].data(), corner_[3].data()},
+          depth_pad_.data(),
+          my_face_gid_.size()};
+}
+
+// The bound. The lists stay valid while every node and every capture-box side is within
+// h = 0.45 skin of where it was at the build (lists_valid in search.cpp). At the
+// reference (a cycle that computed every box exactly and found the lists valid) each node
+// and side has a deviation e from the build, so it may still move h - e. A box's sides
+// move by at most m = delta (1 + A (B + 4 delta)) when no corner of the face has moved
+// more than delta since the reference: a corner term moves by delta, the swept corner
+// also by 2 d |n' - n| <= 4 d |N' - N| / |N| (N the cross product of the diagonals D1, D2,
+// n = N / |N|), and the pad by 0.05 |size' - size| <= 0.025 |N' - N| / size; and
+// |N' - N| <= 2 delta (|D1| + |D2|) + 4 delta^2. So A = 4 d / |N| + 0.025 / size and
+// B = 2 (|D1| + |D2|), at the reference. A flat face (|N| = 0) never passes.
+void ContactPhase::set_lazy_reference() {
+  const std::size_t np = surf_local_.size(), nf = my_face_gid_.size();
+  const SearchWorkspace& w = search_;
+  const double h = 0.45 * w.skin;
+  for (int i = 0; i < 3; ++i) ref_x_[i].assign(xs_[i].begin(), xs_[i].end());
+  ref_node_budget_.assign(np, std::numeric_limits<double>::infinity());
+  for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
+    const auto p = static_cast<std::size_t>(node_point_[k]);
+    double e = 0;
+    for (int i = 0; i < 3; ++i) e = std::max(e, std::abs(xs_[i][p] - w.node_ref[3 * k + i]));
+    ref_node_budget_[p] = h - e;
+  }
+  ref_a_.resize(nf);
+  ref_b_.resize(nf);
+  ref_face_budget_.resize(nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    double e = 0;
+    for (int i = 0; i < 3; ++i) {
+      e = std::max(e, std::abs(cap_.lo[i][f] - w.box_ref[i * nf + f]));
+      e = std::max(e, std::abs(cap_.hi[i][f] - w.box_ref[(3 + i) * nf + f]));
+    }
+    ref_face_budget_[f] = h - e;
+    Vec3 x[4];
+    for (int a = 0; a < 4; ++a) {
+      const auto p = static_cast<std::size_t>(corner_[a][f]);
+      x[a] = {xs_[0][p], xs_[1][p], xs_[2][p]};
+    }
+    const Vec3 d1 = x[2] - x[0], d2 = x[3] - x[1];
+    const double len = norm(cross(d1, d2));
+    ref_a_[f] = 4 * my_face_depth_[f] / len + 0.025 / std::sqrt(0.5 * len);
+    ref_b_[f] = 2 * (norm(d1) + norm(d2));
+  }
+  point_move_.resize(np);
+  lazy_ = true;
+  lazy_builds_ = w.builds;
+}
+
+bool ContactPhase::lazy_bound_holds() {
+  const std::size_t np = surf_local_.size(), nf = my_face_gid_.size();
+  unsigned bad = 0; // also when anything is not a number
+  for (std::size_t k = 0; k < np; ++k) {
+    const double dx = xs_[0][k] - ref_x_[0][k], dy = xs_[1][k] - ref_x_[1][k],
+                 dz = xs_[2][k] - ref_x_[2][k];
+    point_move_[k] = std::sqrt(dx * dx + dy * dy + dz * dz);
+    bad |= static_cast<unsigned>(!(point_move_[k] <= ref_node_budget_[k]));
+  }
+  for (std::size_t f = 0; f < nf; ++f) {
+    double d = 0;
+    for (int a = 0; a < 4; ++a)
+      d = std::max(d, point_move_[static_cast<std::size_t>(corner_[a][f])]);
+    const double m = d * (1 + ref_a_[f] * (ref_b_[f] + 4 * d));
+    bad |= static_cast<unsigned>(!(1.001 * m <= ref_face_budget_[f]));
+  }
+  return bad == 0;
+}
+
 void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers) {
   ++stats_.cycles;
 
@@ -142,17 +216,30 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
   // of the owned contact nodes (their constant fields were set at construction). Face
   // items are packed below, all of them only where they leave this rank.
   const std::size_t nf = my_face_gid_.size();
+  // On one rank every item stays: no RCB look-ups.
+  const bool alone = comm_.size() == 1;
+  // Faces of eroded elements have left the surface.
+  auto alive = [&](std::size_t f) {
+    const auto [fb, fe] = my_face_slot_[f];
+    return blocks_[static_cast<std::size_t>(fb)].alive[static_cast<std::size_t>(fe)] != 0.0;
+  };
+  std::size_t live = nf; // faces alive (counted on one rank)
+  bool lazy_cycle = false;
   {
     ScopedPhase t(timers, Phase::transfer);
     for (std::size_t k = 0; k < surf_local_.size(); ++k) {
       const auto l = static_cast<std::size_t>(surf_local_[k]);
       for (int i = 0; i < 3; ++i) xs_[i][k] = nd.x[i][l] + dt * nd.v[i][l];
     }
-    compute_captures({{xs_[0].data(), xs_[1].data(), xs_[2].data()},
-                      {corner_[0].data(), corner_[1].data(), corner_[2].data(), corner_[3].data()},
-                      depth_pad_.data(),
-                      nf},
-                     cap_);
+    if (alone) {
+      live = 0;
+      for (std::size_t f = 0; f < nf; ++f) live += alive(f) ? 1 : 0;
+    }
+    // One rank: while the bound shows the candidate lists valid, only the faces in some
+    // list need their box (below); otherwise every face gets it.
+    lazy_cycle = alone && live == nf && extra_.empty() && lazy_ && search_.built &&
+                 search_.builds == lazy_builds_ && lazy_bound_holds();
+    if (!lazy_cycle) compute_captures(corners(), cap_);
     node_out_.resize(my_nodes_.size());
     for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
       const int l = my_nodes_[k];
@@ -205,25 +292,16 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
 
   {
     ScopedPhase t(timers, Phase::transfer);
-    // On one rank every item stays: no RCB look-ups.
-    const bool alone = comm_.size() == 1;
     node_dest_.resize(node_out_.size());
     if (alone)
       std::fill(node_dest_.begin(), node_dest_.end(), 0);
     else
       for (std::size_t k = 0; k < node_out_.size(); ++k)
         node_dest_[k] = rcb_.owner({node_out_[k].x[0], node_out_[k].x[1], node_out_[k].x[2]});
-    // Faces go to every rank their capture box touches (ghosts), as copies; faces of
-    // eroded elements have left the surface.
-    auto alive = [&](std::size_t f) {
-      const auto [fb, fe] = my_face_slot_[f];
-      return blocks_[static_cast<std::size_t>(fb)].alive[static_cast<std::size_t>(fe)] != 0.0;
-    };
+    // Faces go to every rank their capture box touches (ghosts), as copies.
     bool one_copy_each = true; // then copy k is face k
     if (alone) {
       // Rank 0 holds each live face once: the lists change only when an element erodes.
-      std::size_t live = 0;
-      for (std::size_t f = 0; f < nf; ++f) live += alive(f) ? 1 : 0;
       one_copy_each = live == nf;
       if (!one_copy_each || face_src_.size() != nf) { // else they are 0..nf-1, all to 0
         face_dest_.assign(live, 0);
@@ -274,11 +352,16 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     if (in_place_) {
       search_faces_ = &face_local_;
     } else {
+      if (lazy_cycle) compute_captures(corners(), cap_); // (cannot happen: one rank stays)
       for (std::size_t f = 0; f < nf; ++f) pack_face(f, nd);
-      face_out_.resize(face_src_.size());
-      for (std::size_t k = 0; k < face_src_.size(); ++k)
-        face_out_[k] = face_local_[static_cast<std::size_t>(face_src_[k])];
-      face_plan_.forward(face_out_, face_in_);
+      if (one_copy_each) { // copy k is face k: no copies to make first
+        face_plan_.forward(face_local_, face_in_);
+      } else {
+        face_out_.resize(face_src_.size());
+        for (std::size_t k = 0; k < face_src_.size(); ++k)
+          face_out_[k] = face_local_[static_cast<std::size_t>(face_src_[k])];
+        face_plan_.forward(face_out_, face_in_);
+      }
       search_faces_ = &face_in_;
     }
     // Only what goes to another rank: items kept here are no traffic.
@@ -295,17 +378,20 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       boxes.lo[i] = std::span<const double>(cap_.lo[i].data(), nf);
       boxes.hi[i] = std::span<const double>(cap_.hi[i].data(), nf);
     }
-    {
+    if (!lazy_cycle) {
       ScopedPhase t(timers, Phase::contact_search);
       update_candidate_lists(*search_nodes_, face_local_, boxes, opt, search_);
     }
     {
       ScopedPhase t(timers, Phase::transfer);
+      if (lazy_cycle) compute_captures(corners(), search_.needed, cap_);
       for (int f : search_.needed) pack_face(static_cast<std::size_t>(f), nd);
+      if (!lazy_cycle && alone && extra_.empty() && search_.built) set_lazy_reference();
     }
     ScopedPhase t(timers, Phase::contact_search);
     find_pairs(*search_nodes_, face_local_, boxes, opt, search_, pairs_);
   } else {
+    lazy_ = false;
     ScopedPhase t(timers, Phase::contact_search);
     find_contacts(*search_nodes_, *search_faces_, opt, search_, pairs_);
   }

@@ -129,6 +129,16 @@ private:
   // reads the boxes from cap_ and the items in place, and only the faces in some
   // candidate list get their positions, velocities and plane packed (pack_face).
   bool in_place_ = false;
+  // One rank, every face alive, no extra nodes: a cycle may skip the capture boxes of the
+  // faces in no candidate list when a bound shows the lists still valid (detect()). The
+  // reference of that bound, set on the last cycle that computed every box:
+  bool lazy_ = false;                   // it is set
+  std::int64_t lazy_builds_ = -1;       // for the lists of this build (search_.builds)
+  std::vector<double> ref_x_[3];        // per point: x* then
+  std::vector<double> ref_node_budget_; // per point: how far its node may still move, m
+  std::vector<double> ref_a_, ref_b_;   // per face: the bound's coefficients (lazy_bound_holds)
+  std::vector<double> ref_face_budget_; // per face: how far its box sides may still move, m
+  std::vector<double> point_move_;      // per point: |x* - ref_x| this cycle, m
 
   Rcb rcb_;
   bool partitioned_ = false;
@@ -158,6 +168,13 @@ private:
   // Writes this cycle's corners (predicted positions, velocities, masses), plane and
   // capture box into face_local_[f].
   void pack_face(std::size_t f, const ContactNodes& nodes);
+  // The faces' corners and depths as compute_captures() reads them.
+  FaceCorners corners() const;
+  // Sets the bound's reference from this cycle's exact boxes and the lists just checked.
+  void set_lazy_reference();
+  // True when the bound shows every node and every capture-box side within 0.45 skin of
+  // where the candidate lists were built, without computing the boxes.
+  bool lazy_bound_holds();
 };
 
 } // namespace anvil
