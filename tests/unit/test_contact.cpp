@@ -2,6 +2,7 @@
 // brute force, the detailed check's rules, and momentum conservation of penalty forces.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -167,6 +168,29 @@ TEST(Contact, ComputeCapturesMatchesSetCaptureBitwise) {
     }
     EXPECT_TRUE(same(one[f].offset, cap.offset[f])) << f;
     EXPECT_TRUE(same(one[f].warp, cap.warp[f])) << f;
+  }
+  // The faces of an index list only, in any order: the same bits, the others untouched.
+  FaceCaptures part;
+  part.resize(n);
+  for (auto& v : part.lo) std::fill(v.begin(), v.end(), -7.0);
+  const std::vector<int> which = {9, 2, 14, 6, 0};
+  compute_captures({{px[0].data(), px[1].data(), px[2].data()},
+                    {corner[0].data(), corner[1].data(), corner[2].data(), corner[3].data()},
+                    depth.data(),
+                    n},
+                   which, part);
+  for (std::size_t f = 0; f < n; ++f) {
+    const bool listed = std::find(which.begin(), which.end(), static_cast<int>(f)) != which.end();
+    for (int i = 0; i < 3; ++i) {
+      if (!listed) {
+        EXPECT_EQ(part.lo[i][f], -7.0) << f;
+        continue;
+      }
+      EXPECT_TRUE(same(cap.lo[i][f], part.lo[i][f])) << f;
+      EXPECT_TRUE(same(cap.hi[i][f], part.hi[i][f])) << f;
+      EXPECT_TRUE(same(cap.normal[i][f], part.normal[i][f])) << f;
+    }
+    if (listed) EXPECT_TRUE(same(cap.warp[f], part.warp[f])) << f;
   }
 }
 

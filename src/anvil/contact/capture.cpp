@@ -40,8 +40,8 @@ void FaceCaptures::resize(std::size_t n) {
 namespace {
 // One vector of faces: lane l is the face whose corners are points c[a][l] and whose
 // depth is depth[l]. r: normal (3), lo (3), hi (3), centre (3), offset, warp.
-void capture_lanes(const FaceCorners& in, const int* const c4[4], const vdouble& depth,
-                   vdouble (&r)[14]) {
+[[gnu::always_inline]] inline void capture_lanes(const FaceCorners& in, const int* const c4[4],
+                                                 const vdouble& depth, vdouble (&r)[14]) {
   vdouble x[4][3];
   for (int a = 0; a < 4; ++a)
     for (int i = 0; i < 3; ++i) x[a][i] = simd::gather(in.x[i], c4[a]);
