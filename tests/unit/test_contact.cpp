@@ -2,10 +2,12 @@
 // brute force, the detailed check's rules, and momentum conservation of penalty forces.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
 
+#include "anvil/contact/capture.hpp"
 #include "anvil/contact/geometry.hpp"
 #include "anvil/contact/penalty.hpp"
 #include "anvil/contact/search.hpp"
@@ -118,6 +120,77 @@ TEST(Contact, SetCapturesMatchesSetCaptureBitwise) {
     }
     EXPECT_EQ(std::memcmp(&one[f].offset, &many[f].offset, 8), 0) << f;
     EXPECT_EQ(std::memcmp(&one[f].warp, &many[f].warp, 8), 0) << f;
+  }
+}
+
+// compute_captures() (structure of arrays, vectorised across faces) gives set_capture()'s
+// bits, for a face count that is not a whole number of vectors.
+TEST(Contact, ComputeCapturesMatchesSetCaptureBitwise) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const std::size_t n = 15;
+  std::vector<ContactFaceItem> one(n);
+  std::vector<double> px[3];
+  std::vector<int> corner[4];
+  std::vector<double> depth;
+  for (std::size_t f = 0; f < n; ++f) {
+    auto& it = one[f];
+    it = {};
+    const double s = std::pow(10.0, -static_cast<double>(f % 5));
+    const double xs[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (int a = 0; a < 4; ++a) {
+      it.x[a][0] = s * (xs[a][0] + 0.2 * u(rng)) + u(rng);
+      it.x[a][1] = s * (xs[a][1] + 0.2 * u(rng));
+      it.x[a][2] = s * 0.3 * u(rng);
+      if (f == 6) it.x[a][0] = it.x[a][1] = it.x[a][2] = 0.25; // degenerate: zero area
+      corner[a].push_back(static_cast<int>(px[0].size()));
+      for (int i = 0; i < 3; ++i) px[i].push_back(it.x[a][i]);
+    }
+    it.depth = 0.1 * s;
+    depth.push_back(it.depth);
+  }
+  for (int a = 0; a < 4; ++a) corner[a].resize(n + 16, 0);
+  depth.resize(n + 16, 0.0);
+  FaceCaptures cap;
+  compute_captures({{px[0].data(), px[1].data(), px[2].data()},
+                    {corner[0].data(), corner[1].data(), corner[2].data(), corner[3].data()},
+                    depth.data(),
+                    n},
+                   cap);
+  auto same = [](double a, double b) { return std::memcmp(&a, &b, 8) == 0; };
+  for (std::size_t f = 0; f < n; ++f) {
+    const FacePlane p = set_capture(one[f]);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_TRUE(same(one[f].normal[i], cap.normal[i][f])) << f;
+      EXPECT_TRUE(same(one[f].lo[i], cap.lo[i][f])) << f;
+      EXPECT_TRUE(same(one[f].hi[i], cap.hi[i][f])) << f;
+      EXPECT_TRUE(same(p.centre[i], cap.centre[i][f])) << f;
+    }
+    EXPECT_TRUE(same(one[f].offset, cap.offset[f])) << f;
+    EXPECT_TRUE(same(one[f].warp, cap.warp[f])) << f;
+  }
+  // The faces of an index list only, in any order: the same bits, the others untouched.
+  FaceCaptures part;
+  part.resize(n);
+  for (auto& v : part.lo) std::fill(v.begin(), v.end(), -7.0);
+  const std::vector<int> which = {9, 2, 14, 6, 0};
+  compute_captures({{px[0].data(), px[1].data(), px[2].data()},
+                    {corner[0].data(), corner[1].data(), corner[2].data(), corner[3].data()},
+                    depth.data(),
+                    n},
+                   which, part);
+  for (std::size_t f = 0; f < n; ++f) {
+    const bool listed = std::find(which.begin(), which.end(), static_cast<int>(f)) != which.end();
+    for (int i = 0; i < 3; ++i) {
+      if (!listed) {
+        EXPECT_EQ(part.lo[i][f], -7.0) << f;
+        continue;
+      }
+      EXPECT_TRUE(same(cap.lo[i][f], part.lo[i][f])) << f;
+      EXPECT_TRUE(same(cap.hi[i][f], part.hi[i][f])) << f;
+      EXPECT_TRUE(same(cap.normal[i][f], part.normal[i][f])) << f;
+    }
+    if (listed) EXPECT_TRUE(same(cap.warp[f], part.warp[f])) << f;
   }
 }
 

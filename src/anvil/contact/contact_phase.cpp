@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+
+#include "anvil/core/simd.hpp"
 
 namespace anvil {
 
@@ -62,6 +65,7 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
     my_face_slot_.emplace_back(static_cast<int>(b), static_cast<int>(e));
   }
   my_face_rank_.assign(my_face_gid_.size(), comm.rank());
+  const std::size_t nf_all = my_face_gid_.size();
   // The fields of the items that never change (ids, owners, penalty data), set once.
   node_out_.resize(my_nodes_.size());
   for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
@@ -83,6 +87,25 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
     it.stiffness = my_face_stiffness_[f];
     it.depth = my_face_depth_[f];
   }
+  // The surface points: owned contact nodes and face corners, each once.
+  surf_local_ = my_nodes_;
+  for (const auto& ln : my_face_nodes_) surf_local_.insert(surf_local_.end(), ln.begin(), ln.end());
+  std::sort(surf_local_.begin(), surf_local_.end());
+  surf_local_.erase(std::unique(surf_local_.begin(), surf_local_.end()), surf_local_.end());
+  auto point = [&](int l) {
+    return static_cast<int>(std::lower_bound(surf_local_.begin(), surf_local_.end(), l) -
+                            surf_local_.begin());
+  };
+  for (int i = 0; i < 3; ++i) xs_[i].resize(surf_local_.size());
+  for (int l : my_nodes_) node_point_.push_back(point(l));
+  const auto padded = static_cast<std::size_t>(simd::padded_size(static_cast<int>(nf_all)));
+  for (int a = 0; a < 4; ++a) {
+    corner_[a].assign(padded, 0);
+    for (std::size_t f = 0; f < nf_all; ++f) corner_[a][f] = point(my_face_nodes_[f][a]);
+  }
+  depth_pad_.assign(padded, 0.0);
+  std::copy(my_face_depth_.begin(), my_face_depth_.end(), depth_pad_.begin());
+  cap_.resize(nf_all);
   last_face_.assign(fe.node_gid.size(), -1);
   allowance_.assign(fe.node_gid.size(), 0.0);
   exchange_ = std::make_unique<NodeExchange>(fe, comm);
@@ -92,22 +115,138 @@ void ContactPhase::set_extra_nodes(std::span<const ContactNodeItem> items) {
   extra_.assign(items.begin(), items.end());
 }
 
+void ContactPhase::pack_face(std::size_t f, const ContactNodes& nd) {
+  auto& it = face_local_[f];
+  for (int a = 0; a < 4; ++a) {
+    const int l = my_face_nodes_[f][a];
+    const auto k = static_cast<std::size_t>(corner_[a][f]);
+    for (int i = 0; i < 3; ++i) {
+      it.x[a][i] = xs_[i][k];
+      it.v[a][i] = nd.v[i][l];
+    }
+    it.mass[a] = nd.mass[l];
+  }
+  for (int i = 0; i < 3; ++i) {
+    it.normal[i] = cap_.normal[i][f];
+    it.lo[i] = cap_.lo[i][f];
+    it.hi[i] = cap_.hi[i][f];
+  }
+  it.offset = cap_.offset[f];
+  it.warp = cap_.warp[f];
+}
+
+FaceCorners ContactPhase::corners() const {
+  return {{xs_[0].data(), xs_[1].data(), xs_[2].data()},
+          {corner_[0].data(), corner_[1].data(), corner_[2].data(), corner_[3].data()},
+          depth_pad_.data(),
+          my_face_gid_.size()};
+}
+
+// The bound. The lists stay valid while every node and every capture-box side is within
+// h = 0.45 skin of where it was at the build (lists_valid in search.cpp). At the
+// reference (a cycle that computed every box exactly and found the lists valid) each node
+// and side has a deviation e from the build, so it may still move h - e. A box's sides
+// move by at most m = delta (1 + A (B + 4 delta)) when no corner of the face has moved
+// more than delta since the reference: a corner term moves by delta, the swept corner
+// also by 2 d |n' - n| <= 4 d |N' - N| / |N| (N the cross product of the diagonals D1, D2,
+// n = N / |N|), and the pad by 0.05 |size' - size| <= 0.025 |N' - N| / size; and
+// |N' - N| <= 2 delta (|D1| + |D2|) + 4 delta^2. So A = 4 d / |N| + 0.025 / size and
+// B = 2 (|D1| + |D2|), at the reference. A flat face (|N| = 0) never passes.
+void ContactPhase::set_lazy_reference() {
+  const std::size_t np = surf_local_.size(), nf = my_face_gid_.size();
+  const SearchWorkspace& w = search_;
+  const double h = 0.45 * w.skin;
+  for (int i = 0; i < 3; ++i) ref_x_[i].assign(xs_[i].begin(), xs_[i].end());
+  ref_node_budget_.assign(np, std::numeric_limits<double>::infinity());
+  for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
+    const auto p = static_cast<std::size_t>(node_point_[k]);
+    double e = 0;
+    for (int i = 0; i < 3; ++i) e = std::max(e, std::abs(xs_[i][p] - w.node_ref[3 * k + i]));
+    ref_node_budget_[p] = h - e;
+  }
+  ref_a_.resize(nf);
+  ref_b_.resize(nf);
+  ref_face_budget_.resize(nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    double e = 0;
+    for (int i = 0; i < 3; ++i) {
+      e = std::max(e, std::abs(cap_.lo[i][f] - w.box_ref[i * nf + f]));
+      e = std::max(e, std::abs(cap_.hi[i][f] - w.box_ref[(3 + i) * nf + f]));
+    }
+    ref_face_budget_[f] = h - e;
+    Vec3 x[4];
+    for (int a = 0; a < 4; ++a) {
+      const auto p = static_cast<std::size_t>(corner_[a][f]);
+      x[a] = {xs_[0][p], xs_[1][p], xs_[2][p]};
+    }
+    const Vec3 d1 = x[2] - x[0], d2 = x[3] - x[1];
+    const double len = norm(cross(d1, d2));
+    ref_a_[f] = 4 * my_face_depth_[f] / len + 0.025 / std::sqrt(0.5 * len);
+    ref_b_[f] = 2 * (norm(d1) + norm(d2));
+  }
+  point_move_.resize(np);
+  lazy_ = true;
+  lazy_builds_ = w.builds;
+}
+
+bool ContactPhase::lazy_bound_holds() {
+  const std::size_t np = surf_local_.size(), nf = my_face_gid_.size();
+  unsigned bad = 0; // also when anything is not a number
+  for (std::size_t k = 0; k < np; ++k) {
+    const double dx = xs_[0][k] - ref_x_[0][k], dy = xs_[1][k] - ref_x_[1][k],
+                 dz = xs_[2][k] - ref_x_[2][k];
+    point_move_[k] = std::sqrt(dx * dx + dy * dy + dz * dz);
+    bad |= static_cast<unsigned>(!(point_move_[k] <= ref_node_budget_[k]));
+  }
+  for (std::size_t f = 0; f < nf; ++f) {
+    double d = 0;
+    for (int a = 0; a < 4; ++a)
+      d = std::max(d, point_move_[static_cast<std::size_t>(corner_[a][f])]);
+    const double m = d * (1 + ref_a_[f] * (ref_b_[f] + 4 * d));
+    bad |= static_cast<unsigned>(!(1.001 * m <= ref_face_budget_[f]));
+  }
+  return bad == 0;
+}
+
 void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers) {
   ++stats_.cycles;
-  auto predicted = [&](int l, int i) { return nd.x[i][l] + dt * nd.v[i][l]; };
 
-  // Items leaving the FE decomposition: owned contact nodes, faces of owned elements
-  // (their constant fields were set at construction). Packing is part of the transfer.
+  // The predicted positions x* = x + dt v of the surface points, then the planes and
+  // capture boxes of the faces of owned elements (vectorised across faces), and the items
+  // of the owned contact nodes (their constant fields were set at construction). Face
+  // items are packed below, all of them only where they leave this rank.
   const std::size_t nf = my_face_gid_.size();
-  std::vector<ContactFaceItem>& faces = face_local_;
+  // On one rank every item stays: no RCB look-ups.
+  const bool alone = comm_.size() == 1;
+  // Faces of eroded elements have left the surface.
+  auto alive = [&](std::size_t f) {
+    const auto [fb, fe] = my_face_slot_[f];
+    return blocks_[static_cast<std::size_t>(fb)].alive[static_cast<std::size_t>(fe)] != 0.0;
+  };
+  std::size_t live = nf; // faces alive (counted on one rank)
+  bool lazy_cycle = false;
   {
     ScopedPhase t(timers, Phase::transfer);
+    for (std::size_t k = 0; k < surf_local_.size(); ++k) {
+      const auto l = static_cast<std::size_t>(surf_local_[k]);
+      for (int i = 0; i < 3; ++i) xs_[i][k] = nd.x[i][l] + dt * nd.v[i][l];
+    }
+    if (alone) {
+      live = 0;
+      for (std::size_t f = 0; f < nf; ++f) live += alive(f) ? 1 : 0;
+    }
+    // One rank: while the bound shows the candidate lists valid, only the faces in some
+    // list need their box (below); otherwise every face gets it.
+    lazy_cycle = alone && live == nf && extra_.empty() && lazy_ && search_.built &&
+                 search_.builds == lazy_builds_ && lazy_bound_holds();
+    if (!lazy_cycle) compute_captures(corners(), cap_);
     node_out_.resize(my_nodes_.size());
     for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
       const int l = my_nodes_[k];
+      const auto p = static_cast<std::size_t>(node_point_[k]);
       auto& it = node_out_[k];
       for (int i = 0; i < 3; ++i) {
-        it.x[i] = predicted(l, i);
+        it.x[i] = xs_[i][p];
         it.v[i] = nd.v[i][l];
       }
       it.mass = nd.mass[l];
@@ -115,19 +254,6 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       it.allowance = allowance_[static_cast<std::size_t>(l)];
     }
     node_out_.insert(node_out_.end(), extra_.begin(), extra_.end());
-    face_centre_.resize(nf);
-    for (std::size_t f = 0; f < nf; ++f) {
-      auto& it = faces[f];
-      for (int a = 0; a < 4; ++a) {
-        const int l = my_face_nodes_[f][a];
-        for (int i = 0; i < 3; ++i) {
-          it.x[a][i] = predicted(l, i);
-          it.v[a][i] = nd.v[i][l];
-        }
-        it.mass[a] = nd.mass[l];
-      }
-    }
-    set_captures(faces, face_centre_);
   }
 
   // Rebalance: RCB of node positions and face centroids, unit weights.
@@ -147,12 +273,12 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     for (std::size_t f = 0; f < nf; ++f) {
       double c[3] = {0, 0, 0};
       for (int a = 0; a < 4; ++a)
-        for (int i = 0; i < 3; ++i) c[i] += 0.25 * faces[f].x[a][i];
+        for (int i = 0; i < 3; ++i) c[i] += 0.25 * xs_[i][static_cast<std::size_t>(corner_[a][f])];
       const std::size_t k = node_out_.size() + f;
       px_[k] = c[0];
       py_[k] = c[1];
       pz_[k] = c[2];
-      pid_[k] = global_nodes_ + faces[f].gid;
+      pid_[k] = global_nodes_ + my_face_gid_[f];
     }
     const RcbPoints pts{px_, py_, pz_, pid_, {}};
     if (partitioned_)
@@ -167,22 +293,35 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
   {
     ScopedPhase t(timers, Phase::transfer);
     node_dest_.resize(node_out_.size());
-    for (std::size_t k = 0; k < node_out_.size(); ++k)
-      node_dest_[k] = rcb_.owner({node_out_[k].x[0], node_out_[k].x[1], node_out_[k].x[2]});
+    if (alone)
+      std::fill(node_dest_.begin(), node_dest_.end(), 0);
+    else
+      for (std::size_t k = 0; k < node_out_.size(); ++k)
+        node_dest_[k] = rcb_.owner({node_out_[k].x[0], node_out_[k].x[1], node_out_[k].x[2]});
     // Faces go to every rank their capture box touches (ghosts), as copies.
-    face_dest_.clear();
-    face_src_.clear();
     bool one_copy_each = true; // then copy k is face k
-    for (std::size_t f = 0; f < nf; ++f) {
-      // Faces of eroded elements have left the surface.
-      const auto [fb, fe] = my_face_slot_[f];
-      if (blocks_[static_cast<std::size_t>(fb)].alive[static_cast<std::size_t>(fe)] == 0.0) {
+    if (alone) {
+      // Rank 0 holds each live face once: the lists change only when an element erodes.
+      one_copy_each = live == nf;
+      if (!one_copy_each || face_src_.size() != nf) { // else they are 0..nf-1, all to 0
+        face_dest_.assign(live, 0);
+        face_src_.clear();
+        for (std::size_t f = 0; f < nf; ++f)
+          if (alive(f)) face_src_.push_back(static_cast<int>(f));
+      }
+    } else {
+      face_dest_.clear();
+      face_src_.clear();
+    }
+    for (std::size_t f = 0; f < nf && !alone; ++f) {
+      if (!alive(f)) {
         one_copy_each = false;
         continue;
       }
-      const auto& fc = faces[f];
-      my_face_rank_[f] = rcb_.owner(face_centre_[f]);
-      rcb_.overlapping({{fc.lo[0], fc.lo[1], fc.lo[2]}, {fc.hi[0], fc.hi[1], fc.hi[2]}}, ranks_);
+      my_face_rank_[f] = rcb_.owner({cap_.centre[0][f], cap_.centre[1][f], cap_.centre[2][f]});
+      rcb_.overlapping({{cap_.lo[0][f], cap_.lo[1][f], cap_.lo[2][f]},
+                        {cap_.hi[0][f], cap_.hi[1][f], cap_.hi[2][f]}},
+                       ranks_);
       one_copy_each &= ranks_.size() == 1;
       for (int r : ranks_) {
         face_src_.push_back(static_cast<int>(f));
@@ -209,26 +348,54 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       node_plan_.forward(node_out_, node_in_);
       search_nodes_ = &node_in_;
     }
-    if (face_plan_.stays() && one_copy_each) {
+    in_place_ = node_plan_.stays() && face_plan_.stays() && one_copy_each;
+    if (in_place_) {
       search_faces_ = &face_local_;
     } else {
-      face_out_.resize(face_src_.size());
-      for (std::size_t k = 0; k < face_src_.size(); ++k)
-        face_out_[k] = faces[static_cast<std::size_t>(face_src_[k])];
-      face_plan_.forward(face_out_, face_in_);
+      if (lazy_cycle) compute_captures(corners(), cap_); // (cannot happen: one rank stays)
+      for (std::size_t f = 0; f < nf; ++f) pack_face(f, nd);
+      if (one_copy_each) { // copy k is face k: no copies to make first
+        face_plan_.forward(face_local_, face_in_);
+      } else {
+        face_out_.resize(face_src_.size());
+        for (std::size_t k = 0; k < face_src_.size(); ++k)
+          face_out_[k] = face_local_[static_cast<std::size_t>(face_src_[k])];
+        face_plan_.forward(face_out_, face_in_);
+      }
       search_faces_ = &face_in_;
     }
-    stats_.bytes_sent += static_cast<double>(node_out_.size() * sizeof(ContactNodeItem) +
-                                             face_src_.size() * sizeof(ContactFaceItem));
+    // Only what goes to another rank: items kept here are no traffic.
+    stats_.bytes_sent += static_cast<double>(node_plan_.sent_elsewhere() * sizeof(ContactNodeItem) +
+                                             face_plan_.sent_elsewhere() * sizeof(ContactFaceItem));
   }
 
-  {
+  SearchOptions opt;
+  opt.dt = dt;
+  if (in_place_) {
+    // The boxes straight from cap_; the items of the faces in some candidate list only.
+    FaceBoxes boxes;
+    for (int i = 0; i < 3; ++i) {
+      boxes.lo[i] = std::span<const double>(cap_.lo[i].data(), nf);
+      boxes.hi[i] = std::span<const double>(cap_.hi[i].data(), nf);
+    }
+    if (!lazy_cycle) {
+      ScopedPhase t(timers, Phase::contact_search);
+      update_candidate_lists(*search_nodes_, face_local_, boxes, opt, search_);
+    }
+    {
+      ScopedPhase t(timers, Phase::transfer);
+      if (lazy_cycle) compute_captures(corners(), search_.needed, cap_);
+      for (int f : search_.needed) pack_face(static_cast<std::size_t>(f), nd);
+      if (!lazy_cycle && alone && extra_.empty() && search_.built) set_lazy_reference();
+    }
     ScopedPhase t(timers, Phase::contact_search);
-    SearchOptions opt;
-    opt.dt = dt;
+    find_pairs(*search_nodes_, face_local_, boxes, opt, search_, pairs_);
+  } else {
+    lazy_ = false;
+    ScopedPhase t(timers, Phase::contact_search);
     find_contacts(*search_nodes_, *search_faces_, opt, search_, pairs_);
-    stats_.list_builds = search_.builds;
   }
+  stats_.list_builds = search_.builds;
 }
 
 void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers) {
@@ -262,7 +429,8 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
     ScopedPhase t(timers, Phase::transfer);
     force_plan_.build(comm_, force_dest_);
     if (!force_plan_.stays()) force_plan_.forward(force_out_, force_in_);
-    stats_.bytes_sent += static_cast<double>(force_out_.size() * sizeof(ContactForceItem));
+    stats_.bytes_sent +=
+        static_cast<double>(force_plan_.sent_elsewhere() * sizeof(ContactForceItem));
   }
 
   {

@@ -14,6 +14,7 @@
 #include <span>
 #include <vector>
 
+#include "anvil/contact/capture.hpp"
 #include "anvil/contact/penalty.hpp"
 #include "anvil/contact/search.hpp"
 #include "anvil/contact/surface.hpp"
@@ -29,11 +30,11 @@ namespace anvil {
 
 struct ContactStats {
   std::int64_t cycles = 0;
-  std::int64_t rebalances = 0;  // RCB recomputations
-  std::int64_t pairs = 0;       // node-face pairs in the last cycle (all ranks)
-  double imbalance = 1;         // last cycle's max/mean contact work per rank
-  double imbalance_max = 1;     // the largest seen
-  double bytes_sent = 0;        // this rank, all cycles (transfers and forces)
+  std::int64_t rebalances = 0; // RCB recomputations
+  std::int64_t pairs = 0;      // node-face pairs in the last cycle (all ranks)
+  double imbalance = 1;        // last cycle's max/mean contact work per rank
+  double imbalance_max = 1;    // the largest seen
+  double bytes_sent = 0; // this rank, all cycles: items sent to other ranks (transfers, forces)
   double max_penetration = 0;   // largest gap behind a face, over all cycles, m
   std::int64_t list_builds = 0; // this rank's candidate-list builds (SearchWorkspace)
   std::int64_t plan_builds = 0; // node and face migration plans built (destinations changed)
@@ -115,6 +116,29 @@ private:
   std::vector<std::pair<std::int64_t, int>> my_face_element_; // (element gid, side)
   std::vector<std::pair<int, int>> my_face_slot_;             // (block, element index) of each face
   std::vector<int> my_face_rank_; // contact rank of the centroid, last cycle
+  // The surface's points on this rank: the owned contact nodes and the corners of the
+  // faces above (local node indices, ascending), with their predicted positions, computed
+  // once a cycle; the nodes' and the faces' corners as indices into them.
+  std::vector<int> surf_local_;
+  std::vector<double> xs_[3];
+  std::vector<int> node_point_;   // per owned contact node
+  std::vector<int> corner_[4];    // per face, padded to whole vectors: its corners' points
+  std::vector<double> depth_pad_; // per face, padded: its depth
+  FaceCaptures cap_;              // per face: mean plane and capture box of this cycle
+  // True when every node and face stays on this rank (one copy each): the search then
+  // reads the boxes from cap_ and the items in place, and only the faces in some
+  // candidate list get their positions, velocities and plane packed (pack_face).
+  bool in_place_ = false;
+  // One rank, every face alive, no extra nodes: a cycle may skip the capture boxes of the
+  // faces in no candidate list when a bound shows the lists still valid (detect()). The
+  // reference of that bound, set on the last cycle that computed every box:
+  bool lazy_ = false;                   // it is set
+  std::int64_t lazy_builds_ = -1;       // for the lists of this build (search_.builds)
+  std::vector<double> ref_x_[3];        // per point: x* then
+  std::vector<double> ref_node_budget_; // per point: how far its node may still move, m
+  std::vector<double> ref_a_, ref_b_;   // per face: the bound's coefficients (lazy_bound_holds)
+  std::vector<double> ref_face_budget_; // per face: how far its box sides may still move, m
+  std::vector<double> point_move_;      // per point: |x* - ref_x| this cycle, m
 
   Rcb rcb_;
   bool partitioned_ = false;
@@ -125,8 +149,7 @@ private:
   std::vector<std::int64_t> pid_;
   std::vector<ContactNodeItem> node_out_, node_in_;
   std::vector<ContactFaceItem> face_local_, face_out_, face_in_; // per face, per copy, received
-  std::vector<Vec3> face_centre_;                             // per face: centre of its mean plane
-  std::vector<int> node_dest_, face_dest_, face_src_, ranks_; // face_src_: face of each copy
+  std::vector<int> node_dest_, face_dest_, face_src_, ranks_;    // face_src_: face of each copy
   // The destinations the plans were built for (reused while nobody's have changed).
   std::vector<int> node_dest_built_, face_dest_built_, face_src_built_;
   bool plans_built_ = false;
@@ -141,6 +164,17 @@ private:
   Migration node_plan_, face_plan_, force_plan_;
   std::unique_ptr<NodeExchange> exchange_;
   ContactStats stats_;
+
+  // Writes this cycle's corners (predicted positions, velocities, masses), plane and
+  // capture box into face_local_[f].
+  void pack_face(std::size_t f, const ContactNodes& nodes);
+  // The faces' corners and depths as compute_captures() reads them.
+  FaceCorners corners() const;
+  // Sets the bound's reference from this cycle's exact boxes and the lists just checked.
+  void set_lazy_reference();
+  // True when the bound shows every node and every capture-box side within 0.45 skin of
+  // where the candidate lists were built, without computing the boxes.
+  bool lazy_bound_holds();
 };
 
 } // namespace anvil

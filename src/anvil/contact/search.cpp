@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "anvil/contact/geometry.hpp"
+#include "anvil/core/simd.hpp"
 
 namespace anvil {
 
@@ -64,37 +65,44 @@ namespace {
 // in a box now was then within half a skin of a box side that was itself within half a
 // skin of where it is now. 0.45 rather than 0.5 leaves room for rounding.)
 bool lists_valid(const std::vector<ContactNodeItem>& nodes,
-                 const std::vector<ContactFaceItem>& faces, const SearchWorkspace& w) {
-  if (!w.built || nodes.size() != w.node_gid.size() || faces.size() != w.face_gid.size())
-    return false;
+                 const std::vector<ContactFaceItem>& faces, const FaceBoxes& boxes,
+                 const SearchWorkspace& w) {
+  const std::size_t nn = nodes.size(), nf = faces.size();
+  if (!w.built || nn != w.node_gid.size() || nf != w.face_gid.size()) return false;
   const double half = 0.45 * w.skin;
-  bool ok = true;
-  for (std::size_t n = 0; n < nodes.size(); ++n) {
+  // No early exit; "bad" also when anything is not a number.
+  unsigned bad = 0;
+  for (std::size_t n = 0; n < nn; ++n) {
     const double* r = &w.node_ref[3 * n];
-    ok &= nodes[n].gid == w.node_gid[n];
-    for (int i = 0; i < 3; ++i) ok &= std::abs(nodes[n].x[i] - r[i]) <= half;
-  }
-  for (std::size_t f = 0; f < faces.size(); ++f) {
-    ok &= faces[f].gid == w.face_gid[f];
-    const double* r = &w.box_ref[6 * f];
+    bad |= static_cast<unsigned>(nodes[n].gid != w.node_gid[n]);
     for (int i = 0; i < 3; ++i)
-      ok &=
-          (std::abs(faces[f].lo[i] - r[i]) <= half) & (std::abs(faces[f].hi[i] - r[3 + i]) <= half);
+      bad |= static_cast<unsigned>(!(std::abs(nodes[n].x[i] - r[i]) <= half));
   }
-  return ok; // false also when anything is not a number
+  for (std::size_t f = 0; f < nf; ++f) bad |= static_cast<unsigned>(faces[f].gid != w.face_gid[f]);
+  // The boxes, a whole vector of faces at a time.
+  const std::size_t nv = nf / simd::width * simd::width;
+  simd::vmask badv(false);
+  for (int s = 0; s < 6; ++s) {
+    const double* b = (s < 3 ? boxes.lo[s] : boxes.hi[s - 3]).data();
+    const double* r = w.box_ref.data() + static_cast<std::size_t>(s) * nf;
+    for (std::size_t f = 0; f < nv; f += simd::width)
+      badv |= !(abs(simd::load(b + f) - simd::load(r + f)) <= half);
+    for (std::size_t f = nv; f < nf; ++f)
+      bad |= static_cast<unsigned>(!(std::abs(b[f] - r[f]) <= half));
+  }
+  return bad == 0 && none_of(badv);
 }
 
 // Builds the candidate lists by binning: the enlarged capture boxes are bucket-sorted on a
 // uniform grid, and each node scans the faces of its cell.
 void build_lists(const std::vector<ContactNodeItem>& nodes,
-                 const std::vector<ContactFaceItem>& faces, const SearchOptions& opt,
-                 SearchWorkspace& w) {
+                 const std::vector<ContactFaceItem>& faces, const FaceBoxes& boxes,
+                 const SearchOptions& opt, SearchWorkspace& w) {
   const std::size_t nf = faces.size();
   w.extent.resize(nf);
-  for (std::size_t f = 0; f < nf; ++f) {
-    const auto& fc = faces[f];
-    w.extent[f] = std::max({fc.hi[0] - fc.lo[0], fc.hi[1] - fc.lo[1], fc.hi[2] - fc.lo[2]});
-  }
+  for (std::size_t f = 0; f < nf; ++f)
+    w.extent[f] = std::max({boxes.hi[0][f] - boxes.lo[0][f], boxes.hi[1][f] - boxes.lo[1][f],
+                            boxes.hi[2][f] - boxes.lo[2][f]});
   std::nth_element(w.extent.begin(), w.extent.begin() + static_cast<std::ptrdiff_t>(nf / 2),
                    w.extent.end());
   const double median = w.extent[nf / 2];
@@ -133,8 +141,8 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
   auto for_cells = [&](std::size_t f, auto&& fn) {
     double b[6];
     for (int i = 0; i < 3; ++i) {
-      b[i] = faces[f].lo[i] - w.skin;
-      b[3 + i] = faces[f].hi[i] + w.skin;
+      b[i] = boxes.lo[i][f] - w.skin;
+      b[3 + i] = boxes.hi[i][f] + w.skin;
       if (b[3 + i] < lo[i] || b[i] > hi[i]) return;
     }
     const int i0 = index(0, b[0]), i1 = index(0, b[3]), j0 = index(1, b[1]), j1 = index(1, b[4]);
@@ -202,27 +210,62 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
   }
   w.face_gid.resize(nf);
   for (std::size_t f = 0; f < nf; ++f) w.face_gid[f] = faces[f].gid;
-  w.box_ref.resize(6 * nf);
+  w.box_ref.resize(6 * nf); // lo x, y, z, then hi x, y, z, each over all faces
+  for (int i = 0; i < 3; ++i) {
+    std::copy(boxes.lo[i].begin(), boxes.lo[i].begin() + static_cast<std::ptrdiff_t>(nf),
+              w.box_ref.begin() + static_cast<std::ptrdiff_t>(i * nf));
+    std::copy(boxes.hi[i].begin(), boxes.hi[i].begin() + static_cast<std::ptrdiff_t>(nf),
+              w.box_ref.begin() + static_cast<std::ptrdiff_t>((3 + i) * nf));
+  }
+  // The faces the pair search may read: every face in some list.
+  w.mark.assign(nf, 0);
+  for (int f : w.list) w.mark[static_cast<std::size_t>(f)] = 1;
+  w.needed.clear();
   for (std::size_t f = 0; f < nf; ++f)
-    for (int i = 0; i < 3; ++i) {
-      w.box_ref[6 * f + i] = faces[f].lo[i];
-      w.box_ref[6 * f + 3 + i] = faces[f].hi[i];
-    }
+    if (w.mark[f]) w.needed.push_back(static_cast<int>(f));
   w.built = true;
   ++w.builds;
 }
 
 } // namespace
 
+bool update_candidate_lists(const std::vector<ContactNodeItem>& nodes,
+                            const std::vector<ContactFaceItem>& faces, const FaceBoxes& boxes,
+                            const SearchOptions& opt, SearchWorkspace& w) {
+  if (nodes.empty() || faces.empty()) {
+    w.built = false;
+    w.active.clear();
+    w.needed.clear();
+    return false;
+  }
+  if (lists_valid(nodes, faces, boxes, w)) return false;
+  build_lists(nodes, faces, boxes, opt, w);
+  return true;
+}
+
 void find_contacts(const std::vector<ContactNodeItem>& nodes,
                    const std::vector<ContactFaceItem>& faces, const SearchOptions& opt,
                    SearchWorkspace& w, std::vector<ContactPair>& pairs) {
-  pairs.clear();
-  if (nodes.empty() || faces.empty()) {
-    w.built = false;
-    return;
+  FaceBoxes boxes;
+  for (int i = 0; i < 6; ++i) w.box[i].resize(faces.size());
+  for (std::size_t f = 0; f < faces.size(); ++f)
+    for (int i = 0; i < 3; ++i) {
+      w.box[i][f] = faces[f].lo[i];
+      w.box[3 + i][f] = faces[f].hi[i];
+    }
+  for (int i = 0; i < 3; ++i) {
+    boxes.lo[i] = w.box[i];
+    boxes.hi[i] = w.box[3 + i];
   }
-  if (!lists_valid(nodes, faces, w)) build_lists(nodes, faces, opt, w);
+  update_candidate_lists(nodes, faces, boxes, opt, w);
+  find_pairs(nodes, faces, boxes, opt, w, pairs);
+}
+
+void find_pairs(const std::vector<ContactNodeItem>& nodes,
+                const std::vector<ContactFaceItem>& faces, const FaceBoxes& boxes,
+                const SearchOptions& opt, SearchWorkspace& w, std::vector<ContactPair>& pairs) {
+  pairs.clear();
+  if (nodes.empty() || faces.empty()) return;
 
   const double tol = 1 + opt.parametric_tolerance;
   std::vector<int>& own = w.own;
@@ -246,9 +289,9 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
     return false;
   };
   auto holds = [&](int f, const Vec3& p) {
-    const auto& fc = faces[static_cast<std::size_t>(f)];
-    return !((p.x < fc.lo[0]) | (p.x > fc.hi[0]) | (p.y < fc.lo[1]) | (p.y > fc.hi[1]) |
-             (p.z < fc.lo[2]) | (p.z > fc.hi[2]));
+    const auto k = static_cast<std::size_t>(f);
+    return !((p.x < boxes.lo[0][k]) | (p.x > boxes.hi[0][k]) | (p.y < boxes.lo[1][k]) |
+             (p.y > boxes.hi[1][k]) | (p.z < boxes.lo[2][k]) | (p.z > boxes.hi[2][k]));
   };
   for (std::size_t k = 0; k < w.active.size(); ++k) {
     const auto n = static_cast<std::size_t>(w.active[k]);

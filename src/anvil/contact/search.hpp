@@ -94,6 +94,12 @@ struct SearchOptions {
   double skin = 0.1;
 };
 
+// The capture boxes of the faces (structure of arrays, one entry per face of the face
+// list): what the search tests every cycle. The items' own lo/hi are not read.
+struct FaceBoxes {
+  std::span<const double> lo[3], hi[3];
+};
+
 // Scratch space and candidate lists kept between cycles (no allocation in steady state).
 struct SearchWorkspace {
   struct CellEntry {
@@ -120,13 +126,33 @@ struct SearchWorkspace {
   std::vector<int> list_start;        // per active node: its first candidate (+ end)
   std::vector<int> own_start;         // per active node: its first own face
   std::vector<int> list;              // face indices
+  std::vector<int> needed;            // the faces in some list, ascending (each once)
+  std::vector<char> mark;             // per face: in some list (scratch of the build)
+  std::vector<double> box[6];         // find_contacts(): the items' boxes as FaceBoxes
   std::int64_t builds = 0;            // lists built since the workspace was made
 };
 
 // Finds, for every node, the face it penetrates (if any): pairs in ascending node index.
-// A node never pairs with a face of an element it belongs to.
+// A node never pairs with a face of an element it belongs to. Reads the capture boxes
+// from the items (lo, hi): update_candidate_lists() then find_pairs().
 void find_contacts(const std::vector<ContactNodeItem>& nodes,
                    const std::vector<ContactFaceItem>& faces, const SearchOptions& options,
                    SearchWorkspace& work, std::vector<ContactPair>& pairs);
+
+// The two halves of find_contacts(), for a caller that keeps the boxes apart from the
+// items. First: makes the candidate lists valid for these nodes and boxes (rebuilds them
+// when a node or a box has moved too far, or the node or face ids changed); returns true
+// when it rebuilt them. It reads the faces' ids, nodes and opposite nodes only. Afterwards
+// work.needed lists the faces find_pairs() may read beyond those: of every other face it
+// reads nothing, so the rest of their items (positions, velocities, plane) need not be
+// filled.
+bool update_candidate_lists(const std::vector<ContactNodeItem>& nodes,
+                            const std::vector<ContactFaceItem>& faces, const FaceBoxes& boxes,
+                            const SearchOptions& options, SearchWorkspace& work);
+// Second: the exact capture-box test of the listed candidates and the detailed check.
+void find_pairs(const std::vector<ContactNodeItem>& nodes,
+                const std::vector<ContactFaceItem>& faces, const FaceBoxes& boxes,
+                const SearchOptions& options, SearchWorkspace& work,
+                std::vector<ContactPair>& pairs);
 
 } // namespace anvil

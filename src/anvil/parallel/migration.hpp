@@ -40,6 +40,12 @@ public:
   // True when every item stays on this rank and none arrives: forward() and reverse() are
   // then plain copies in the same order, which a caller may skip.
   bool stays() const { return comm_ != nullptr && peers_.empty(); }
+  // Items forward() sends to other ranks (send_count() less those that stay here).
+  std::size_t sent_elsewhere() const {
+    return comm_
+               ? order_.size() - static_cast<std::size_t>(scount_[static_cast<std::size_t>(rank_)])
+               : 0;
+  }
   // Items received from `rank`, and where they start in the received layout.
   std::size_t recv_count(int rank) const { return static_cast<std::size_t>(rcount_[rank]); }
   std::size_t recv_offset(int rank) const { return static_cast<std::size_t>(rdispl_[rank]); }
