@@ -407,21 +407,25 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
     force_dest_.clear();
     penalty_forces(*search_nodes_, *search_faces_, pairs_, {config_.friction, dt}, force_out_,
                    force_dest_);
-    double deepest = 0;
-    for (const auto& p : pairs_) deepest = std::max(deepest, -p.gap);
+    double deepest = 0, resisted = 0;
+    for (const auto& p : pairs_) {
+      deepest = std::max(deepest, -p.gap);
+      resisted = std::max(resisted, -p.gap - p.allowance);
+    }
     // Load of this rank: nodes searched plus faces held; one reduction for the balance
-    // test, the pair count and the deepest penetration.
+    // test, the pair count and the deepest penetrations.
     double red[4] = {static_cast<double>(search_nodes_->size() + search_faces_->size()), 0,
                      static_cast<double>(pairs_.size()), deepest};
     red[1] = red[0];
-    double mx[2] = {red[0], red[3]};
-    comm_.max(std::span<double>(mx, 2));
+    double mx[3] = {red[0], red[3], resisted};
+    comm_.max(std::span<double>(mx, 3));
     comm_.sum(std::span<double>(red + 1, 2));
     const double mean = red[1] / comm_.size();
     stats_.imbalance = mean > 0 ? mx[0] / mean : 1.0;
     stats_.imbalance_max = std::max(stats_.imbalance_max, stats_.imbalance);
     stats_.pairs = static_cast<std::int64_t>(red[2]);
     stats_.max_penetration = std::max(stats_.max_penetration, mx[1]);
+    stats_.max_penetration_resisted = std::max(stats_.max_penetration_resisted, mx[2]);
     rebalance_due_ = stats_.imbalance > config_.rebalance_threshold;
   }
 

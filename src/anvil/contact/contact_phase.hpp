@@ -38,6 +38,10 @@ struct ContactStats {
   double max_penetration = 0;   // largest gap behind a face, over all cycles, m
   std::int64_t list_builds = 0; // this rank's candidate-list builds (SearchWorkspace)
   std::int64_t plan_builds = 0; // node and face migration plans built (destinations changed)
+  // Largest penetration beyond the pair's allowance, over all cycles, m: the part the
+  // penalty force resists. max_penetration minus this is depth a pair already had when the
+  // search first found it (docs/contact.md, "The can crush and its limits").
+  double max_penetration_resisted = 0;
 };
 
 // FE-side view of the nodes the contact phase reads and writes.

@@ -467,6 +467,7 @@ void Outputs::write_summary(int status, const std::string& message) {
                     {"load_imbalance_last", contact_stats.imbalance},
                     {"load_imbalance_max", contact_stats.imbalance_max},
                     {"max_penetration", contact_stats.max_penetration},
+                    {"max_penetration_resisted", contact_stats.max_penetration_resisted},
                     {"candidate_list_builds_max", list_builds_max},
                     {"plan_builds", contact_stats.plan_builds},
                     {"bytes_sent_per_rank_per_cycle_max",
