@@ -116,7 +116,23 @@ void ContactPhase::set_extra_nodes(std::span<const ContactNodeItem> items) {
 }
 
 void ContactPhase::pack_face(std::size_t f, const ContactNodes& nd) {
-  auto& it = face_local_[f];
+  pack_cycle(f, nd, face_local_[f]);
+}
+
+void ContactPhase::pack_copy(std::size_t f, const ContactNodes& nd, ContactFaceItem& it) const {
+  const ContactFaceItem& c = face_local_[f]; // its constant fields
+  it.gid = c.gid;
+  for (int a = 0; a < 4; ++a) {
+    it.node[a] = c.node[a];
+    it.opposite[a] = c.opposite[a];
+    it.owner[a] = c.owner[a];
+  }
+  it.stiffness = c.stiffness;
+  it.depth = c.depth;
+  pack_cycle(f, nd, it);
+}
+
+void ContactPhase::pack_cycle(std::size_t f, const ContactNodes& nd, ContactFaceItem& it) const {
   for (int a = 0; a < 4; ++a) {
     const int l = my_face_nodes_[f][a];
     const auto k = static_cast<std::size_t>(corner_[a][f]);
@@ -353,15 +369,11 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       search_faces_ = &face_local_;
     } else {
       if (lazy_cycle) compute_captures(corners(), cap_); // (cannot happen: one rank stays)
-      for (std::size_t f = 0; f < nf; ++f) pack_face(f, nd);
-      if (one_copy_each) { // copy k is face k: no copies to make first
-        face_plan_.forward(face_local_, face_in_);
-      } else {
-        face_out_.resize(face_src_.size());
-        for (std::size_t k = 0; k < face_src_.size(); ++k)
-          face_out_[k] = face_local_[static_cast<std::size_t>(face_src_[k])];
-        face_plan_.forward(face_out_, face_in_);
-      }
+      // Each copy is packed straight into the send buffer of its rank, or into face_in_
+      // where it stays: no face item is copied.
+      face_plan_.forward_packed(face_in_, [&](std::size_t k, ContactFaceItem& it) {
+        pack_copy(static_cast<std::size_t>(face_src_[k]), nd, it);
+      });
       search_faces_ = &face_in_;
     }
     // Only what goes to another rank: items kept here are no traffic.
