@@ -303,6 +303,8 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       rcb_.partition(pts);
     partitioned_ = true;
     rebalance_due_ = false;
+    rank_box_.resize(static_cast<std::size_t>(comm_.size()));
+    for (int r = 0; r < comm_.size(); ++r) rank_box_[static_cast<std::size_t>(r)] = rcb_.box(r);
     ++stats_.rebalances;
   }
 
@@ -312,8 +314,15 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     if (alone)
       std::fill(node_dest_.begin(), node_dest_.end(), 0);
     else
-      for (std::size_t k = 0; k < node_out_.size(); ++k)
-        node_dest_[k] = rcb_.owner({node_out_[k].x[0], node_out_[k].x[1], node_out_[k].x[2]});
+      for (std::size_t k = 0; k < node_out_.size(); ++k) {
+        // Last cycle's rank when the point is still in its half-open box (exactly
+        // Rcb::owner's answer there), else the tree.
+        const Vec3 x{node_out_[k].x[0], node_out_[k].x[1], node_out_[k].x[2]};
+        const Box3& b = rank_box_[static_cast<std::size_t>(node_dest_[k])];
+        if (!(x.x >= b.lo.x && x.x < b.hi.x && x.y >= b.lo.y && x.y < b.hi.y && x.z >= b.lo.z &&
+              x.z < b.hi.z))
+          node_dest_[k] = rcb_.owner(x);
+      }
     // Faces go to every rank their capture box touches (ghosts), as copies.
     bool one_copy_each = true; // then copy k is face k
     if (alone) {
@@ -333,6 +342,21 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       if (!alive(f)) {
         one_copy_each = false;
         continue;
+      }
+      // A capture box strictly inside the box of the face's last rank overlaps that rank
+      // only, and a centre in its half-open box is that rank's: Rcb::overlapping's and
+      // Rcb::owner's answers, without the tree.
+      {
+        const Box3& b = rank_box_[static_cast<std::size_t>(my_face_rank_[f])];
+        bool inside = true;
+        for (int i = 0; i < 3; ++i)
+          inside &= cap_.lo[i][f] > b.lo[i] && cap_.hi[i][f] < b.hi[i] &&
+                    cap_.centre[i][f] >= b.lo[i] && cap_.centre[i][f] < b.hi[i];
+        if (inside) {
+          face_src_.push_back(static_cast<int>(f));
+          face_dest_.push_back(my_face_rank_[f]);
+          continue;
+        }
       }
       my_face_rank_[f] = rcb_.owner({cap_.centre[0][f], cap_.centre[1][f], cap_.centre[2][f]});
       rcb_.overlapping({{cap_.lo[0][f], cap_.lo[1][f], cap_.lo[2][f]},

@@ -145,6 +145,7 @@ private:
   std::vector<double> point_move_;      // per point: |x* - ref_x| this cycle, m
 
   Rcb rcb_;
+  std::vector<Box3> rank_box_; // rcb_.box(r) of every rank, since the last partition
   bool partitioned_ = false;
   bool rebalance_due_ = true;
 
