@@ -116,7 +116,23 @@ void ContactPhase::set_extra_nodes(std::span<const ContactNodeItem> items) {
 }
 
 void ContactPhase::pack_face(std::size_t f, const ContactNodes& nd) {
-  auto& it = face_local_[f];
+  pack_cycle(f, nd, face_local_[f]);
+}
+
+void ContactPhase::pack_copy(std::size_t f, const ContactNodes& nd, ContactFaceItem& it) const {
+  const ContactFaceItem& c = face_local_[f]; // its constant fields
+  it.gid = c.gid;
+  for (int a = 0; a < 4; ++a) {
+    it.node[a] = c.node[a];
+    it.opposite[a] = c.opposite[a];
+    it.owner[a] = c.owner[a];
+  }
+  it.stiffness = c.stiffness;
+  it.depth = c.depth;
+  pack_cycle(f, nd, it);
+}
+
+void ContactPhase::pack_cycle(std::size_t f, const ContactNodes& nd, ContactFaceItem& it) const {
   for (int a = 0; a < 4; ++a) {
     const int l = my_face_nodes_[f][a];
     const auto k = static_cast<std::size_t>(corner_[a][f]);
@@ -287,6 +303,8 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       rcb_.partition(pts);
     partitioned_ = true;
     rebalance_due_ = false;
+    rank_box_.resize(static_cast<std::size_t>(comm_.size()));
+    for (int r = 0; r < comm_.size(); ++r) rank_box_[static_cast<std::size_t>(r)] = rcb_.box(r);
     ++stats_.rebalances;
   }
 
@@ -296,8 +314,15 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     if (alone)
       std::fill(node_dest_.begin(), node_dest_.end(), 0);
     else
-      for (std::size_t k = 0; k < node_out_.size(); ++k)
-        node_dest_[k] = rcb_.owner({node_out_[k].x[0], node_out_[k].x[1], node_out_[k].x[2]});
+      for (std::size_t k = 0; k < node_out_.size(); ++k) {
+        // Last cycle's rank when the point is still in its half-open box (exactly
+        // Rcb::owner's answer there), else the tree.
+        const Vec3 x{node_out_[k].x[0], node_out_[k].x[1], node_out_[k].x[2]};
+        const Box3& b = rank_box_[static_cast<std::size_t>(node_dest_[k])];
+        if (!(x.x >= b.lo.x && x.x < b.hi.x && x.y >= b.lo.y && x.y < b.hi.y && x.z >= b.lo.z &&
+              x.z < b.hi.z))
+          node_dest_[k] = rcb_.owner(x);
+      }
     // Faces go to every rank their capture box touches (ghosts), as copies.
     bool one_copy_each = true; // then copy k is face k
     if (alone) {
@@ -317,6 +342,21 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       if (!alive(f)) {
         one_copy_each = false;
         continue;
+      }
+      // A capture box strictly inside the box of the face's last rank overlaps that rank
+      // only, and a centre in its half-open box is that rank's: Rcb::overlapping's and
+      // Rcb::owner's answers, without the tree.
+      {
+        const Box3& b = rank_box_[static_cast<std::size_t>(my_face_rank_[f])];
+        bool inside = true;
+        for (int i = 0; i < 3; ++i)
+          inside &= cap_.lo[i][f] > b.lo[i] && cap_.hi[i][f] < b.hi[i] &&
+                    cap_.centre[i][f] >= b.lo[i] && cap_.centre[i][f] < b.hi[i];
+        if (inside) {
+          face_src_.push_back(static_cast<int>(f));
+          face_dest_.push_back(my_face_rank_[f]);
+          continue;
+        }
       }
       my_face_rank_[f] = rcb_.owner({cap_.centre[0][f], cap_.centre[1][f], cap_.centre[2][f]});
       rcb_.overlapping({{cap_.lo[0][f], cap_.lo[1][f], cap_.lo[2][f]},
@@ -353,15 +393,11 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       search_faces_ = &face_local_;
     } else {
       if (lazy_cycle) compute_captures(corners(), cap_); // (cannot happen: one rank stays)
-      for (std::size_t f = 0; f < nf; ++f) pack_face(f, nd);
-      if (one_copy_each) { // copy k is face k: no copies to make first
-        face_plan_.forward(face_local_, face_in_);
-      } else {
-        face_out_.resize(face_src_.size());
-        for (std::size_t k = 0; k < face_src_.size(); ++k)
-          face_out_[k] = face_local_[static_cast<std::size_t>(face_src_[k])];
-        face_plan_.forward(face_out_, face_in_);
-      }
+      // Each copy is packed straight into the send buffer of its rank, or into face_in_
+      // where it stays: no face item is copied.
+      face_plan_.forward_packed(face_in_, [&](std::size_t k, ContactFaceItem& it) {
+        pack_copy(static_cast<std::size_t>(face_src_[k]), nd, it);
+      });
       search_faces_ = &face_in_;
     }
     // Only what goes to another rank: items kept here are no traffic.

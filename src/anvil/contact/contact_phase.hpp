@@ -145,6 +145,7 @@ private:
   std::vector<double> point_move_;      // per point: |x* - ref_x| this cycle, m
 
   Rcb rcb_;
+  std::vector<Box3> rank_box_; // rcb_.box(r) of every rank, since the last partition
   bool partitioned_ = false;
   bool rebalance_due_ = true;
 
@@ -152,8 +153,8 @@ private:
   std::vector<double> px_, py_, pz_, pw_;
   std::vector<std::int64_t> pid_;
   std::vector<ContactNodeItem> node_out_, node_in_;
-  std::vector<ContactFaceItem> face_local_, face_out_, face_in_; // per face, per copy, received
-  std::vector<int> node_dest_, face_dest_, face_src_, ranks_;    // face_src_: face of each copy
+  std::vector<ContactFaceItem> face_local_, face_in_;         // per face, received
+  std::vector<int> node_dest_, face_dest_, face_src_, ranks_; // face_src_: face of each copy
   // The destinations the plans were built for (reused while nobody's have changed).
   std::vector<int> node_dest_built_, face_dest_built_, face_src_built_;
   bool plans_built_ = false;
@@ -172,6 +173,9 @@ private:
   // Writes this cycle's corners (predicted positions, velocities, masses), plane and
   // capture box into face_local_[f].
   void pack_face(std::size_t f, const ContactNodes& nodes);
+  // The same fields, and the constant ones of face_local_[f], into another item.
+  void pack_copy(std::size_t f, const ContactNodes& nodes, ContactFaceItem& it) const;
+  void pack_cycle(std::size_t f, const ContactNodes& nodes, ContactFaceItem& it) const;
   // The faces' corners and depths as compute_captures() reads them.
   FaceCorners corners() const;
   // Sets the bound's reference from this cycle's exact boxes and the lists just checked.

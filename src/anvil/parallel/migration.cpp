@@ -88,6 +88,21 @@ void Migration::build(const Comm& comm, std::span<const int> dest) {
       peers_.push_back(q);
 }
 
+void Migration::post_receives(void* out_v, std::size_t size) {
+  if (!comm_) throw std::logic_error("Migration: build() was not called");
+  auto* out = static_cast<unsigned char*>(out_v);
+  for (int q : peers_) {
+    const auto qz = static_cast<std::size_t>(q);
+    if (rcount_[qz] > 0)
+      comm_->irecv_bytes(out + rdispl_[qz] * size, rcount_[qz] * size, q, kForwardTag, requests_);
+  }
+}
+
+void Migration::send_group(int q, const void* data, std::size_t size) {
+  const auto qz = static_cast<std::size_t>(q);
+  comm_->isend_bytes(data, scount_[qz] * size, q, kForwardTag, requests_);
+}
+
 void Migration::move_bytes(const void* in_v, void* out_v, std::size_t size, bool reverse) {
   if (!comm_) throw std::logic_error("Migration: build() was not called");
   const auto* in = static_cast<const unsigned char*>(in_v);

@@ -21,6 +21,7 @@
 #include <span>
 #include <stdexcept>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "anvil/parallel/comm.hpp"
@@ -65,6 +66,39 @@ public:
     forward(std::span<const T>(in), std::span<T>(out));
   }
 
+  // Like forward(), without an input array: pack(i, T& item) writes local item i (0 <= i <
+  // send_count()) straight into its place, the send buffer of its rank or, for items that
+  // stay, out itself. Each item is written once and moved no further (forward() copies it
+  // twice when it stays: into the input, then into out). Collective.
+  template <class T, class Pack>
+  void forward_packed(std::span<T> out, Pack&& pack) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    if (out.size() != recv_count())
+      throw std::invalid_argument("Migration::forward_packed: out does not match the plan");
+    const std::size_t need = order_.size() * sizeof(T);
+    if (buffer_.size() < need) buffer_.resize(need);
+    T* buf = reinterpret_cast<T*>(buffer_.data());
+    auto pack_group = [&](int q, T* dst) {
+      const auto qz = static_cast<std::size_t>(q);
+      const std::int64_t* idx = order_.data() + sdispl_[qz];
+      for (std::int64_t k = 0; k < scount_[qz]; ++k) pack(static_cast<std::size_t>(idx[k]), dst[k]);
+    };
+    post_receives(out.data(), sizeof(T));
+    for (int q : peers_) {
+      const auto qz = static_cast<std::size_t>(q);
+      if (scount_[qz] == 0) continue;
+      pack_group(q, buf + sdispl_[qz]);
+      send_group(q, buf + sdispl_[qz], sizeof(T));
+    }
+    pack_group(rank_, out.data() + rdispl_[static_cast<std::size_t>(rank_)]);
+    requests_.wait();
+  }
+  template <class T, class Pack>
+  void forward_packed(std::vector<T>& out, Pack&& pack) {
+    out.resize(recv_count());
+    forward_packed(std::span<T>(out), std::forward<Pack>(pack));
+  }
+
   // Moves one field back: in has recv_count() items in the received layout, out gets
   // send_count() items at the original positions. Collective.
   template <class T>
@@ -83,6 +117,10 @@ public:
 private:
   // Moves items of `size` bytes forward or in reverse (see above).
   void move_bytes(const void* in, void* out, std::size_t size, bool reverse);
+  // forward_packed's messages: receives from every peer into out (received layout), and
+  // the send of rank q's group, packed at data.
+  void post_receives(void* out, std::size_t size);
+  void send_group(int q, const void* data, std::size_t size);
 
   const Comm* comm_ = nullptr;
   int rank_ = 0;
