@@ -86,43 +86,6 @@ TEST(Contact, ProjectionMatchesBruteForceOnWarpedFaces) {
   }
 }
 
-// set_captures() gives set_capture()'s bits for warped, degenerate and mixed-size faces.
-TEST(Contact, SetCapturesMatchesSetCaptureBitwise) {
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<ContactFaceItem> one(13), many;
-  for (std::size_t f = 0; f < one.size(); ++f) {
-    auto& it = one[f];
-    it = {};
-    const double s = std::pow(10.0, -static_cast<double>(f % 4));
-    const double xs[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-    for (int a = 0; a < 4; ++a) {
-      it.x[a][0] = s * (xs[a][0] + 0.2 * u(rng)) + u(rng);
-      it.x[a][1] = s * (xs[a][1] + 0.2 * u(rng));
-      it.x[a][2] = s * 0.3 * u(rng);
-    }
-    if (f == 5)
-      for (int a = 0; a < 4; ++a)
-        for (int i = 0; i < 3; ++i) it.x[a][i] = 0.5; // degenerate: zero area
-    it.depth = 0.1 * s;
-  }
-  many = one;
-  std::vector<Vec3> centres(many.size());
-  set_captures(many, centres);
-  for (std::size_t f = 0; f < one.size(); ++f) {
-    const FacePlane p = set_capture(one[f]);
-    for (int i = 0; i < 3; ++i) {
-      EXPECT_EQ(std::memcmp(&one[f].normal[i], &many[f].normal[i], 8), 0) << f;
-      EXPECT_EQ(std::memcmp(&one[f].lo[i], &many[f].lo[i], 8), 0) << f;
-      EXPECT_EQ(std::memcmp(&one[f].hi[i], &many[f].hi[i], 8), 0) << f;
-      const double ca = p.centre[i], cb = centres[f][i];
-      EXPECT_EQ(std::memcmp(&ca, &cb, 8), 0) << f;
-    }
-    EXPECT_EQ(std::memcmp(&one[f].offset, &many[f].offset, 8), 0) << f;
-    EXPECT_EQ(std::memcmp(&one[f].warp, &many[f].warp, 8), 0) << f;
-  }
-}
-
 // compute_captures() (structure of arrays, vectorised across faces) gives set_capture()'s
 // bits, for a face count that is not a whole number of vectors.
 TEST(Contact, ComputeCapturesMatchesSetCaptureBitwise) {

@@ -54,10 +54,6 @@ FacePlane set_capture(ContactFaceItem& f) {
   return p;
 }
 
-void set_captures(std::span<ContactFaceItem> faces, std::span<Vec3> centres) {
-  for (std::size_t f = 0; f < faces.size(); ++f) centres[f] = set_capture(faces[f]).centre;
-}
-
 namespace {
 
 // True when the candidate lists of the last build still hold every face whose capture box

@@ -81,8 +81,6 @@ Box3 capture_box(const ContactFaceItem& face, const FacePlane& plane);
 // Computes the face's mean plane and capture box from its corners and depth and stores
 // them in the item (the search reads them from there); returns the plane.
 FacePlane set_capture(ContactFaceItem& face);
-// set_capture() for every face; the centre of each face's mean plane goes to centres[f].
-void set_captures(std::span<ContactFaceItem> faces, std::span<Vec3> centres);
 
 struct SearchOptions {
   double dt = 0; // the step just predicted: x - dt v is the start of the step (0: no check)

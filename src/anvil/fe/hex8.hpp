@@ -167,18 +167,10 @@ ANVIL_HEX8_INLINE void hourglass_shape(const V (&x)[8][3], const V (&B)[8][3], c
   }
 }
 
-// Velocity gradient L_ij = (1/V) sum_a v_ia B_ja split into the rate of deformation
-// d (xx, yy, zz, xy, yz, xz) and the spin's axial vector w (W_zy, W_xz, W_yx).
+// The velocity gradient L split into the rate of deformation d (xx, yy, zz, xy, yz, xz)
+// and the spin's axial vector w (W_zy, W_xz, W_yx). For elements and particles alike.
 template <class V>
-ANVIL_HEX8_INLINE void velocity_gradient(const V (&v)[8][3], const V (&B)[8][3],
-                                         const V& inv_volume, V (&d)[6], V (&w)[3]) {
-  V L[3][3];
-  _Pragma("GCC unroll 8") for (int i = 0; i < 3; ++i)
-      _Pragma("GCC unroll 8") for (int j = 0; j < 3; ++j) {
-    V s = v[0][i] * B[0][j];
-    _Pragma("GCC unroll 8") for (int a = 1; a < 8; ++a) s += v[a][i] * B[a][j];
-    L[i][j] = s * inv_volume;
-  }
+ANVIL_HEX8_INLINE void rate_and_spin(const V (&L)[3][3], V (&d)[6], V (&w)[3]) {
   d[0] = L[0][0];
   d[1] = L[1][1];
   d[2] = L[2][2];

@@ -275,14 +275,8 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       for (auto& row : L)
         for (auto& x : row) x *= inv12;
       // Rate of deformation d (xx, yy, zz, xy, yz, xz) and the spin's axial vector w.
-      const vdouble d[6] = {L[0][0],
-                            L[1][1],
-                            L[2][2],
-                            0.5 * (L[0][1] + L[1][0]),
-                            0.5 * (L[1][2] + L[2][1]),
-                            0.5 * (L[0][2] + L[2][0])};
-      const vdouble w[3] = {0.5 * (L[2][1] - L[1][2]), 0.5 * (L[0][2] - L[2][0]),
-                            0.5 * (L[1][0] - L[0][1])};
+      vdouble d[6], w[3];
+      hex8::rate_and_spin(L, d, w);
       vdouble Q[3][3], s[6];
       hex8::hughes_winget(w, dt, Q);
       _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) s[k] = simd::load(&b.stress[k][e]);

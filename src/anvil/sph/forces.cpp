@@ -276,14 +276,8 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) w.binv[9 * i + 3 * a + b] = Bi[a][b];
     }
-    const double d[6] = {L[0][0],
-                         L[1][1],
-                         L[2][2],
-                         0.5 * (L[0][1] + L[1][0]),
-                         0.5 * (L[1][2] + L[2][1]),
-                         0.5 * (L[0][2] + L[2][0])};
-    const double spin[3] = {0.5 * (L[2][1] - L[1][2]), 0.5 * (L[0][2] - L[2][0]),
-                            0.5 * (L[1][0] - L[0][1])};
+    double d[6], spin[3];
+    hex8::rate_and_spin(L, d, spin);
     // Continuity, time-centred: rho(n) = rho(n-1) (1 - tr D dt/2) / (1 + tr D dt/2); or
     // the summation at x(n) (tied to the particles' spacing: across a shock the
     // integrated rate drifts from it, and the pressure with it; docs/sph.md, Sod).
