@@ -1,6 +1,8 @@
 // The element's building blocks against their definitions.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "anvil/fe/hex8.hpp"
@@ -78,6 +80,77 @@ TEST(Hex8, LinearCompletenessAndHourglassOrthogonality) {
     EXPECT_NEAR(s0, 0.0, 1e-12);
     for (double v : s) EXPECT_NEAR(v, 0.0, 1e-12);
   }
+}
+
+// The bound on the viscous hourglass damping matrix sum_al gamma_al gamma_al^T that the
+// stable step uses, against the largest eigenvalue of the Gram matrix of the shape vectors
+// formed explicitly by hourglass_shape: Gershgorin's largest absolute row sum of that
+// matrix, so never below its largest eigenvalue (found by power iteration), and exactly
+// 8 on a parallelepiped, where gamma = Gamma (Flanagan and Belytschko 1981).
+// Tolerances: round-off, 1e-12 relative; the power iteration's estimate may fall short
+// of the eigenvalue, never exceed it.
+TEST(Hex8, HourglassDampingBoundBoundsTheDampingMatrix) {
+  auto check = [](const double(&x)[8][3]) {
+    double B[8][3], g[4][8];
+    hex8::gradient(x, B);
+    const double V = hex8::volume(x, B);
+    hex8::hourglass_shape(x, B, 1.0 / V, g);
+    double Bc[3][8], h[4][3];
+    for (int a = 0; a < 8; ++a)
+      for (int i = 0; i < 3; ++i) Bc[i][a] = B[a][i];
+    for (int al = 0; al < 4; ++al)
+      for (int i = 0; i < 3; ++i) {
+        h[al][i] = 0;
+        for (int a = 0; a < 8; ++a) h[al][i] += hex8::gamma_base[al][a] * x[a][i] / V;
+      }
+    double G[4][4], gersh = 0;
+    for (int a = 0; a < 4; ++a) {
+      double row = 0;
+      for (int b = 0; b < 4; ++b) {
+        G[a][b] = 0;
+        for (int n = 0; n < 8; ++n) G[a][b] += g[a][n] * g[b][n];
+        row += std::abs(G[a][b]);
+      }
+      gersh = std::max(gersh, row);
+    }
+    double v[4] = {1, 0.9, 0.8, 0.7}, lambda = 0;
+    for (int it = 0; it < 500; ++it) {
+      double w[4] = {0, 0, 0, 0}, n = 0;
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) w[a] += G[a][b] * v[b];
+      for (double c : w) n += c * c;
+      n = std::sqrt(n);
+      lambda = n;
+      for (int a = 0; a < 4; ++a) v[a] = w[a] / n;
+    }
+    const double bound = hex8::hourglass_damping_bound(Bc, h);
+    EXPECT_NEAR(bound, gersh, 1e-12 * gersh);
+    EXPECT_GE(bound, lambda * (1 - 1e-12));
+    return bound;
+  };
+  for (unsigned seed = 1; seed <= 5; ++seed) {
+    double x[8][3];
+    distorted(x, seed);
+    EXPECT_GT(check(x), 8.0);
+  }
+  // A sheared, stretched brick (a parallelepiped): gamma = Gamma, orthogonal, norm^2 8.
+  double p[8][3];
+  static constexpr double s[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                     {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  for (int a = 0; a < 8; ++a) {
+    p[a][0] = 3.0 * s[a][0] + 0.4 * s[a][1] + 0.2 * s[a][2];
+    p[a][1] = 0.5 * s[a][1] - 0.3 * s[a][2];
+    p[a][2] = 0.05 * s[a][2];
+  }
+  EXPECT_NEAR(check(p), 8.0, 8e-12);
+  // A thin element warped out of its plane, as in a tight fold: the bound grows.
+  double w[8][3];
+  for (int a = 0; a < 8; ++a) {
+    w[a][0] = 2.0 * s[a][0];
+    w[a][1] = 2.0 * s[a][1];
+    w[a][2] = 0.1 * s[a][2] + ((a == 0 || a == 2 || a == 4 || a == 6) ? 0.3 : 0.0);
+  }
+  EXPECT_GT(check(w), 8.0);
 }
 
 // The Hughes-Winget rotation is orthogonal and equals the Cayley transform of the spin:

@@ -421,7 +421,37 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       // Stable time step: Flanagan-Belytschko bound on the maximum eigenvalue,
       // omega^2 <= 8 c^2 B:B / V^2, i.e. dt = V / (c sqrt(2 B:B)), reduced for the bulk
       // viscosity.
-      vdouble dte = lc / (qv + stdx::sqrt(qv * qv + c * c));
+      // The viscous hourglass force damps the nodes at a rate of at most
+      // r = kv lambda / (m / 8): lambda bounds the largest eigenvalue of the damping
+      // matrix sum_al gamma_al gamma_al^T, m / 8 is this element's share of any of its
+      // nodes' mass. Central differences with a lagged damping rate r and a frequency
+      // omega are stable while dt^2 omega^2 + 2 dt r < 4, which is the bulk viscosity's
+      // form with r lc / 4 added to its rate term. lambda is first bounded cheaply by
+      // (sqrt 8 + |B| |h|)^2 (exact on a parallelepiped); Gershgorin's sharper bound
+      // (hex8::hourglass_damping_bound) is computed only where the cheap step is not above
+      // its lane's smallest so far, since only there can the element set the step. The
+      // step is the same as with the sharp bound everywhere.
+      vdouble dte;
+      if (!stiff) {
+        const vdouble kr = (0.25 * 8.0) * kv * lc / mass;
+        vdouble hh = h[0][0] * h[0][0];
+        _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
+            _Pragma("GCC unroll 12") for (int i = (al == 0 ? 1 : 0); i < 3; ++i) hh +=
+            h[al][i] * h[al][i];
+        const vdouble root = 2.8284271247461903 + stdx::sqrt(bb * hh);
+        vdouble qh = qv + kr * root * root;
+        dte = lc / (qh + stdx::sqrt(qh * qh + c * c));
+        if (stdx::any_of(dte <= best_dt)) {
+          vdouble Bc[3][8];
+          _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a)
+              _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) Bc[i][a] =
+                  Bt(a, i) * (1.0 / 12.0);
+          qh = qv + kr * hex8::hourglass_damping_bound(Bc, h);
+          dte = lc / (qh + stdx::sqrt(qh * qh + c * c));
+        }
+      } else {
+        dte = lc / (qv + stdx::sqrt(qv * qv + c * c));
+      }
 
       // Eroded elements: no force, no energy, no time step (select, not multiply: their
       // arithmetic may have produced non-finite values).
