@@ -149,14 +149,15 @@ struct SphWorkspace {
   std::vector<double> energy_pred; // e predicted at the new state (equations of state)
 };
 
-// Pass 1 over own particles, over the interval dt (the previous step): selects this
-// step's neighbours among the candidate lists (work.nl: the candidates within the
-// kernel's support at the current positions and h) and keeps each entry's kernel
-// derivative for pass 2. The candidates must hold every pair within the support.
+// Pass 1 for own particles, over the interval dt (the previous step): selects this
+// step's neighbours among the candidate half lists (work.nl: the candidates within the
+// kernel's support at the current positions and h; rows of own and ghost particles,
+// find_candidates) and keeps each entry's kernel derivative for pass 2. The candidates
+// must hold every pair within the support that concerns an own particle.
 void sph_kinematics(const SphView& v, std::span<const SetParams> sets, KernelType kernel,
                     const NeighbourList& candidates, double dt, SphWorkspace& work);
 
-// Pass 2 over own particles, over work.nl: forces at t(n), energy rates, stable step.
+// Pass 2 for own particles, over work.nl: forces at t(n), energy rates, stable step.
 void sph_forces(const SphView& v, std::span<const SetParams> sets, KernelType kernel,
                 SphWorkspace& work, SphResult& result);
 
