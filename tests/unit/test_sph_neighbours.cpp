@@ -1,6 +1,7 @@
 // SPH neighbour lists (src/anvil/sph/neighbours.hpp): the neighbours filtered from the
-// candidate (Verlet) lists are exactly the pairs with r_ij < h_i + h_j at the current
-// positions, in ascending global id, whatever the positions and the radius of the
+// candidate (Verlet) half lists are exactly the pairs with r_ij < h_i + h_j at the current
+// positions that concern an own particle, each once in the row of its lower global id,
+// rows and entries in ascending global id, whatever the positions and the radius of the
 // candidates' build (as long as the candidates hold every such pair). This is what makes
 // the particle phase's results independent of when the lists were built (a restart builds
 // them afresh) and of the rank count. Reference: a brute-force search over all pairs.
@@ -54,57 +55,72 @@ Cloud make_cloud(int n, unsigned seed) {
   return c;
 }
 
-// Brute force: the pairs within the support, each row in ascending gid.
-std::vector<std::vector<int>> brute(const Cloud& c, std::size_t n_query) {
-  std::vector<std::vector<int>> rows(n_query);
-  for (std::size_t i = 0; i < n_query; ++i) {
-    for (std::size_t j = 0; j < c.x.size(); ++j) {
-      if (j == i) continue;
+// Brute force: the pairs within the support of which i or j is own (i < n_own), in the
+// row of the lower gid; rows (in ascending gid) and entries in ascending gid.
+struct Rows {
+  std::vector<int> particle;
+  std::vector<std::vector<int>> list;
+};
+Rows brute(const Cloud& c, std::size_t n_own) {
+  const std::size_t n = c.x.size();
+  Rows rows;
+  for (std::size_t i = 0; i < n; ++i) rows.particle.push_back(static_cast<int>(i));
+  auto by_gid = [&](int a, int b) {
+    return c.gid[static_cast<std::size_t>(a)] < c.gid[static_cast<std::size_t>(b)];
+  };
+  std::sort(rows.particle.begin(), rows.particle.end(), by_gid);
+  for (const int ii : rows.particle) {
+    const auto i = static_cast<std::size_t>(ii);
+    std::vector<int> row;
+    for (std::size_t j = 0; j < n; ++j) {
+      if (c.gid[j] <= c.gid[i] || (i >= n_own && j >= n_own)) continue;
       const double dx = c.x[i] - c.x[j], dy = c.y[i] - c.y[j], dz = c.z[i] - c.z[j];
       const double s = c.h[i] + c.h[j];
-      if (dx * dx + dy * dy + dz * dz < s * s) rows[i].push_back(static_cast<int>(j));
+      if (dx * dx + dy * dy + dz * dz < s * s) row.push_back(static_cast<int>(j));
     }
-    std::sort(rows[i].begin(), rows[i].end(), [&](int a, int b) {
-      return c.gid[static_cast<std::size_t>(a)] < c.gid[static_cast<std::size_t>(b)];
-    });
+    std::sort(row.begin(), row.end(), by_gid);
+    rows.list.push_back(row);
   }
   return rows;
 }
 
-void expect_lists(const NeighbourList& nl, const std::vector<std::vector<int>>& ref) {
-  ASSERT_EQ(nl.len.size(), ref.size());
+void expect_lists(const NeighbourList& nl, const Rows& ref) {
+  ASSERT_EQ(nl.len.size(), ref.list.size());
+  ASSERT_EQ(nl.row, ref.particle);
   std::size_t total = 0;
-  for (std::size_t i = 0; i < ref.size(); ++i) {
-    ASSERT_EQ(nl.start[i] % anvil::simd::width, 0);
-    ASSERT_EQ(nl.len[i], static_cast<int>(ref[i].size())) << "particle " << i;
-    for (std::size_t k = 0; k < ref[i].size(); ++k)
-      ASSERT_EQ(nl.index[static_cast<std::size_t>(nl.start[i]) + k], ref[i][k]) << "particle " << i;
+  for (std::size_t r = 0; r < ref.list.size(); ++r) {
+    const int i = ref.particle[r];
+    ASSERT_EQ(nl.start[r] % anvil::simd::width, 0);
+    ASSERT_EQ(nl.len[r], static_cast<int>(ref.list[r].size())) << "particle " << i;
+    for (std::size_t k = 0; k < ref.list[r].size(); ++k)
+      ASSERT_EQ(nl.index[static_cast<std::size_t>(nl.start[r]) + k], ref.list[r][k])
+          << "particle " << i;
     // Padding: the particle itself, up to the next row.
-    for (auto k = nl.start[i] + nl.len[i]; k < nl.start[i + 1]; ++k)
-      ASSERT_EQ(nl.index[static_cast<std::size_t>(k)], static_cast<int>(i));
-    ASSERT_LT(nl.start[i + 1] - nl.start[i] - nl.len[i], anvil::simd::width);
-    total += ref[i].size();
+    for (auto k = nl.start[r] + nl.len[r]; k < nl.start[r + 1]; ++k)
+      ASSERT_EQ(nl.index[static_cast<std::size_t>(k)], i);
+    ASSERT_LT(nl.start[r + 1] - nl.start[r] - nl.len[r], anvil::simd::width);
+    total += ref.list[r].size();
   }
   EXPECT_EQ(nl.pairs(), total);
 }
 
 TEST(SphNeighbours, FilteredCandidatesAreTheExactPairsInGidOrder) {
   Cloud c = make_cloud(9, 1);
-  const std::size_t n_query = c.x.size() - 100; // the rest act as ghosts
+  const std::size_t n_own = c.x.size() - 100; // the rest act as ghosts
   const double hmax = *std::max_element(c.h.begin(), c.h.end());
   NeighbourWorkspace work;
   NeighbourList cand, nl;
-  find_candidates(c.x, c.y, c.z, c.gid, n_query, 2 * hmax * 1.2, work, cand);
+  find_candidates(c.x, c.y, c.z, c.gid, n_own, 2 * hmax * 1.2, work, cand);
   filter_neighbours(c.xh.data()->x, 4, cand, nl);
-  expect_lists(nl, brute(c, n_query));
+  expect_lists(nl, brute(c, n_own));
 }
 
 // Candidates built at other positions, with other radii, give the same neighbours once
 // filtered at the current positions: the lists do not depend on when they were built.
 TEST(SphNeighbours, IndependentOfTheBuild) {
   const Cloud now = make_cloud(8, 2);
-  const std::size_t n_query = now.x.size();
-  const auto ref = brute(now, n_query);
+  const std::size_t n_own = now.x.size() - 50;
+  const auto ref = brute(now, n_own);
   const double hmax = *std::max_element(now.h.begin(), now.h.end());
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> move(-0.1, 0.1);
@@ -120,7 +136,7 @@ TEST(SphNeighbours, IndependentOfTheBuild) {
     const double radius = std::max(2 * hmax * (1 + skin), 2 * hmax + 2 * dmax);
     NeighbourWorkspace work;
     NeighbourList cand, nl;
-    find_candidates(then.x, then.y, then.z, then.gid, n_query, radius, work, cand);
+    find_candidates(then.x, then.y, then.z, then.gid, n_own, radius, work, cand);
     filter_neighbours(now.xh.data()->x, 4, cand, nl);
     expect_lists(nl, ref);
   }

@@ -4,6 +4,7 @@
 // what keeps results independent of the partition.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <experimental/simd>
@@ -133,6 +134,48 @@ inline void gather4(const double* p, int stride, const int* idx, vdouble (&out)[
 #endif
   for (int a = 0; a < 4; ++a)
     out[a] = vdouble([&](auto l) { return p[static_cast<std::ptrdiff_t>(stride) * idx[l] + a]; });
+}
+
+// The converse of gather4: adds lane l of v[0..3] to the four consecutive doubles at
+// q[l] (32-byte aligned; the caller forms the `width` record addresses once for all the
+// groups it adds: the stores may alias an index array, which would then be read again),
+// lane after lane (a record that several lanes name receives their values in lane order).
+// With AVX: the 4 x 4 transpose and one vector add per lane instead of sixteen scalar ones.
+inline void scatter_add4(double* const* q, const vdouble (&v)[4]) {
+#if defined(__AVX__)
+  if constexpr (width == 4) {
+    const __m256d a = static_cast<__m256d>(v[0]), b = static_cast<__m256d>(v[1]);
+    const __m256d c = static_cast<__m256d>(v[2]), d = static_cast<__m256d>(v[3]);
+    const __m256d t0 = _mm256_unpacklo_pd(a, b), t1 = _mm256_unpackhi_pd(a, b);
+    const __m256d t2 = _mm256_unpacklo_pd(c, d), t3 = _mm256_unpackhi_pd(c, d);
+    _mm256_store_pd(q[0],
+                    _mm256_add_pd(_mm256_load_pd(q[0]), _mm256_permute2f128_pd(t0, t2, 0x20)));
+    _mm256_store_pd(q[1],
+                    _mm256_add_pd(_mm256_load_pd(q[1]), _mm256_permute2f128_pd(t1, t3, 0x20)));
+    _mm256_store_pd(q[2],
+                    _mm256_add_pd(_mm256_load_pd(q[2]), _mm256_permute2f128_pd(t0, t2, 0x31)));
+    _mm256_store_pd(q[3],
+                    _mm256_add_pd(_mm256_load_pd(q[3]), _mm256_permute2f128_pd(t1, t3, 0x31)));
+    return;
+  }
+#endif
+  for (int l = 0; l < width; ++l)
+    for (int a = 0; a < 4; ++a) q[l][a] += v[a][l];
+}
+
+// q[l][0] = std::max(q[l][0], v[l]) for every lane, lane after lane (the bits of
+// std::max, NaNs included: maxsd(x, m) is m < x ? x : m).
+inline void scatter_max(double* const* q, const vdouble& v) {
+#if defined(__AVX__)
+  if constexpr (width == 4) {
+    const __m256d x = static_cast<__m256d>(v);
+    const __m128d lo = _mm256_castpd256_pd128(x), hi = _mm256_extractf128_pd(x, 1);
+    const __m128d lane[4] = {lo, _mm_unpackhi_pd(lo, lo), hi, _mm_unpackhi_pd(hi, hi)};
+    for (int l = 0; l < 4; ++l) _mm_store_sd(q[l], _mm_max_sd(lane[l], _mm_load_sd(q[l])));
+    return;
+  }
+#endif
+  for (int l = 0; l < width; ++l) q[l][0] = std::max(q[l][0], static_cast<double>(v[l]));
 }
 
 // Bit l set when lane l's sign bit is set (x < y exactly when x - y is negative, for

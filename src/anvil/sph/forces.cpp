@@ -197,7 +197,8 @@ inline vdouble artificial_factor(const vdouble& wk, const vdouble& hb, const Set
 }
 
 // Pass 1's pair loop for one kernel (the kernel is a template parameter so that the
-// loop has no per-pair branch on it).
+// loop has no per-pair branch on it), over the half lists in ascending gid (forces.hpp):
+// each pair's kernel once, for both particles.
 template <KernelType K, int D>
 void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double dt,
                       SphWorkspace& w) {
@@ -206,21 +207,30 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
   const double* rdp = rd->x;
   constexpr int stride = sizeof(NeighbourRead1) / sizeof(double);
   const NeighbourList& nl = w.nl;
-  bool keep_w = false; // pass 2 needs W for the artificial stress
-  for (const auto& st : sets) keep_w = keep_w || st.epsilon > 0;
-  for (std::size_t i = 0; i < n; ++i) {
+  bool keep_w = false, any_summation = false, any_corrected = false;
+  for (const auto& st : sets) {
+    keep_w = keep_w || st.epsilon > 0; // pass 2 needs W for the artificial stress
+    any_summation = any_summation || st.summation;
+    any_corrected = any_corrected || st.corrected;
+  }
+  using S1 = LowerSums1;
+  for (std::size_t r = 0; r < nl.row.size(); ++r) {
+    const auto i = static_cast<std::size_t>(nl.row[r]);
     const NeighbourRead1& pi = rd[i];
     const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
-    // The pairs, `width` at a time (lane l takes the entries k0 + l): each lane sums its
-    // entries in list order and the lanes are added in lane order at the end, so the
-    // sums depend only on the list, which is the same on every rank. Entries past the
-    // row's end are i itself: zero distance, so zero gradient and no contribution to the
+    // The row's pairs, `width` at a time (lane l takes the entries k0 + l): each lane sums
+    // its entries in list order and the lanes are added in lane order at the end. The
+    // lower sums of i are complete (every row of a lower gid has run): read them before
+    // the row, whose padding entries (i itself) add their partner terms to them. A
+    // padding entry has zero distance, so zero gradient and no contribution to i's own
     // gradient sums (the summation density masks them).
+    const S1 lower = w.low1[i];
     vdouble Lv[3][3], Bv[3][3], sum_mw = 0.0;
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) Lv[a][b] = Bv[a][b] = 0.0;
     const vdouble xi[3] = {pi.x[0], pi.x[1], pi.x[2]}, vi[3] = {pi.v[0], pi.v[1], pi.v[2]};
-    const std::int64_t k_begin = nl.start[i], k_end = k_begin + nl.len[i];
+    const vdouble mi = p.mass[i], vol_i = pi.volume;
+    const std::int64_t k_begin = nl.start[r], k_end = k_begin + nl.len[r];
     for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
       const int* idx = nl.index.data() + k0;
       vdouble q0[4], q1[4];
@@ -235,10 +245,15 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
       simd::store(dwr, w.dwr.data() + k0);
       if (keep_w) simd::store(wk, w.wk.data() + k0);
       // Volume weights V_j = m_j / rho_j: consistent across density jumps (a gas
-      // interface, particles of different sets).
+      // interface, particles of different sets). Particle j's terms are i's with V_i for
+      // V_j (grad_j W_ji = -grad_i W_ij and v_i - v_j change sign together).
       const vdouble vj = q1[3];
-      vdouble dv[3];
-      for (int a = 0; a < 3; ++a) dv[a] = vj * (q1[a] - vi[a]);
+      vdouble dv[3], dvj[3];
+      for (int a = 0; a < 3; ++a) {
+        const vdouble u = q1[a] - vi[a];
+        dv[a] = vj * u;
+        dvj[a] = vol_i * u;
+      }
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) Lv[a][b] += dv[a] * g[b];
       if (si.summation)
@@ -246,12 +261,33 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
       if (si.corrected)
         for (int a = 0; a < 3; ++a)
           for (int b = 0; b < 3; ++b) Bv[a][b] -= (vj * dx[a]) * g[b];
+      const vdouble mw = any_summation ? mi * wk : vdouble(0.0);
+      double* q[width];
+      for (int l = 0; l < width; ++l) q[l] = w.low1[static_cast<std::size_t>(idx[l])].a;
+      const vdouble s0[4] = {dvj[0] * g[0], dvj[0] * g[1], dvj[0] * g[2], dvj[1] * g[0]};
+      const vdouble s1[4] = {dvj[1] * g[1], dvj[1] * g[2], dvj[2] * g[0], dvj[2] * g[1]};
+      const vdouble xj[3] = {vol_i * dx[0], vol_i * dx[1], vol_i * dx[2]};
+      const vdouble s2[4] = {dvj[2] * g[2], mw, xj[0] * g[0], xj[0] * g[1]};
+      simd::scatter_add4(q, s0);
+      for (auto& ql : q) ql += 4;
+      simd::scatter_add4(q, s1);
+      for (auto& ql : q) ql += 4;
+      simd::scatter_add4(q, s2);
+      if (any_corrected) {
+        const vdouble s3[4] = {xj[0] * g[2], xj[1] * g[0], xj[1] * g[1], xj[1] * g[2]};
+        const vdouble s4[4] = {xj[2] * g[0], xj[2] * g[1], xj[2] * g[2], 0.0};
+        for (auto& ql : q) ql += 4;
+        simd::scatter_add4(q, s3);
+        for (auto& ql : q) ql += 4;
+        simd::scatter_add4(q, s4);
+      }
     }
+    if (i >= n) continue; // a ghost's row: its partners' terms only
     double L[3][3], B[3][3];
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) {
-        L[a][b] = lane_sum(Lv[a][b]);
-        B[a][b] = lane_sum(Bv[a][b]);
+        L[a][b] = lower.a[S1::L + 3 * a + b] + lane_sum(Lv[a][b]);
+        B[a][b] = si.corrected ? lane_sum(Bv[a][b]) - lower.a[S1::B + 3 * a + b] : 0.0;
       }
     if (si.corrected) {
       // Normalised gradient L B^-1, B = sum V_j (x_j - x_i) (x) grad W: exact for a
@@ -283,7 +319,7 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
     // integrated rate drifts from it, and the pressure with it; docs/sph.md, Sod).
     const double tr = (d[0] + d[1] + d[2]) * dt;
     if (si.summation) {
-      p.rho[i] = lane_sum(sum_mw) + p.mass[i] * self_weight<K, D>(pi.h);
+      p.rho[i] = (lower.a[S1::mw] + lane_sum(sum_mw)) + p.mass[i] * self_weight<K, D>(pi.h);
     } else {
       p.rho[i] = p.rho[i] * (1 - 0.5 * tr) / (1 + 0.5 * tr);
     }
@@ -325,7 +361,9 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
     r.volume = p.mass[i] / p.rho[i];
   }
   filter_neighbours(w.read1.data()->x, sizeof(NeighbourRead1) / sizeof(double), candidates, w.nl);
-  w.dwr.resize(static_cast<std::size_t>(w.nl.start[n]));
+  w.dwr.resize(static_cast<std::size_t>(w.nl.start.back()));
+  w.low1.resize(p.n_all);
+  std::fill(w.low1.begin(), w.low1.end(), LowerSums1{});
   bool any_epsilon = false;
   for (const auto& st : sets) any_epsilon = any_epsilon || st.epsilon > 0;
   if (any_epsilon) w.wk.resize(w.dwr.size());
@@ -418,23 +456,27 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
   const bool same_as = uniform(sets, [](const SetParams& st) {
     return std::array<double, 3>{st.epsilon, st.w_spacing, st.exponent};
   });
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t r = 0; r < nl.row.size(); ++r) {
+    const auto i = static_cast<std::size_t>(nl.row[r]);
     const double* pi = rd[i].a;
     const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
-    // The pairs `width` at a time, lanes summed in lane order at the end (see pass 1).
-    // Entries past the row's end (i itself) have zero gradients and no approach: they
-    // add nothing.
+    // The row's pairs `width` at a time, lanes summed in lane order at the end, after the
+    // lower sums (see pass 1). Entries past the row's end (i itself) have zero gradients
+    // and no approach: they add nothing to i's sums (their partner terms go to i's lower
+    // sums, already read).
+    const LowerSums2 lower = w.low2[i];
+    const double mu_lower = lower.mu;
+    const vdouble mi = pi[R2::mass];
     vdouble accv[3] = {0.0, 0.0, 0.0}, dev = 0.0, mumv = 0.0;
-    const std::int64_t k_begin = nl.start[i], k_end = k_begin + nl.len[i];
+    const std::int64_t k_begin = nl.start[r], k_end = k_begin + nl.len[r];
     for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
       const int* idx = nl.index.data() + k0;
+      // The neighbours' records group by group, each loaded where it is first used (fewer
+      // values live at once).
       vdouble qx[4], qv[4], qr[4], qs[4], qt[4], qu[4] = {0.0, 0.0, 0.0, 0.0};
-      simd::gather4(rdp + R2::x, stride, idx, qx);                      // x, h
-      simd::gather4(rdp + R2::v, stride, idx, qv);                      // v, c
-      simd::gather4(rdp + R2::rho, stride, idx, qr);                    // rho, 1/rho, m, has_r
-      simd::gather4(rdp + R2::S, stride, idx, qs);                      // S0..S3
-      simd::gather4(rdp + R2::S + 4, stride, idx, qt);                  // S4..S7
-      if constexpr (Corr) simd::gather4(rdp + R2::S8, stride, idx, qu); // S8, R4, R5
+      simd::gather4(rdp + R2::x, stride, idx, qx);   // x, h
+      simd::gather4(rdp + R2::v, stride, idx, qv);   // v, c
+      simd::gather4(rdp + R2::rho, stride, idx, qr); // rho, 1/rho, m, has_r
       vdouble dx[3], dv[3];
       for (int a = 0; a < 3; ++a) {
         dx[a] = pi[R2::x + a] - qx[a];
@@ -464,8 +506,17 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
         const vdouble pv = (-(pi[R2::alpha] + qa[0]) * cb * mu + (pi[R2::beta] + qa[1]) * mu * mu) /
                            (pi[R2::rho] + qr[0]);
         stdx::where(approaching, visc) = pv;
-        stdx::where(approaching, mumv) = stdx::max(mumv, -mu);
+        // The largest approach of the pair for both particles' stable steps.
+        vdouble muj = 0.0;
+        stdx::where(approaching, muj) = -mu;
+        mumv = stdx::max(mumv, muj);
+        double* qm[width];
+        for (int l = 0; l < width; ++l) qm[l] = &w.low2[static_cast<std::size_t>(idx[l])].mu;
+        simd::scatter_max(qm, muj);
       }
+      simd::gather4(rdp + R2::S, stride, idx, qs);                      // S0..S3
+      simd::gather4(rdp + R2::S + 4, stride, idx, qt);                  // S4..S7
+      if constexpr (Corr) simd::gather4(rdp + R2::S8, stride, idx, qu); // S8, R4, R5
       const vdouble irr = pi[R2::inv_rho] * qr[1];
       // T = (P_i + P_j + f^n (R_i + R_j)) / (rho_i rho_j) - Pi I; T[6..8] (yx zy zx)
       // differ from T[3..5] only where a gradient is normalised (Corr).
@@ -473,7 +524,7 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
       const vdouble Sj[9] = {qs[0], qs[1], qs[2], qs[3], qt[0], qt[1], qt[2], qt[3], qu[0]};
       vdouble T[nt];
       for (int c = 0; c < nt; ++c) T[c] = (pi[R2::S + c] + Sj[c]) * irr;
-      vdouble rg = 0.0;
+      vdouble rg = 0.0, rgj = 0.0;
       if (stdx::any_of(fn > 0.0) && (pi[R2::has_r] != 0.0 || stdx::any_of(qr[3] > 0.0))) {
         vdouble qR[4];
         simd::gather4(rdp + R2::R, stride, idx, qR);
@@ -489,22 +540,35 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
         rg = fi * (dv[0] * (Ri[0] * g[0] + Ri[3] * g[1] + Ri[5] * g[2]) +
                    dv[1] * (Ri[3] * g[0] + Ri[1] * g[1] + Ri[4] * g[2]) +
                    dv[2] * (Ri[5] * g[0] + Ri[4] * g[1] + Ri[2] * g[2]));
+        // And on particle j (v_ji and grad_j W_ji reverse together).
+        rgj = fi * (dv[0] * (Rj[0] * g[0] + Rj[3] * g[1] + Rj[5] * g[2]) +
+                    dv[1] * (Rj[3] * g[0] + Rj[1] * g[1] + Rj[4] * g[2]) +
+                    dv[2] * (Rj[5] * g[0] + Rj[4] * g[1] + Rj[2] * g[2]));
       }
       T[0] -= visc;
       T[1] -= visc;
       T[2] -= visc;
       const vdouble mj = qr[2];
       const int yx = Corr ? 6 : 3, zy = Corr ? 7 : 4, zx = Corr ? 8 : 5;
-      accv[0] += mj * (T[0] * g[0] + T[3] * g[1] + T[5] * g[2]);
-      accv[1] += mj * (T[yx] * g[0] + T[1] * g[1] + T[4] * g[2]);
-      accv[2] += mj * (T[zx] * g[0] + T[zy] * g[1] + T[2] * g[2]);
-      // Half the viscous dissipation of the pair heats particle i.
+      const vdouble tg[3] = {T[0] * g[0] + T[3] * g[1] + T[5] * g[2],
+                             T[yx] * g[0] + T[1] * g[1] + T[4] * g[2],
+                             T[zx] * g[0] + T[zy] * g[1] + T[2] * g[2]};
+      for (int a = 0; a < 3; ++a) accv[a] += mj * tg[a];
+      // Half the viscous dissipation of the pair heats each particle.
       const vdouble dvg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
-      dev += mj * (0.5 * visc * dvg - rg);
+      const vdouble half_visc = 0.5 * visc * dvg;
+      dev += mj * (half_visc - rg);
+      // Particle j's terms: the same T with grad_j W_ji = -g (its force sum is reversed).
+      const vdouble sj[4] = {mi * tg[0], mi * tg[1], mi * tg[2], mi * (half_visc - rgj)};
+      double* q[width]; // the partners' lower sums
+      for (int l = 0; l < width; ++l) q[l] = w.low2[static_cast<std::size_t>(idx[l])].f;
+      simd::scatter_add4(q, sj);
     }
-    const double acc[3] = {lane_sum(accv[0]), lane_sum(accv[1]), lane_sum(accv[2])};
-    const double de = lane_sum(dev);
-    double mu_max = 0;
+    const double acc[3] = {lane_sum(accv[0]) - lower.f[0], lane_sum(accv[1]) - lower.f[1],
+                           lane_sum(accv[2]) - lower.f[2]};
+    const double de = lower.e + lane_sum(dev);
+    if (i >= n) continue; // a ghost's row: its partners' terms only
+    double mu_max = mu_lower;
     for (int l = 0; l < width; ++l) mu_max = std::max(mu_max, static_cast<double>(mumv[l]));
     for (int a = 0; a < 3; ++a) p.force[a][i] = pi[R2::mass] * acc[a];
     p.energy_rate[i] = de;
@@ -528,6 +592,8 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
                 SphWorkspace& w, SphResult& res) {
   using R2 = NeighbourRead2;
   w.read2.resize(p.n_all);
+  w.low2.resize(p.n_all);
+  std::fill(w.low2.begin(), w.low2.end(), LowerSums2{});
   for (std::size_t i = 0; i < p.n_all; ++i) {
     double* r = w.read2[i].a;
     const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];

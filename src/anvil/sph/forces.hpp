@@ -25,9 +25,15 @@
 //
 // W is evaluated at the mean smoothing length h_ij = (h_i + h_j)/2, so grad_i W_ij =
 // -grad_j W_ji and the pair forces cancel exactly (momentum is conserved to round-off).
-// Every sum over neighbours is a function of the neighbour list alone (ascending global
-// id, neighbours.hpp): the pair loops run simd::width entries at a time, lane l summing
-// the entries l, l + width, ... in list order, and the lanes are added in lane order.
+// Each pair is evaluated once, in the half-list row of its particle of lower global id
+// (neighbours.hpp), for both particles: the row's particle takes its terms at once,
+// the partner's terms are added to the partner's running sum of lower neighbours. The
+// rows run in ascending global id, so a particle's lower sum receives its terms in
+// ascending global id and is complete when its own row comes; its row's terms are summed
+// simd::width entries at a time, lane l summing the entries l, l + width, ... in list
+// order, the lanes added in lane order, then added to the lower sum. Every sum is thus a
+// function of the neighbour lists alone, and each pair's terms are the same operations on
+// the same inputs on any rank (a ghost's row holds the pairs with own particles).
 #pragma once
 
 #include <cmath>
@@ -114,26 +120,44 @@ struct alignas(64) NeighbourRead2 {
   double a[32];
 };
 
+// A particle's running sums over its lower neighbours (their rows' terms for it), in
+// groups of four doubles (simd::scatter_add4). Pass 1: the velocity gradient's
+// sum_j V_j (v_j - v_i) (x) grad_i W_ij (row-major), sum_j m_j W_ij, and
+// sum_j V_j (x_i - x_j) (x) grad_i W_ij (the normalisation's B, negated).
+struct alignas(32) LowerSums1 {
+  static constexpr int L = 0, mw = 9, B = 10;
+  double a[20];
+};
+// Pass 2: sum_j m_j T_ij grad_j W_ji (the force's sum with its sign reversed), the
+// energy rate sum_j m_j (Pi_ij v_ij . grad_i W_ij / 2 - f v_ij . R_i grad_i W_ij / (rho_i rho_j))
+// and the largest approach max_j -mu_ij (0 if none).
+struct alignas(64) LowerSums2 {
+  double f[3], e, mu, pad[3];
+};
+
 // Scratch kept between cycles (the cycle allocates nothing in steady state).
 struct SphWorkspace {
   std::vector<NeighbourRead1> read1;
   std::vector<NeighbourRead2> read2;
-  NeighbourList nl;                // this step's neighbours (filtered candidates)
+  NeighbourList nl;                // this step's neighbours (filtered candidates, half lists)
   std::vector<double> dwr, wk;     // per entry of nl: (1/r) dW/dr and (artificial stress) W
+  std::vector<LowerSums1> low1;    // per particle (own and ghost), pass 1
+  std::vector<LowerSums2> low2;    // and pass 2
   std::vector<double> d[6];        // rate of deformation of own particles
   std::vector<double> binv;        // B^-1 of own particles, 9 per particle (row-major)
   std::vector<double> power_old;   // rotated old stress : D
   std::vector<double> energy_pred; // e predicted at the new state (equations of state)
 };
 
-// Pass 1 over own particles, over the interval dt (the previous step): selects this
-// step's neighbours among the candidate lists (work.nl: the candidates within the
-// kernel's support at the current positions and h) and keeps each entry's kernel
-// derivative for pass 2. The candidates must hold every pair within the support.
+// Pass 1 for own particles, over the interval dt (the previous step): selects this
+// step's neighbours among the candidate half lists (work.nl: the candidates within the
+// kernel's support at the current positions and h; rows of own and ghost particles,
+// find_candidates) and keeps each entry's kernel derivative for pass 2. The candidates
+// must hold every pair within the support that concerns an own particle.
 void sph_kinematics(const SphView& v, std::span<const SetParams> sets, KernelType kernel,
                     const NeighbourList& candidates, double dt, SphWorkspace& work);
 
-// Pass 2 over own particles, over work.nl: forces at t(n), energy rates, stable step.
+// Pass 2 for own particles, over work.nl: forces at t(n), energy rates, stable step.
 void sph_forces(const SphView& v, std::span<const SetParams> sets, KernelType kernel,
                 SphWorkspace& work, SphResult& result);
 

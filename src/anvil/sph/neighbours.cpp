@@ -10,13 +10,18 @@ namespace anvil::sph {
 
 void find_candidates(std::span<const double> x, std::span<const double> y,
                      std::span<const double> z, std::span<const std::int64_t> gid,
-                     std::size_t n_query, double radius, NeighbourWorkspace& w,
-                     NeighbourList& out) {
+                     std::size_t n_own, double radius, NeighbourWorkspace& w, NeighbourList& out) {
   const std::size_t n = x.size();
-  out.start.assign(n_query + 1, 0);
-  out.len.assign(n_query, 0);
+  out.start.assign(n + 1, 0);
+  out.len.assign(n, 0);
   out.count = 0;
-  if (n == 0 || n_query == 0) return;
+  // Rows in ascending gid (own particles are sorted already, ghosts follow them).
+  out.row.resize(n);
+  for (std::size_t i = 0; i < n; ++i) out.row[i] = static_cast<int>(i);
+  std::sort(out.row.begin(), out.row.end(), [&](int a, int b) {
+    return gid[static_cast<std::size_t>(a)] < gid[static_cast<std::size_t>(b)];
+  });
+  if (n == 0 || n_own == 0) return;
   // Cells of half the radius: a particle's candidates lie in the 5 x 5 x 5 cells
   // around its own (about 40% fewer than in 3 x 3 x 3 cells of the full radius).
   constexpr int reach = 2;
@@ -80,11 +85,13 @@ void find_candidates(std::span<const double> x, std::span<const double> y,
   w.xs.assign(n + simd::width, 1e300);
   w.ys.assign(n + simd::width, 1e300);
   w.zs.assign(n + simd::width, 1e300);
+  w.gs.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     const auto p = static_cast<std::size_t>(w.order[k]);
     w.xs[k] = x[p];
     w.ys[k] = y[p];
     w.zs[k] = z[p];
+    w.gs[k] = gid[p];
   }
   // Range of sorted entries in the cells key-2 .. key+2 (a row along x).
   auto row = [&](std::int64_t key, int& b, int& e) {
@@ -101,8 +108,11 @@ void find_candidates(std::span<const double> x, std::span<const double> y,
   const std::int64_t sy = dims[0], sz = dims[0] * dims[1];
   const double r2max = radius * radius;
   std::size_t pos = 0;
-  for (std::size_t i = 0; i < n_query; ++i) {
+  for (std::size_t r = 0; r < n; ++r) {
+    const auto i = static_cast<std::size_t>(out.row[r]);
     const double xi = x[i], yi = y[i], zi = z[i];
+    const std::int64_t gi = gid[i];
+    const bool own = i < n_own;
     const std::int64_t k0 = w.key[i];
     const std::size_t row_begin = pos;
     for (int dz = -reach; dz <= reach; ++dz)
@@ -115,9 +125,9 @@ void find_candidates(std::span<const double> x, std::span<const double> y,
           out.index.resize(2 * (pos + static_cast<std::size_t>(m)) + 2 * simd::width);
         // The distance test `width` candidates at a time over the row's contiguous copies
         // (padded past the end with far-away points), then the accepted entries in order,
-        // appended without a branch (written always, the count advanced by the test).
+        // appended without a branch (written always, the count advanced by the test):
+        // partners of larger gid, own ones only for a ghost's row.
         int* dst = out.index.data();
-        const int self = static_cast<int>(i);
         for (int k = b; k < e; k += simd::width) {
           const simd::vdouble dx_ = xi - simd::load(w.xs.data() + k);
           const simd::vdouble dy_ = yi - simd::load(w.ys.data() + k);
@@ -127,7 +137,8 @@ void find_candidates(std::span<const double> x, std::span<const double> y,
           for (int l = 0; l < lanes; ++l) {
             const int j = w.order[static_cast<std::size_t>(k + l)];
             dst[pos] = j;
-            pos += static_cast<std::size_t>(in[l] & (j != self));
+            pos += static_cast<std::size_t>(in[l] & (w.gs[static_cast<std::size_t>(k + l)] > gi) &
+                                            (own | (static_cast<std::size_t>(j) < n_own)));
           }
         }
       }
@@ -136,17 +147,18 @@ void find_candidates(std::span<const double> x, std::span<const double> y,
     std::sort(row_ptr, out.index.data() + pos, [&](int a, int b) {
       return gid[static_cast<std::size_t>(a)] < gid[static_cast<std::size_t>(b)];
     });
-    out.len[i] = static_cast<int>(pos - row_begin);
+    out.len[r] = static_cast<int>(pos - row_begin);
     out.count += pos - row_begin;
     if (pos + simd::width > out.index.size()) out.index.resize(2 * pos + 2 * simd::width);
     while (pos % simd::width != 0) out.index[pos++] = static_cast<int>(i);
-    out.start[i + 1] = static_cast<std::int64_t>(pos);
+    out.start[r + 1] = static_cast<std::int64_t>(pos);
   }
 }
 
 void filter_neighbours(const double* xh, int stride, const NeighbourList& cand,
                        NeighbourList& out) {
   const std::size_t n = cand.len.size();
+  out.row.assign(cand.row.begin(), cand.row.end());
   out.start.resize(n + 1);
   out.len.resize(n);
   out.start[0] = 0;
@@ -156,12 +168,13 @@ void filter_neighbours(const double* xh, int stride, const NeighbourList& cand,
   if (out.index.size() < need) out.index.resize(need);
   int* dst = out.index.data();
   std::size_t pos = 0, count = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double* ri = xh + static_cast<std::ptrdiff_t>(stride) * static_cast<std::ptrdiff_t>(i);
+  for (std::size_t r = 0; r < n; ++r) {
+    const int i = cand.row[r];
+    const double* ri = xh + static_cast<std::ptrdiff_t>(stride) * i;
     const double xi = ri[0], yi = ri[1], zi = ri[2], hi_ = ri[3];
     const std::size_t row_begin = pos;
-    const int* src = cand.index.data() + cand.start[i];
-    const int m = cand.len[i];
+    const int* src = cand.index.data() + cand.start[r];
+    const int m = cand.len[r];
     for (int k = 0; k < m; k += simd::width) {
       simd::vdouble q[4];
       simd::gather4(xh, stride, src + k, q);
@@ -171,10 +184,10 @@ void filter_neighbours(const double* xh, int stride, const NeighbourList& cand,
       if (m - k < simd::width) bits &= (1u << (m - k)) - 1u;
       pos += static_cast<std::size_t>(simd::compress_store(bits, src + k, dst + pos));
     }
-    out.len[i] = static_cast<int>(pos - row_begin);
+    out.len[r] = static_cast<int>(pos - row_begin);
     count += pos - row_begin;
-    while (pos % simd::width != 0) dst[pos++] = static_cast<int>(i);
-    out.start[i + 1] = static_cast<std::int64_t>(pos);
+    while (pos % simd::width != 0) dst[pos++] = i;
+    out.start[r + 1] = static_cast<std::int64_t>(pos);
   }
   out.count = count;
 }

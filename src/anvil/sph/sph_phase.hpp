@@ -41,10 +41,10 @@ namespace anvil::sph {
 
 struct SphStats {
   std::int64_t cycles = 0;
-  std::int64_t rebalances = 0;  // RCB recuts (the first partition included)
-  std::int64_t migrations = 0;  // cycles on which escaped particles moved
-  std::int64_t ghosts = 0;      // ghost copies received, this rank, last cycle
-  std::int64_t pairs = 0;       // neighbour entries of own particles, this rank, last cycle
+  std::int64_t rebalances = 0; // RCB recuts (the first partition included)
+  std::int64_t migrations = 0; // cycles on which escaped particles moved
+  std::int64_t ghosts = 0;     // ghost copies received, this rank, last cycle
+  std::int64_t pairs = 0; // neighbour pairs with an own particle (each once), this rank, last cycle
   std::int64_t list_builds = 0; // cycles on which the candidate lists and ghost plan were built
   double imbalance = 1;         // last cycle's max/mean particle count
   double imbalance_max = 1;     // the largest seen
