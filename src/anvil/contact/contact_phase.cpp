@@ -175,7 +175,9 @@ void ContactPhase::pack_cycle(std::size_t f, const ContactNodes& nd, Item& it) c
   it.warp = cap_.warp[f];
 }
 
-void ContactPhase::pack_node(std::size_t k, const ContactNodes& nd, ContactNodeItem& it) const {
+// (Inlined: it runs once per owned contact node on full cycles.)
+[[gnu::always_inline]] inline void ContactPhase::pack_node(std::size_t k, const ContactNodes& nd,
+                                                           ContactNodeItem& it) const {
   const auto l = static_cast<std::size_t>(my_nodes_[k]);
   const auto p = static_cast<std::size_t>(node_point_[k]);
   it.gid = node_out_[k].gid;
@@ -261,16 +263,15 @@ void ContactPhase::set_bound_geometry() {
   for (int i = 0; i < 3; ++i) ref_x_[i].assign(xs_[i].begin(), xs_[i].end());
   ref_a_.resize(nf);
   ref_b_.resize(nf);
+  // From this cycle's captures (every face's): a loop the compiler vectorises.
+  const double* len = cap_.len.data();
+  const double* diag = cap_.diag.data();
+  const double* depth = depth_pad_.data();
+  double* a = ref_a_.data();
+  double* b = ref_b_.data();
   for (std::size_t f = 0; f < nf; ++f) {
-    Vec3 x[4];
-    for (int a = 0; a < 4; ++a) {
-      const auto p = static_cast<std::size_t>(corner_[a][f]);
-      x[a] = {xs_[0][p], xs_[1][p], xs_[2][p]};
-    }
-    const Vec3 d1 = x[2] - x[0], d2 = x[3] - x[1];
-    const double len = norm(cross(d1, d2));
-    ref_a_[f] = 4 * my_face_depth_[f] / len + 0.025 / std::sqrt(0.5 * len);
-    ref_b_[f] = 2 * (norm(d1) + norm(d2));
+    a[f] = 4 * depth[f] / len[f] + 0.025 / std::sqrt(0.5 * len[f]);
+    b[f] = 2 * diag[f];
   }
   point_move_.resize(np);
 }
@@ -285,15 +286,36 @@ void ContactPhase::set_bound_geometry() {
 // While n has moved at most 0.45 g from x0 and each side of f's box at most 0.45 g from
 // B0, a box B that holds n now had x0 within 0.9 g of B0, so B0 enlarged by g overlapped
 // r's box around x0 (Rcb::overlapping reports r), and f is on r. The budget of each item
-// is the smaller of the two, less what it has moved since its destinations were
-// computed. The bound (lazy_bound_holds) then checks every cycle that no item has used its
-// budget up; any rank's failure makes the next cycle full on every rank (detect()).
-void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live) {
-  const std::size_t np = surf_local_.size(), nf = my_face_gid_.size();
+// is the smaller of the two. Each cycle checks every node exactly and bounds every face's
+// box (shared_bound_holds); a face whose bound fails is checked exactly, and if within its
+// budget gets a new reference (rebase_faces). Any failure makes the next cycle full on
+// every rank (detect()).
+void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live, bool recomputed) {
+  const std::size_t nf = my_face_gid_.size(), nn = my_nodes_.size();
+  const std::size_t nfp = static_cast<std::size_t>(simd::padded_size(static_cast<int>(nf)));
   const SearchWorkspace& w = search_;
   const std::vector<ContactNodeItem>& held = *search_nodes_;
   const double inf = std::numeric_limits<double>::infinity();
   const double h = 0.45 * w.skin, gh = 0.45 * ghost_margin_;
+  // The ghosting: full budgets where the destinations were just computed, else what is
+  // left of them (the references are those of the last full cycle or rebase).
+  if (recomputed) {
+    sn_ghost_.assign(nn, gh);
+    sf_ghost_.assign(nfp, gh);
+  } else {
+    for (std::size_t k = 0; k < nn; ++k) {
+      const auto p = static_cast<std::size_t>(node_point_[k]);
+      double e = 0;
+      for (int i = 0; i < 3; ++i) e = std::max(e, std::abs(xs_[i][p] - sn_x_[i][k]));
+      sn_ghost_[k] -= e;
+    }
+    for (std::size_t f = 0; f < nf; ++f) {
+      double e = 0;
+      for (int s = 0; s < 6; ++s)
+        e = std::max(e, std::abs((s < 3 ? cap_.lo[s][f] : cap_.hi[s - 3][f]) - sf_box_[s][f]));
+      sf_ghost_[f] -= e;
+    }
+  }
   // Without lists (no node or no face held here) nothing held here can pair while the
   // destinations are kept.
   const bool built = w.built;
@@ -315,12 +337,12 @@ void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live
   for (std::size_t k = 0; k < fb_send_.size(); ++k)
     keep_send_[k] = static_cast<char>(fb_send_[k].keep);
   node_sub_.build_subset(node_plan_, keep_send_, keep_recv_);
-  ref_node_budget_.assign(np, inf);
-  for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
+  sn_budget_.resize(nn);
+  for (int i = 0; i < 3; ++i) sn_x_[i].resize(nn);
+  for (std::size_t k = 0; k < nn; ++k) {
     const auto p = static_cast<std::size_t>(node_point_[k]);
-    const double dx = xs_[0][p] - ghost_x_[0][p], dy = xs_[1][p] - ghost_x_[1][p],
-                 dz = xs_[2][p] - ghost_x_[2][p];
-    ref_node_budget_[p] = std::min(fb_send_[k].budget, gh - std::sqrt(dx * dx + dy * dy + dz * dz));
+    for (int i = 0; i < 3; ++i) sn_x_[i][k] = xs_[i][p];
+    sn_budget_[k] = std::min(fb_send_[k].budget, sn_ghost_[k]);
   }
 
   // Faces: the same per copy (the faces in some list), each face's budget the least of
@@ -341,40 +363,120 @@ void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live
   keep_recv_.resize(nr);
   for (std::size_t j = 0; j < nr; ++j) keep_recv_[j] = static_cast<char>(fb_recv_[j].keep);
   keep_send_.resize(fb_send_.size());
-  ref_face_budget_.assign(nf, inf);
+  sf_budget_.assign(nfp, inf); // dead faces and the padding never fail
   sub_faces_.clear();
   for (std::size_t c = 0; c < fb_send_.size(); ++c) { // copies in ascending face order
     const int f = face_src_[c];
     keep_send_[c] = static_cast<char>(fb_send_[c].keep);
-    auto& budget = ref_face_budget_[static_cast<std::size_t>(f)];
-    budget = std::min(budget, fb_send_[c].budget);
+    auto& budget = sf_budget_[static_cast<std::size_t>(f)];
+    budget = std::min(budget, std::min(fb_send_[c].budget, sf_ghost_[static_cast<std::size_t>(f)]));
     if (keep_send_[c] != 0 && (sub_faces_.empty() || sub_faces_.back() != f))
       sub_faces_.push_back(f);
   }
   face_sub_.build_subset(face_plan_, keep_send_, keep_recv_);
+  // What lazy cycles may need, at most, so that they allocate nothing.
+  node_sub_.reserve(node_plan_.send_count() * sizeof(ContactNodeItem));
+  face_sub_.reserve(face_plan_.send_count() * sizeof(FaceMotion));
+  node_sub_in_.reserve(node_plan_.recv_count());
+  face_sub_in_.reserve(face_plan_.recv_count());
+  fail_.reserve(nfp);
+  near_.reserve(nf);
+
+  for (auto& v : sf_x_) v.resize(nfp);
+  for (auto& v : sf_box_) v.resize(nf);
+  sf_a_.assign(nfp, 0.0);
+  sf_b_.assign(nfp, 0.0);
+  sf_near_.assign(nf, 0);
   near_.clear();
-  for (std::size_t f = 0; f < nf; ++f) {
-    if (!alive(f)) continue;
-    double e = 0;
-    for (int i = 0; i < 3; ++i) {
-      e = std::max(e, std::abs(cap_.lo[i][f] - ghost_box_[i][f]));
-      e = std::max(e, std::abs(cap_.hi[i][f] - ghost_box_[3 + i][f]));
-    }
-    ref_face_budget_[f] = std::min(ref_face_budget_[f], gh - e);
-    // The centre moves no more than the corners (at most 0.45 g while the bound holds):
-    // only a face whose centre is nearer its rank's box side can change rank (the
-    // contact_rank field).
-    const Box3& b = rank_box_[static_cast<std::size_t>(my_face_rank_[f])];
-    bool far = true;
-    for (int i = 0; i < 3; ++i)
-      far &= cap_.centre[i][f] - b.lo[i] > 0.5 * ghost_margin_ &&
-             b.hi[i] - cap_.centre[i][f] > 0.5 * ghost_margin_;
-    if (!far) near_.push_back(static_cast<int>(f));
-  }
-  set_bound_geometry();
+  for (std::size_t f = 0; f < nfp; ++f) set_face_reference(f);
   live_ref_ = live;
   // Extra nodes (set_extra_nodes) change every cycle: no lazy cycle while there are any.
   shared_ = node_out_.size() == my_nodes_.size();
+}
+
+void ContactPhase::set_face_reference(std::size_t f) {
+  for (int a = 0; a < 4; ++a) {
+    const auto p = static_cast<std::size_t>(corner_[a][f]);
+    for (int i = 0; i < 3; ++i) sf_x_[3 * a + i][f] = xs_[i][p];
+  }
+  if (f >= my_face_gid_.size()) return; // padding
+  for (int i = 0; i < 3; ++i) {
+    sf_box_[i][f] = cap_.lo[i][f];
+    sf_box_[3 + i][f] = cap_.hi[i][f];
+  }
+  sf_a_[f] = 4 * my_face_depth_[f] / cap_.len[f] + 0.025 / std::sqrt(0.5 * cap_.len[f]);
+  sf_b_[f] = 2 * cap_.diag[f];
+  if (!alive(f)) return;
+  // The centre moves no more than the corners, at most 0.45 g while the bound holds: only
+  // a face whose centre is nearer its rank's box side can change rank.
+  const double c[3] = {cap_.centre[0][f], cap_.centre[1][f], cap_.centre[2][f]};
+  update_face_rank(f, c);
+  const Box3& b = rank_box_[static_cast<std::size_t>(my_face_rank_[f])];
+  bool far = true;
+  for (int i = 0; i < 3; ++i)
+    far &= c[i] - b.lo[i] > 0.5 * ghost_margin_ && b.hi[i] - c[i] > 0.5 * ghost_margin_;
+  if (!far && sf_near_[f] == 0) {
+    sf_near_[f] = 1;
+    near_.push_back(static_cast<int>(f));
+  }
+}
+
+// The face bound of lazy_bound_holds(), per face from its own reference, vectorised
+// across faces: delta is the largest distance of a corner from where it was then.
+bool ContactPhase::shared_bound_holds() {
+  unsigned bad = 0; // also when anything is not a number
+  for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
+    const auto p = static_cast<std::size_t>(node_point_[k]);
+    const double e = std::max({std::abs(xs_[0][p] - sn_x_[0][k]), std::abs(xs_[1][p] - sn_x_[1][k]),
+                               std::abs(xs_[2][p] - sn_x_[2][k])});
+    bad |= static_cast<unsigned>(!(e <= sn_budget_[k]));
+  }
+  fail_.clear();
+  const std::size_t nfp = sf_budget_.size();
+  const double* x[3] = {xs_[0].data(), xs_[1].data(), xs_[2].data()};
+  const int* c[4] = {corner_[0].data(), corner_[1].data(), corner_[2].data(), corner_[3].data()};
+  const double* r[12];
+  for (int k = 0; k < 12; ++k) r[k] = sf_x_[k].data();
+  const double *A = sf_a_.data(), *B = sf_b_.data(), *budget = sf_budget_.data();
+  for (std::size_t f = 0; f < nfp; f += simd::width) {
+    simd::vdouble d2 = 0.0;
+    for (int a = 0; a < 4; ++a) {
+      simd::vdouble s = 0.0;
+      for (int i = 0; i < 3; ++i) {
+        const simd::vdouble d = simd::gather_i32(x[i], c[a] + f) - simd::load(r[3 * a + i] + f);
+        s += d * d;
+      }
+      where(d2 < s, d2) = s;
+    }
+    const simd::vdouble delta = sqrt(d2);
+    const simd::vdouble m = delta * (1 + simd::load(A + f) * (simd::load(B + f) + 4 * delta));
+    const simd::vmask ok = 1.001 * m <= simd::load(budget + f);
+    if (all_of(ok)) continue;
+    for (int l = 0; l < simd::width; ++l)
+      if (!ok[l]) fail_.push_back(static_cast<int>(f) + l);
+  }
+  return bad == 0;
+}
+
+bool ContactPhase::rebase_faces() {
+  compute_captures(corners(), fail_, cap_);
+  unsigned bad = 0; // also when anything is not a number
+  for (int f : fail_)
+    for (int s = 0; s < 6; ++s) {
+      const double b = s < 3 ? cap_.lo[s][f] : cap_.hi[s - 3][f];
+      bad |= static_cast<unsigned>(!(std::abs(b - sf_box_[s][f]) <= sf_budget_[f]));
+    }
+  if (bad != 0) return false;
+  for (int fi : fail_) {
+    const auto f = static_cast<std::size_t>(fi);
+    double e = 0;
+    for (int s = 0; s < 6; ++s)
+      e = std::max(e, std::abs((s < 3 ? cap_.lo[s][f] : cap_.hi[s - 3][f]) - sf_box_[s][f]));
+    sf_budget_[f] -= e;
+    sf_ghost_[f] -= e;
+    set_face_reference(f);
+  }
+  return true;
 }
 
 bool ContactPhase::compute_destinations(std::size_t live) {
@@ -422,13 +524,6 @@ bool ContactPhase::compute_destinations(std::size_t live) {
       face_dest_.push_back(r);
     }
   }
-  // The ghosting reference of set_shared_reference().
-  for (int i = 0; i < 3; ++i) {
-    ghost_x_[i].assign(xs_[i].begin(), xs_[i].end());
-    ghost_box_[i].assign(cap_.lo[i].begin(), cap_.lo[i].begin() + static_cast<std::ptrdiff_t>(nf));
-    ghost_box_[3 + i].assign(cap_.hi[i].begin(),
-                             cap_.hi[i].begin() + static_cast<std::ptrdiff_t>(nf));
-  }
   return !plans_built_ || node_dest_ != node_dest_built_ || face_dest_ != face_dest_built_ ||
          face_src_ != face_src_built_;
 }
@@ -472,7 +567,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
   const bool alone = comm_.size() == 1;
   std::size_t live = 0;    // faces alive
   bool lazy_cycle = false; // one rank: the bound holds
-  bool bound_ok = false;   // several ranks: this rank's bound holds
+  bool bound_ok = false;   // several ranks: this rank's items are within their budgets
   {
     ScopedPhase t(timers, Phase::transfer);
     for (std::size_t k = 0; k < surf_local_.size(); ++k) {
@@ -486,9 +581,11 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     if (alone)
       lazy_cycle = live == nf && extra_.empty() && lazy_ && search_.built &&
                    search_.builds == lazy_builds_ && lazy_bound_holds();
-    else
-      bound_ok =
-          shared_ && !rebalance_due_ && extra_.empty() && live == live_ref_ && lazy_bound_holds();
+    else if (shared_ && !rebalance_due_ && extra_.empty() && live == live_ref_) {
+      // Faces whose bound fails may still be within their budgets (exact boxes).
+      bound_ok = shared_bound_holds();
+      if (bound_ok && !fail_.empty()) bound_ok = rebase_faces();
+    }
     if (!lazy_cycle && !bound_ok) compute_captures(corners(), cap_);
     if (!bound_ok) {
       node_out_.resize(my_nodes_.size());
@@ -605,11 +702,6 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
         compute_captures(corners(), cap_);
         node_out_.resize(my_nodes_.size());
         for (std::size_t k = 0; k < my_nodes_.size(); ++k) pack_node(k, nd, node_out_[k]);
-        for (std::size_t f = 0; f < nf; ++f) {
-          if (!alive(f)) continue;
-          const double c[3] = {cap_.centre[0][f], cap_.centre[1][f], cap_.centre[2][f]};
-          update_face_rank(f, c);
-        }
       }
       // Where every item stays on this rank, the search reads the local items in place.
       if (node_plan_.stays()) {
@@ -683,7 +775,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
   }
   if (!alone && !lazy) {
     ScopedPhase t(timers, Phase::transfer);
-    set_shared_reference(boxes, live);
+    set_shared_reference(boxes, live, !bound_ok);
   }
   stats_.list_builds = search_.builds;
   stats_.lazy_cycles += lazy_cycle || lazy ? 1 : 0;

@@ -104,6 +104,8 @@ void Migration::build_subset(const Migration& base, std::span<const char> send_k
   // base's groups filtered: the kept items of each destination, in base's order.
   order_.clear();
   position_.clear();
+  order_.reserve(base.order_.size()); // a subset never outgrows its base
+  position_.reserve(base.recv_total_);
   for (std::size_t q = 0; q < Pz; ++q) {
     for (std::int64_t k = base.sdispl_[q]; k < base.sdispl_[q + 1]; ++k) {
       const std::int64_t i = base.order_[static_cast<std::size_t>(k)];

@@ -48,6 +48,11 @@ public:
   // stay built while this plan is used, and a rebuild of base needs a new subset.
   void build_subset(const Migration& base, std::span<const char> send_keep,
                     std::span<const char> recv_keep);
+  // Grows the send buffer to `bytes` now (e.g. a subset's largest move, its base's item
+  // count times the item size), so that later moves of up to that size allocate nothing.
+  void reserve(std::size_t bytes) {
+    if (buffer_.size() < bytes) buffer_.resize(bytes);
+  }
   // Subset plans: base's received position of this plan's received item j.
   std::size_t base_position(std::size_t j) const { return static_cast<std::size_t>(position_[j]); }
 
