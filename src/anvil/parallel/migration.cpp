@@ -65,9 +65,10 @@ void Migration::build(const Comm& comm, std::span<const int> dest) {
   // rank throw (a negative count cannot occur otherwise).
   if (bad) scount_.assign(Pz, -1);
   comm.alltoall_bytes(scount_.data(), sizeof(std::int64_t), rcount_.data());
+  // Every rank receives the -1 of a rank with a bad destination: no reduction is needed.
   bool any_bad = bad != 0;
   for (std::int64_t c : rcount_) any_bad |= c < 0;
-  if (comm.max(static_cast<std::int64_t>(any_bad)) != 0)
+  if (any_bad)
     throw std::invalid_argument("Migration::build: destination rank out of range on some rank");
 
   for (std::size_t q = 0; q < Pz; ++q) {
