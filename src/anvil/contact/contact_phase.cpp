@@ -390,8 +390,7 @@ void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live
   near_.clear();
   for (std::size_t f = 0; f < nfp; ++f) set_face_reference(f);
   live_ref_ = live;
-  // Extra nodes (set_extra_nodes) change every cycle: no lazy cycle while there are any.
-  shared_ = node_out_.size() == my_nodes_.size();
+  shared_ = true; // (never with extra nodes anywhere: they change every cycle)
 }
 
 void ContactPhase::set_face_reference(std::size_t f) {
@@ -630,7 +629,8 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     ++stats_.rebalances;
   }
 
-  bool lazy = false; // several ranks: every rank's bound holds
+  bool lazy = false;            // several ranks: every rank's bound holds
+  bool extra_somewhere = false; // some rank has extra nodes this cycle
   {
     ScopedPhase t(timers, Phase::transfer);
     bool changed = false;
@@ -662,10 +662,14 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     }
     // One reduction: 2 when some rank's destinations have changed (the plans are rebuilt,
     // instead of two all-to-alls of counts), 1 when some rank's bound fails (a full
-    // cycle), 0 when every rank's bound holds (a lazy cycle).
-    const std::int64_t state = changed ? 2 : (alone || bound_ok ? 0 : 1);
-    const std::int64_t worst = comm_.max(state);
+    // cycle), 0 when every rank's bound holds (a lazy cycle); and whether some rank has
+    // extra nodes (then the next cycle cannot be lazy either: no reference is set).
+    std::int64_t red[2] = {changed ? 2 : (alone || bound_ok ? 0 : 1),
+                           static_cast<std::int64_t>(!extra_.empty())};
+    comm_.max(std::span<std::int64_t>(red, 2));
+    const std::int64_t worst = red[0];
     lazy = !alone && worst == 0;
+    extra_somewhere = red[1] != 0;
     if (worst == 2) {
       node_plan_.build(comm_, node_dest_);
       face_plan_.build(comm_, face_dest_);
@@ -773,9 +777,11 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     ScopedPhase t(timers, Phase::contact_search);
     find_pairs(*search_nodes_, *search_faces_, boxes, opt, search_, pairs_);
   }
-  if (!alone && !lazy) {
+  if (!alone && !lazy && !extra_somewhere) {
     ScopedPhase t(timers, Phase::transfer);
     set_shared_reference(boxes, live, !bound_ok);
+  } else if (extra_somewhere) {
+    shared_ = false;
   }
   stats_.list_builds = search_.builds;
   stats_.lazy_cycles += lazy_cycle || lazy ? 1 : 0;
