@@ -3,7 +3,8 @@
 // source index; reverse() returns every field bit for bit to the original positions
 // (NaN payloads and signed zeros included); rebuilding the plan for new destinations
 // and moving again reuses its buffers; items staying home and ranks that send or receive
-// nothing; a destination out of range throws on every rank.
+// nothing; a destination out of range throws on every rank; a subset plan moves exactly
+// the items its receivers marked.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -138,6 +139,55 @@ TEST(Migration, ForwardPackedMatchesForward) {
   plan.forward_packed(b, [&](std::size_t i, Vec3& item) { item = in[i]; });
   ASSERT_EQ(a.size(), b.size());
   EXPECT_TRUE(same_bits(a.data(), b.data(), a.size() * sizeof(Vec3)));
+}
+
+// A subset plan (build_subset) moves exactly the items the receivers marked, sent back to
+// their senders along reverse(): each arrives with the bits forward() gives it, and
+// base_position() says where forward() put it. Marking everything gives forward()'s
+// layout; marking nothing moves nothing.
+TEST(Migration, SubsetDeliversTheMarkedItems) {
+  const Comm comm = Comm::world();
+  const int P = comm.size();
+  const std::size_t n = 700 + 29 * static_cast<std::size_t>(comm.rank());
+  std::vector<int> dest(n);
+  std::vector<std::int64_t> in(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint64_t h = mix(static_cast<std::uint64_t>(comm.rank()) * 7919 + i);
+    dest[i] = static_cast<int>(h % static_cast<std::uint64_t>(P));
+    in[i] = static_cast<std::int64_t>(mix(h + 5) >> 1);
+  }
+  Migration plan;
+  plan.build(comm, dest);
+  std::vector<std::int64_t> full;
+  plan.forward(in, full);
+  for (int rule = 0; rule < 3; ++rule) {
+    // The receiver marks its items (about a third, all, none), the senders learn it.
+    std::vector<char> recv_keep(full.size()), send_keep;
+    for (std::size_t j = 0; j < full.size(); ++j)
+      recv_keep[j] = rule == 1 || (rule == 0 && mix(static_cast<std::uint64_t>(full[j])) % 3 == 0);
+    plan.reverse(recv_keep, send_keep);
+    Migration sub;
+    sub.build_subset(plan, send_keep, recv_keep);
+    std::size_t marked = 0;
+    for (char k : recv_keep) marked += k != 0 ? 1 : 0;
+    std::vector<std::int64_t> got;
+    sub.forward_packed(got, [&](std::size_t i, std::int64_t& item) {
+      EXPECT_NE(send_keep[i], 0) << "packs only marked items";
+      item = in[i];
+    });
+    ASSERT_EQ(got.size(), marked) << "rule " << rule;
+    std::size_t last = 0;
+    for (std::size_t j = 0; j < got.size(); ++j) {
+      const std::size_t pos = sub.base_position(j);
+      ASSERT_LT(pos, full.size());
+      EXPECT_TRUE(j == 0 || pos > last) << "positions ascend";
+      EXPECT_NE(recv_keep[pos], 0);
+      EXPECT_EQ(got[j], full[pos]) << "rule " << rule << " item " << j;
+      last = pos;
+    }
+    if (rule == 1)
+      for (std::size_t j = 0; j < got.size(); ++j) EXPECT_EQ(sub.base_position(j), j);
+  }
 }
 
 TEST(Migration, SteadyStateAllocatesNothing) {

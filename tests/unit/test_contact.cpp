@@ -131,6 +131,12 @@ TEST(Contact, ComputeCapturesMatchesSetCaptureBitwise) {
     }
     EXPECT_TRUE(same(one[f].offset, cap.offset[f])) << f;
     EXPECT_TRUE(same(one[f].warp, cap.warp[f])) << f;
+    // The diagonals' cross product (the size's square, twice) and lengths.
+    const auto& x = one[f].x;
+    const Vec3 d1{x[2][0] - x[0][0], x[2][1] - x[0][1], x[2][2] - x[0][2]};
+    const Vec3 d2{x[3][0] - x[1][0], x[3][1] - x[1][1], x[3][2] - x[1][2]};
+    EXPECT_NEAR(cap.len[f], 2 * p.size * p.size, 1e-12 * (1 + cap.len[f])) << f;
+    EXPECT_NEAR(cap.diag[f], norm(d1) + norm(d2), 1e-12 * cap.diag[f]) << f;
   }
   // The faces of an index list only, in any order: the same bits, the others untouched.
   FaceCaptures part;

@@ -35,13 +35,17 @@ void FaceCaptures::resize(std::size_t n) {
   }
   offset.resize(m);
   warp.resize(m);
+  len.resize(m);
+  diag.resize(m);
 }
 
 namespace {
+constexpr int kFields = 16; // arrays of FaceCaptures
+
 // One vector of faces: lane l is the face whose corners are points c[a][l] and whose
-// depth is depth[l]. r: normal (3), lo (3), hi (3), centre (3), offset, warp.
+// depth is depth[l]. r: normal (3), lo (3), hi (3), centre (3), offset, warp, len, diag.
 [[gnu::always_inline]] inline void capture_lanes(const FaceCorners& in, const int* const c4[4],
-                                                 const vdouble& depth, vdouble (&r)[14]) {
+                                                 const vdouble& depth, vdouble (&r)[kFields]) {
   vdouble x[4][3];
   for (int a = 0; a < 4; ++a)
     for (int i = 0; i < 3; ++i) x[a][i] = simd::gather(in.x[i], c4[a]);
@@ -85,6 +89,9 @@ namespace {
   }
   r[12] = c[0] * nu[0] + c[1] * nu[1] + c[2] * nu[2];
   r[13] = warp;
+  r[14] = len;
+  r[15] = sqrt(d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2]) +
+          sqrt(d2[0] * d2[0] + d2[1] * d2[1] + d2[2] * d2[2]);
 }
 
 double* field(FaceCaptures& out, int k) {
@@ -92,27 +99,28 @@ double* field(FaceCaptures& out, int k) {
   if (k < 6) return out.lo[k - 3].data();
   if (k < 9) return out.hi[k - 6].data();
   if (k < 12) return out.centre[k - 9].data();
-  return k == 12 ? out.offset.data() : out.warp.data();
+  if (k < 14) return k == 12 ? out.offset.data() : out.warp.data();
+  return k == 14 ? out.len.data() : out.diag.data();
 }
 } // namespace
 
 void compute_captures(const FaceCorners& in, FaceCaptures& out) {
   out.resize(in.n);
   const std::size_t m = padded(in.n);
-  double* dst[14];
-  for (int k = 0; k < 14; ++k) dst[k] = field(out, k);
+  double* dst[kFields];
+  for (int k = 0; k < kFields; ++k) dst[k] = field(out, k);
   for (std::size_t f = 0; f < m; f += simd::width) {
     const int* c4[4] = {in.corner[0] + f, in.corner[1] + f, in.corner[2] + f, in.corner[3] + f};
-    vdouble r[14];
+    vdouble r[kFields];
     capture_lanes(in, c4, simd::load(in.depth + f), r);
-    for (int k = 0; k < 14; ++k) simd::store(r[k], dst[k] + f);
+    for (int k = 0; k < kFields; ++k) simd::store(r[k], dst[k] + f);
   }
 }
 
 void compute_captures(const FaceCorners& in, std::span<const int> which, FaceCaptures& out) {
   out.resize(in.n);
-  double* dst[14];
-  for (int k = 0; k < 14; ++k) dst[k] = field(out, k);
+  double* dst[kFields];
+  for (int k = 0; k < kFields; ++k) dst[k] = field(out, k);
   for (std::size_t j = 0; j < which.size(); j += simd::width) {
     // The faces which[j..j + width), the last one repeated past the end.
     int face[simd::width], c[4][simd::width];
@@ -123,9 +131,9 @@ void compute_captures(const FaceCorners& in, std::span<const int> which, FaceCap
       dep[l] = in.depth[face[l]];
     }
     const int* c4[4] = {c[0], c[1], c[2], c[3]};
-    vdouble r[14];
+    vdouble r[kFields];
     capture_lanes(in, c4, simd::load(dep), r);
-    for (int k = 0; k < 14; ++k)
+    for (int k = 0; k < kFields; ++k)
       for (int l = 0; l < simd::width; ++l) dst[k][face[l]] = r[k][l];
   }
 }

@@ -17,6 +17,8 @@ struct FaceCaptures {
   std::vector<double> warp;         // largest distance of a corner from the mean plane, m
   std::vector<double> lo[3], hi[3]; // capture box, m
   std::vector<double> centre[3];    // centre of the mean plane, m
+  std::vector<double> len;          // |D1 x D2| of the diagonals D1, D2 (twice the area), m^2
+  std::vector<double> diag;         // |D1| + |D2|, m
   // Sizes every array to n rounded up to a whole number of vectors.
   void resize(std::size_t n);
 };

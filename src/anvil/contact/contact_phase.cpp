@@ -109,6 +109,29 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
   last_face_.assign(fe.node_gid.size(), -1);
   allowance_.assign(fe.node_gid.size(), 0.0);
   exchange_ = std::make_unique<NodeExchange>(fe, comm);
+  // Several ranks: the ghosting margin g (set_shared_reference), the skin the candidate
+  // lists use (SearchOptions::skin of the median capture-box extent) for the initial
+  // geometry, the least over the ranks so that every rank uses the same.
+  if (comm.size() > 1) {
+    for (std::size_t k = 0; k < surf_local_.size(); ++k) {
+      const Vec3& p = mesh.nodes[static_cast<std::size_t>(
+          fe.node_gid[static_cast<std::size_t>(surf_local_[k])])];
+      for (int i = 0; i < 3; ++i) xs_[i][k] = p[i];
+    }
+    compute_captures(corners(), cap_);
+    std::vector<double> extent(nf_all);
+    for (std::size_t f = 0; f < nf_all; ++f)
+      extent[f] = std::max({cap_.hi[0][f] - cap_.lo[0][f], cap_.hi[1][f] - cap_.lo[1][f],
+                            cap_.hi[2][f] - cap_.lo[2][f]});
+    double median = std::numeric_limits<double>::infinity();
+    if (!extent.empty()) {
+      std::nth_element(extent.begin(), extent.begin() + static_cast<std::ptrdiff_t>(nf_all / 2),
+                       extent.end());
+      median = extent[nf_all / 2];
+    }
+    const double g = comm.min(SearchOptions{}.skin * median);
+    ghost_margin_ = std::isfinite(g) ? g : 0.0;
+  }
 }
 
 void ContactPhase::set_extra_nodes(std::span<const ContactNodeItem> items) {
@@ -132,7 +155,8 @@ void ContactPhase::pack_copy(std::size_t f, const ContactNodes& nd, ContactFaceI
   pack_cycle(f, nd, it);
 }
 
-void ContactPhase::pack_cycle(std::size_t f, const ContactNodes& nd, ContactFaceItem& it) const {
+template <class Item>
+void ContactPhase::pack_cycle(std::size_t f, const ContactNodes& nd, Item& it) const {
   for (int a = 0; a < 4; ++a) {
     const int l = my_face_nodes_[f][a];
     const auto k = static_cast<std::size_t>(corner_[a][f]);
@@ -149,6 +173,47 @@ void ContactPhase::pack_cycle(std::size_t f, const ContactNodes& nd, ContactFace
   }
   it.offset = cap_.offset[f];
   it.warp = cap_.warp[f];
+}
+
+// (Inlined: it runs once per owned contact node on full cycles.)
+[[gnu::always_inline]] inline void ContactPhase::pack_node(std::size_t k, const ContactNodes& nd,
+                                                           ContactNodeItem& it) const {
+  const auto l = static_cast<std::size_t>(my_nodes_[k]);
+  const auto p = static_cast<std::size_t>(node_point_[k]);
+  it.gid = node_out_[k].gid;
+  it.owner = node_out_[k].owner;
+  for (int i = 0; i < 3; ++i) {
+    it.x[i] = xs_[i][p];
+    it.v[i] = nd.v[i][l];
+  }
+  it.mass = nd.mass[l];
+  it.last_face = last_face_[l];
+  it.allowance = allowance_[l];
+}
+
+void ContactPhase::unpack_motion(const FaceMotion& m, std::size_t j) {
+  ContactFaceItem& it = face_in_[j];
+  for (int a = 0; a < 4; ++a) {
+    for (int i = 0; i < 3; ++i) {
+      it.x[a][i] = m.x[a][i];
+      it.v[a][i] = m.v[a][i];
+    }
+    it.mass[a] = m.mass[a];
+  }
+  for (int i = 0; i < 3; ++i) {
+    it.normal[i] = m.normal[i];
+    it.lo[i] = m.lo[i];
+    it.hi[i] = m.hi[i];
+    recv_box_[i][j] = m.lo[i];
+    recv_box_[3 + i][j] = m.hi[i];
+  }
+  it.offset = m.offset;
+  it.warp = m.warp;
+}
+
+bool ContactPhase::alive(std::size_t f) const {
+  const auto [b, e] = my_face_slot_[f];
+  return blocks_[static_cast<std::size_t>(b)].alive[static_cast<std::size_t>(e)] != 0.0;
 }
 
 FaceCorners ContactPhase::corners() const {
@@ -172,7 +237,6 @@ void ContactPhase::set_lazy_reference() {
   const std::size_t np = surf_local_.size(), nf = my_face_gid_.size();
   const SearchWorkspace& w = search_;
   const double h = 0.45 * w.skin;
-  for (int i = 0; i < 3; ++i) ref_x_[i].assign(xs_[i].begin(), xs_[i].end());
   ref_node_budget_.assign(np, std::numeric_limits<double>::infinity());
   for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
     const auto p = static_cast<std::size_t>(node_point_[k]);
@@ -180,8 +244,6 @@ void ContactPhase::set_lazy_reference() {
     for (int i = 0; i < 3; ++i) e = std::max(e, std::abs(xs_[i][p] - w.node_ref[3 * k + i]));
     ref_node_budget_[p] = h - e;
   }
-  ref_a_.resize(nf);
-  ref_b_.resize(nf);
   ref_face_budget_.resize(nf);
   for (std::size_t f = 0; f < nf; ++f) {
     double e = 0;
@@ -190,19 +252,287 @@ void ContactPhase::set_lazy_reference() {
       e = std::max(e, std::abs(cap_.hi[i][f] - w.box_ref[(3 + i) * nf + f]));
     }
     ref_face_budget_[f] = h - e;
-    Vec3 x[4];
-    for (int a = 0; a < 4; ++a) {
-      const auto p = static_cast<std::size_t>(corner_[a][f]);
-      x[a] = {xs_[0][p], xs_[1][p], xs_[2][p]};
-    }
-    const Vec3 d1 = x[2] - x[0], d2 = x[3] - x[1];
-    const double len = norm(cross(d1, d2));
-    ref_a_[f] = 4 * my_face_depth_[f] / len + 0.025 / std::sqrt(0.5 * len);
-    ref_b_[f] = 2 * (norm(d1) + norm(d2));
   }
-  point_move_.resize(np);
+  set_bound_geometry();
   lazy_ = true;
   lazy_builds_ = w.builds;
+}
+
+void ContactPhase::set_bound_geometry() {
+  const std::size_t np = surf_local_.size(), nf = my_face_gid_.size();
+  for (int i = 0; i < 3; ++i) ref_x_[i].assign(xs_[i].begin(), xs_[i].end());
+  ref_a_.resize(nf);
+  ref_b_.resize(nf);
+  // From this cycle's captures (every face's): a loop the compiler vectorises.
+  const double* len = cap_.len.data();
+  const double* diag = cap_.diag.data();
+  const double* depth = depth_pad_.data();
+  double* a = ref_a_.data();
+  double* b = ref_b_.data();
+  for (std::size_t f = 0; f < nf; ++f) {
+    a[f] = 4 * depth[f] / len[f] + 0.025 / std::sqrt(0.5 * len[f]);
+    b[f] = 2 * diag[f];
+  }
+  point_move_.resize(np);
+}
+
+// Several ranks. A lazy cycle keeps the last full cycle's destinations, plans and received
+// layout; its pairs are the exact search's when (1) every receiver's candidate lists are
+// still valid, and (2) every face whose capture box holds a node is held where the node is.
+// (1): each receiver tells each item's sender how far it may still move (its lists' 0.45
+// skin less its deviation from the build, as set_lazy_reference() does on one rank). (2):
+// at the cycle its destinations were computed, node n was in the box of its rank r (at
+// x0), and face f went to every rank that its capture box B0, enlarged by g, touches.
+// While n has moved at most 0.45 g from x0 and each side of f's box at most 0.45 g from
+// B0, a box B that holds n now had x0 within 0.9 g of B0, so B0 enlarged by g overlapped
+// r's box around x0 (Rcb::overlapping reports r), and f is on r. The budget of each item
+// is the smaller of the two. Each cycle checks every node exactly and bounds every face's
+// box (shared_bound_holds); a face whose bound fails is checked exactly, and if within its
+// budget gets a new reference (rebase_faces). Any failure makes the next cycle full on
+// every rank (detect()).
+void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live, bool recomputed) {
+  const std::size_t nf = my_face_gid_.size(), nn = my_nodes_.size();
+  const std::size_t nfp = static_cast<std::size_t>(simd::padded_size(static_cast<int>(nf)));
+  const SearchWorkspace& w = search_;
+  const std::vector<ContactNodeItem>& held = *search_nodes_;
+  const double inf = std::numeric_limits<double>::infinity();
+  const double h = 0.45 * w.skin, gh = 0.45 * ghost_margin_;
+  // The ghosting: full budgets where the destinations were just computed, else what is
+  // left of them (the references are those of the last full cycle or rebase).
+  if (recomputed) {
+    sn_ghost_.assign(nn, gh);
+    sf_ghost_.assign(nfp, gh);
+  } else {
+    for (std::size_t k = 0; k < nn; ++k) {
+      const auto p = static_cast<std::size_t>(node_point_[k]);
+      double e = 0;
+      for (int i = 0; i < 3; ++i) e = std::max(e, std::abs(xs_[i][p] - sn_x_[i][k]));
+      sn_ghost_[k] -= e;
+    }
+    for (std::size_t f = 0; f < nf; ++f) {
+      double e = 0;
+      for (int s = 0; s < 6; ++s)
+        e = std::max(e, std::abs((s < 3 ? cap_.lo[s][f] : cap_.hi[s - 3][f]) - sf_box_[s][f]));
+      sf_ghost_[f] -= e;
+    }
+  }
+  // Without lists (no node or no face held here) nothing held here can pair while the
+  // destinations are kept.
+  const bool built = w.built;
+
+  // Nodes: the receiver's budgets and flags (the active nodes), back to the senders.
+  fb_recv_.resize(held.size());
+  for (std::size_t j = 0; j < held.size(); ++j) {
+    double e = 0;
+    if (built)
+      for (int i = 0; i < 3; ++i) e = std::max(e, std::abs(held[j].x[i] - w.node_ref[3 * j + i]));
+    fb_recv_[j] = {built ? h - e : inf, 0};
+  }
+  for (int n : w.active) fb_recv_[static_cast<std::size_t>(n)].keep = 1;
+  node_plan_.reverse(fb_recv_, fb_send_);
+  keep_recv_.resize(fb_recv_.size());
+  for (std::size_t j = 0; j < fb_recv_.size(); ++j)
+    keep_recv_[j] = static_cast<char>(fb_recv_[j].keep);
+  keep_send_.resize(fb_send_.size());
+  for (std::size_t k = 0; k < fb_send_.size(); ++k)
+    keep_send_[k] = static_cast<char>(fb_send_[k].keep);
+  node_sub_.build_subset(node_plan_, keep_send_, keep_recv_);
+  sn_budget_.resize(nn);
+  for (int i = 0; i < 3; ++i) sn_x_[i].resize(nn);
+  for (std::size_t k = 0; k < nn; ++k) {
+    const auto p = static_cast<std::size_t>(node_point_[k]);
+    for (int i = 0; i < 3; ++i) sn_x_[i][k] = xs_[i][p];
+    sn_budget_[k] = std::min(fb_send_[k].budget, sn_ghost_[k]);
+  }
+
+  // Faces: the same per copy (the faces in some list), each face's budget the least of
+  // its copies'.
+  const std::size_t nr = face_plan_.recv_count();
+  fb_recv_.resize(nr);
+  for (std::size_t j = 0; j < nr; ++j) {
+    double e = 0;
+    if (built)
+      for (int s = 0; s < 6; ++s) {
+        const double b = s < 3 ? boxes.lo[s][j] : boxes.hi[s - 3][j];
+        e = std::max(e, std::abs(b - w.box_ref[static_cast<std::size_t>(s) * nr + j]));
+      }
+    fb_recv_[j] = {built ? h - e : inf, 0};
+  }
+  for (int f : w.needed) fb_recv_[static_cast<std::size_t>(f)].keep = 1;
+  face_plan_.reverse(fb_recv_, fb_send_);
+  keep_recv_.resize(nr);
+  for (std::size_t j = 0; j < nr; ++j) keep_recv_[j] = static_cast<char>(fb_recv_[j].keep);
+  keep_send_.resize(fb_send_.size());
+  sf_budget_.assign(nfp, inf); // dead faces and the padding never fail
+  sub_faces_.clear();
+  for (std::size_t c = 0; c < fb_send_.size(); ++c) { // copies in ascending face order
+    const int f = face_src_[c];
+    keep_send_[c] = static_cast<char>(fb_send_[c].keep);
+    auto& budget = sf_budget_[static_cast<std::size_t>(f)];
+    budget = std::min(budget, std::min(fb_send_[c].budget, sf_ghost_[static_cast<std::size_t>(f)]));
+    if (keep_send_[c] != 0 && (sub_faces_.empty() || sub_faces_.back() != f))
+      sub_faces_.push_back(f);
+  }
+  face_sub_.build_subset(face_plan_, keep_send_, keep_recv_);
+  // What lazy cycles may need, at most, so that they allocate nothing.
+  node_sub_.reserve(node_plan_.send_count() * sizeof(ContactNodeItem));
+  face_sub_.reserve(face_plan_.send_count() * sizeof(FaceMotion));
+  node_sub_in_.reserve(node_plan_.recv_count());
+  face_sub_in_.reserve(face_plan_.recv_count());
+  fail_.reserve(nfp);
+  near_.reserve(nf);
+
+  for (auto& v : sf_x_) v.resize(nfp);
+  for (auto& v : sf_box_) v.resize(nf);
+  sf_a_.assign(nfp, 0.0);
+  sf_b_.assign(nfp, 0.0);
+  sf_near_.assign(nf, 0);
+  near_.clear();
+  for (std::size_t f = 0; f < nfp; ++f) set_face_reference(f);
+  live_ref_ = live;
+  shared_ = true; // (never with extra nodes anywhere: they change every cycle)
+}
+
+void ContactPhase::set_face_reference(std::size_t f) {
+  for (int a = 0; a < 4; ++a) {
+    const auto p = static_cast<std::size_t>(corner_[a][f]);
+    for (int i = 0; i < 3; ++i) sf_x_[3 * a + i][f] = xs_[i][p];
+  }
+  if (f >= my_face_gid_.size()) return; // padding
+  for (int i = 0; i < 3; ++i) {
+    sf_box_[i][f] = cap_.lo[i][f];
+    sf_box_[3 + i][f] = cap_.hi[i][f];
+  }
+  sf_a_[f] = 4 * my_face_depth_[f] / cap_.len[f] + 0.025 / std::sqrt(0.5 * cap_.len[f]);
+  sf_b_[f] = 2 * cap_.diag[f];
+  if (!alive(f)) return;
+  // The centre moves no more than the corners, at most 0.45 g while the bound holds: only
+  // a face whose centre is nearer its rank's box side can change rank.
+  const double c[3] = {cap_.centre[0][f], cap_.centre[1][f], cap_.centre[2][f]};
+  update_face_rank(f, c);
+  const Box3& b = rank_box_[static_cast<std::size_t>(my_face_rank_[f])];
+  bool far = true;
+  for (int i = 0; i < 3; ++i)
+    far &= c[i] - b.lo[i] > 0.5 * ghost_margin_ && b.hi[i] - c[i] > 0.5 * ghost_margin_;
+  if (!far && sf_near_[f] == 0) {
+    sf_near_[f] = 1;
+    near_.push_back(static_cast<int>(f));
+  }
+}
+
+// The face bound of lazy_bound_holds(), per face from its own reference, vectorised
+// across faces: delta is the largest distance of a corner from where it was then.
+bool ContactPhase::shared_bound_holds() {
+  unsigned bad = 0; // also when anything is not a number
+  for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
+    const auto p = static_cast<std::size_t>(node_point_[k]);
+    const double e = std::max({std::abs(xs_[0][p] - sn_x_[0][k]), std::abs(xs_[1][p] - sn_x_[1][k]),
+                               std::abs(xs_[2][p] - sn_x_[2][k])});
+    bad |= static_cast<unsigned>(!(e <= sn_budget_[k]));
+  }
+  fail_.clear();
+  const std::size_t nfp = sf_budget_.size();
+  const double* x[3] = {xs_[0].data(), xs_[1].data(), xs_[2].data()};
+  const int* c[4] = {corner_[0].data(), corner_[1].data(), corner_[2].data(), corner_[3].data()};
+  const double* r[12];
+  for (int k = 0; k < 12; ++k) r[k] = sf_x_[k].data();
+  const double *A = sf_a_.data(), *B = sf_b_.data(), *budget = sf_budget_.data();
+  for (std::size_t f = 0; f < nfp; f += simd::width) {
+    simd::vdouble d2 = 0.0;
+    for (int a = 0; a < 4; ++a) {
+      simd::vdouble s = 0.0;
+      for (int i = 0; i < 3; ++i) {
+        const simd::vdouble d = simd::gather_i32(x[i], c[a] + f) - simd::load(r[3 * a + i] + f);
+        s += d * d;
+      }
+      where(d2 < s, d2) = s;
+    }
+    const simd::vdouble delta = sqrt(d2);
+    const simd::vdouble m = delta * (1 + simd::load(A + f) * (simd::load(B + f) + 4 * delta));
+    const simd::vmask ok = 1.001 * m <= simd::load(budget + f);
+    if (all_of(ok)) continue;
+    for (int l = 0; l < simd::width; ++l)
+      if (!ok[l]) fail_.push_back(static_cast<int>(f) + l);
+  }
+  return bad == 0;
+}
+
+bool ContactPhase::rebase_faces() {
+  compute_captures(corners(), fail_, cap_);
+  unsigned bad = 0; // also when anything is not a number
+  for (int f : fail_)
+    for (int s = 0; s < 6; ++s) {
+      const double b = s < 3 ? cap_.lo[s][f] : cap_.hi[s - 3][f];
+      bad |= static_cast<unsigned>(!(std::abs(b - sf_box_[s][f]) <= sf_budget_[f]));
+    }
+  if (bad != 0) return false;
+  for (int fi : fail_) {
+    const auto f = static_cast<std::size_t>(fi);
+    double e = 0;
+    for (int s = 0; s < 6; ++s)
+      e = std::max(e, std::abs((s < 3 ? cap_.lo[s][f] : cap_.hi[s - 3][f]) - sf_box_[s][f]));
+    sf_budget_[f] -= e;
+    sf_ghost_[f] -= e;
+    set_face_reference(f);
+  }
+  return true;
+}
+
+bool ContactPhase::compute_destinations(std::size_t live) {
+  const std::size_t nf = my_face_gid_.size();
+  node_dest_.resize(node_out_.size());
+  for (std::size_t k = 0; k < node_out_.size(); ++k) {
+    // Last cycle's rank when the point is still in its half-open box (exactly
+    // Rcb::owner's answer there), else the tree.
+    const Vec3 x{node_out_[k].x[0], node_out_[k].x[1], node_out_[k].x[2]};
+    const Box3& b = rank_box_[static_cast<std::size_t>(node_dest_[k])];
+    if (!(x.x >= b.lo.x && x.x < b.hi.x && x.y >= b.lo.y && x.y < b.hi.y && x.z >= b.lo.z &&
+          x.z < b.hi.z))
+      node_dest_[k] = rcb_.owner(x);
+  }
+  // Faces go to every rank their capture box, enlarged by the ghosting margin, touches
+  // (ghosts), as copies.
+  const double g = ghost_margin_;
+  face_dest_.clear();
+  face_src_.clear();
+  one_copy_each_ = live == nf; // then copy k is face k
+  for (std::size_t f = 0; f < nf; ++f) {
+    if (!alive(f)) continue;
+    const Box3 q{{cap_.lo[0][f] - g, cap_.lo[1][f] - g, cap_.lo[2][f] - g},
+                 {cap_.hi[0][f] + g, cap_.hi[1][f] + g, cap_.hi[2][f] + g}};
+    // A box strictly inside the box of the face's last rank overlaps that rank only, and
+    // a centre in its half-open box is that rank's: Rcb::overlapping's and Rcb::owner's
+    // answers, without the tree.
+    {
+      const Box3& b = rank_box_[static_cast<std::size_t>(my_face_rank_[f])];
+      bool inside = true;
+      for (int i = 0; i < 3; ++i)
+        inside &= q.lo[i] > b.lo[i] && q.hi[i] < b.hi[i] && cap_.centre[i][f] >= b.lo[i] &&
+                  cap_.centre[i][f] < b.hi[i];
+      if (inside) {
+        face_src_.push_back(static_cast<int>(f));
+        face_dest_.push_back(my_face_rank_[f]);
+        continue;
+      }
+    }
+    my_face_rank_[f] = rcb_.owner({cap_.centre[0][f], cap_.centre[1][f], cap_.centre[2][f]});
+    rcb_.overlapping(q, ranks_);
+    one_copy_each_ &= ranks_.size() == 1;
+    for (int r : ranks_) {
+      face_src_.push_back(static_cast<int>(f));
+      face_dest_.push_back(r);
+    }
+  }
+  return !plans_built_ || node_dest_ != node_dest_built_ || face_dest_ != face_dest_built_ ||
+         face_src_ != face_src_built_;
+}
+
+void ContactPhase::update_face_rank(std::size_t f, const double (&c)[3]) {
+  int& r = my_face_rank_[f];
+  const Box3& b = rank_box_[static_cast<std::size_t>(r)];
+  bool in = true;
+  for (int i = 0; i < 3; ++i) in &= c[i] >= b.lo[i] && c[i] < b.hi[i];
+  if (!in) r = rcb_.owner({c[0], c[1], c[2]});
 }
 
 bool ContactPhase::lazy_bound_holds() {
@@ -234,42 +564,33 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
   const std::size_t nf = my_face_gid_.size();
   // On one rank every item stays: no RCB look-ups.
   const bool alone = comm_.size() == 1;
-  // Faces of eroded elements have left the surface.
-  auto alive = [&](std::size_t f) {
-    const auto [fb, fe] = my_face_slot_[f];
-    return blocks_[static_cast<std::size_t>(fb)].alive[static_cast<std::size_t>(fe)] != 0.0;
-  };
-  std::size_t live = nf; // faces alive (counted on one rank)
-  bool lazy_cycle = false;
+  std::size_t live = 0;    // faces alive
+  bool lazy_cycle = false; // one rank: the bound holds
+  bool bound_ok = false;   // several ranks: this rank's items are within their budgets
   {
     ScopedPhase t(timers, Phase::transfer);
     for (std::size_t k = 0; k < surf_local_.size(); ++k) {
       const auto l = static_cast<std::size_t>(surf_local_[k]);
       for (int i = 0; i < 3; ++i) xs_[i][k] = nd.x[i][l] + dt * nd.v[i][l];
     }
-    if (alone) {
-      live = 0;
-      for (std::size_t f = 0; f < nf; ++f) live += alive(f) ? 1 : 0;
+    for (std::size_t f = 0; f < nf; ++f) live += alive(f) ? 1 : 0;
+    // While the bound shows the candidate lists valid (and, on several ranks, the
+    // ghosting), only the faces some list reads need their box (below); otherwise every
+    // face gets it.
+    if (alone)
+      lazy_cycle = live == nf && extra_.empty() && lazy_ && search_.built &&
+                   search_.builds == lazy_builds_ && lazy_bound_holds();
+    else if (shared_ && !rebalance_due_ && extra_.empty() && live == live_ref_) {
+      // Faces whose bound fails may still be within their budgets (exact boxes).
+      bound_ok = shared_bound_holds();
+      if (bound_ok && !fail_.empty()) bound_ok = rebase_faces();
     }
-    // One rank: while the bound shows the candidate lists valid, only the faces in some
-    // list need their box (below); otherwise every face gets it.
-    lazy_cycle = alone && live == nf && extra_.empty() && lazy_ && search_.built &&
-                 search_.builds == lazy_builds_ && lazy_bound_holds();
-    if (!lazy_cycle) compute_captures(corners(), cap_);
-    node_out_.resize(my_nodes_.size());
-    for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
-      const int l = my_nodes_[k];
-      const auto p = static_cast<std::size_t>(node_point_[k]);
-      auto& it = node_out_[k];
-      for (int i = 0; i < 3; ++i) {
-        it.x[i] = xs_[i][p];
-        it.v[i] = nd.v[i][l];
-      }
-      it.mass = nd.mass[l];
-      it.last_face = last_face_[static_cast<std::size_t>(l)];
-      it.allowance = allowance_[static_cast<std::size_t>(l)];
+    if (!lazy_cycle && !bound_ok) compute_captures(corners(), cap_);
+    if (!bound_ok) {
+      node_out_.resize(my_nodes_.size());
+      for (std::size_t k = 0; k < my_nodes_.size(); ++k) pack_node(k, nd, node_out_[k]);
+      node_out_.insert(node_out_.end(), extra_.begin(), extra_.end());
     }
-    node_out_.insert(node_out_.end(), extra_.begin(), extra_.end());
   }
 
   // Rebalance: RCB of node positions and face centroids, unit weights.
@@ -308,71 +629,48 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     ++stats_.rebalances;
   }
 
+  bool lazy = false;            // several ranks: every rank's bound holds
+  bool extra_somewhere = false; // some rank has extra nodes this cycle
   {
     ScopedPhase t(timers, Phase::transfer);
-    node_dest_.resize(node_out_.size());
-    if (alone)
-      std::fill(node_dest_.begin(), node_dest_.end(), 0);
-    else
-      for (std::size_t k = 0; k < node_out_.size(); ++k) {
-        // Last cycle's rank when the point is still in its half-open box (exactly
-        // Rcb::owner's answer there), else the tree.
-        const Vec3 x{node_out_[k].x[0], node_out_[k].x[1], node_out_[k].x[2]};
-        const Box3& b = rank_box_[static_cast<std::size_t>(node_dest_[k])];
-        if (!(x.x >= b.lo.x && x.x < b.hi.x && x.y >= b.lo.y && x.y < b.hi.y && x.z >= b.lo.z &&
-              x.z < b.hi.z))
-          node_dest_[k] = rcb_.owner(x);
-      }
-    // Faces go to every rank their capture box touches (ghosts), as copies.
-    bool one_copy_each = true; // then copy k is face k
+    bool changed = false;
     if (alone) {
       // Rank 0 holds each live face once: the lists change only when an element erodes.
-      one_copy_each = live == nf;
-      if (!one_copy_each || face_src_.size() != nf) { // else they are 0..nf-1, all to 0
+      node_dest_.assign(node_out_.size(), 0);
+      one_copy_each_ = live == nf;
+      if (!one_copy_each_ || face_src_.size() != nf) { // else they are 0..nf-1, all to 0
         face_dest_.assign(live, 0);
         face_src_.clear();
         for (std::size_t f = 0; f < nf; ++f)
           if (alive(f)) face_src_.push_back(static_cast<int>(f));
       }
+      changed = !plans_built_ || node_dest_ != node_dest_built_ || face_dest_ != face_dest_built_ ||
+                face_src_ != face_src_built_;
+    } else if (!bound_ok) {
+      changed = compute_destinations(live);
     } else {
-      face_dest_.clear();
-      face_src_.clear();
-    }
-    for (std::size_t f = 0; f < nf && !alone; ++f) {
-      if (!alive(f)) {
-        one_copy_each = false;
-        continue;
-      }
-      // A capture box strictly inside the box of the face's last rank overlaps that rank
-      // only, and a centre in its half-open box is that rank's: Rcb::overlapping's and
-      // Rcb::owner's answers, without the tree.
-      {
-        const Box3& b = rank_box_[static_cast<std::size_t>(my_face_rank_[f])];
-        bool inside = true;
+      // The destinations stay; the centres near a rank's box side may have left it.
+      for (int f : near_) {
+        double c[3];
         for (int i = 0; i < 3; ++i)
-          inside &= cap_.lo[i][f] > b.lo[i] && cap_.hi[i][f] < b.hi[i] &&
-                    cap_.centre[i][f] >= b.lo[i] && cap_.centre[i][f] < b.hi[i];
-        if (inside) {
-          face_src_.push_back(static_cast<int>(f));
-          face_dest_.push_back(my_face_rank_[f]);
-          continue;
-        }
-      }
-      my_face_rank_[f] = rcb_.owner({cap_.centre[0][f], cap_.centre[1][f], cap_.centre[2][f]});
-      rcb_.overlapping({{cap_.lo[0][f], cap_.lo[1][f], cap_.lo[2][f]},
-                        {cap_.hi[0][f], cap_.hi[1][f], cap_.hi[2][f]}},
-                       ranks_);
-      one_copy_each &= ranks_.size() == 1;
-      for (int r : ranks_) {
-        face_src_.push_back(static_cast<int>(f));
-        face_dest_.push_back(r);
+          c[i] = 0.25 * (xs_[i][static_cast<std::size_t>(corner_[0][f])] +
+                         xs_[i][static_cast<std::size_t>(corner_[1][f])] +
+                         xs_[i][static_cast<std::size_t>(corner_[2][f])] +
+                         xs_[i][static_cast<std::size_t>(corner_[3][f])]);
+        update_face_rank(static_cast<std::size_t>(f), c);
       }
     }
-    // The plans depend only on the destinations: rebuilt when some rank's have changed
-    // (one reduction instead of two all-to-alls of counts).
-    const bool changed = !plans_built_ || node_dest_ != node_dest_built_ ||
-                         face_dest_ != face_dest_built_ || face_src_ != face_src_built_;
-    if (comm_.max(static_cast<std::int64_t>(changed)) != 0) {
+    // One reduction: 2 when some rank's destinations have changed (the plans are rebuilt,
+    // instead of two all-to-alls of counts), 1 when some rank's bound fails (a full
+    // cycle), 0 when every rank's bound holds (a lazy cycle); and whether some rank has
+    // extra nodes (then the next cycle cannot be lazy either: no reference is set).
+    std::int64_t red[2] = {changed ? 2 : (alone || bound_ok ? 0 : 1),
+                           static_cast<std::int64_t>(!extra_.empty())};
+    comm_.max(std::span<std::int64_t>(red, 2));
+    const std::int64_t worst = red[0];
+    lazy = !alone && worst == 0;
+    extra_somewhere = red[1] != 0;
+    if (worst == 2) {
       node_plan_.build(comm_, node_dest_);
       face_plan_.build(comm_, face_dest_);
       node_dest_built_ = node_dest_;
@@ -381,57 +679,112 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       plans_built_ = true;
       ++stats_.plan_builds;
     }
-    // Where every item stays on this rank, the search reads the local items in place.
-    if (node_plan_.stays()) {
-      search_nodes_ = &node_out_;
+    if (lazy) {
+      // Only the items some receiver's lists read, and of a face only what changes.
+      compute_captures(corners(), sub_faces_, cap_);
+      node_sub_.forward_packed(node_sub_in_,
+                               [&](std::size_t k, ContactNodeItem& it) { pack_node(k, nd, it); });
+      std::vector<ContactNodeItem>& held = node_plan_.stays() ? node_out_ : node_in_;
+      for (std::size_t j = 0; j < node_sub_in_.size(); ++j)
+        held[node_sub_.base_position(j)] = node_sub_in_[j];
+      if (in_place_) {
+        for (int f : sub_faces_) pack_face(static_cast<std::size_t>(f), nd);
+      } else {
+        face_sub_.forward_packed(face_sub_in_, [&](std::size_t k, FaceMotion& m) {
+          pack_cycle(static_cast<std::size_t>(face_src_[k]), nd, m);
+        });
+        for (std::size_t j = 0; j < face_sub_in_.size(); ++j)
+          unpack_motion(face_sub_in_[j], face_sub_.base_position(j));
+      }
+      stats_.bytes_sent +=
+          static_cast<double>(node_sub_.sent_elsewhere() * sizeof(ContactNodeItem) +
+                              face_sub_.sent_elsewhere() * sizeof(FaceMotion));
     } else {
-      node_plan_.forward(node_out_, node_in_);
-      search_nodes_ = &node_in_;
+      if (!alone && bound_ok) {
+        // Some other rank's bound failed: this rank keeps its destinations, and its items
+        // go in full.
+        compute_captures(corners(), cap_);
+        node_out_.resize(my_nodes_.size());
+        for (std::size_t k = 0; k < my_nodes_.size(); ++k) pack_node(k, nd, node_out_[k]);
+      }
+      // Where every item stays on this rank, the search reads the local items in place.
+      if (node_plan_.stays()) {
+        search_nodes_ = &node_out_;
+      } else {
+        node_plan_.forward(node_out_, node_in_);
+        search_nodes_ = &node_in_;
+      }
+      in_place_ = node_plan_.stays() && face_plan_.stays() && one_copy_each_;
+      if (in_place_) {
+        search_faces_ = &face_local_;
+      } else {
+        if (lazy_cycle) compute_captures(corners(), cap_); // (cannot happen: one rank stays)
+        // Each copy is packed straight into the send buffer of its rank, or into face_in_
+        // where it stays: no face item is copied.
+        face_plan_.forward_packed(face_in_, [&](std::size_t k, ContactFaceItem& it) {
+          pack_copy(static_cast<std::size_t>(face_src_[k]), nd, it);
+        });
+        search_faces_ = &face_in_;
+      }
+      // Only what goes to another rank: items kept here are no traffic.
+      stats_.bytes_sent +=
+          static_cast<double>(node_plan_.sent_elsewhere() * sizeof(ContactNodeItem) +
+                              face_plan_.sent_elsewhere() * sizeof(ContactFaceItem));
     }
-    in_place_ = node_plan_.stays() && face_plan_.stays() && one_copy_each;
-    if (in_place_) {
-      search_faces_ = &face_local_;
-    } else {
-      if (lazy_cycle) compute_captures(corners(), cap_); // (cannot happen: one rank stays)
-      // Each copy is packed straight into the send buffer of its rank, or into face_in_
-      // where it stays: no face item is copied.
-      face_plan_.forward_packed(face_in_, [&](std::size_t k, ContactFaceItem& it) {
-        pack_copy(static_cast<std::size_t>(face_src_[k]), nd, it);
-      });
-      search_faces_ = &face_in_;
-    }
-    // Only what goes to another rank: items kept here are no traffic.
-    stats_.bytes_sent += static_cast<double>(node_plan_.sent_elsewhere() * sizeof(ContactNodeItem) +
-                                             face_plan_.sent_elsewhere() * sizeof(ContactFaceItem));
   }
 
   SearchOptions opt;
   opt.dt = dt;
+  FaceBoxes boxes;
   if (in_place_) {
     // The boxes straight from cap_; the items of the faces in some candidate list only.
-    FaceBoxes boxes;
     for (int i = 0; i < 3; ++i) {
       boxes.lo[i] = std::span<const double>(cap_.lo[i].data(), nf);
       boxes.hi[i] = std::span<const double>(cap_.hi[i].data(), nf);
     }
-    if (!lazy_cycle) {
+    if (!lazy_cycle && !lazy) {
       ScopedPhase t(timers, Phase::contact_search);
       update_candidate_lists(*search_nodes_, face_local_, boxes, opt, search_);
     }
-    {
+    if (!lazy) {
       ScopedPhase t(timers, Phase::transfer);
       if (lazy_cycle) compute_captures(corners(), search_.needed, cap_);
       for (int f : search_.needed) pack_face(static_cast<std::size_t>(f), nd);
       if (!lazy_cycle && alone && extra_.empty() && search_.built) set_lazy_reference();
     }
-    ScopedPhase t(timers, Phase::contact_search);
-    find_pairs(*search_nodes_, face_local_, boxes, opt, search_, pairs_);
   } else {
     lazy_ = false;
+    // The boxes of the received items, as find_contacts() reads them (a lazy cycle has
+    // updated those of the items the lists read).
+    const std::size_t nr = face_in_.size();
+    for (int s = 0; s < 6; ++s) recv_box_[s].resize(nr);
+    if (!lazy)
+      for (std::size_t j = 0; j < nr; ++j)
+        for (int i = 0; i < 3; ++i) {
+          recv_box_[i][j] = face_in_[j].lo[i];
+          recv_box_[3 + i][j] = face_in_[j].hi[i];
+        }
+    for (int i = 0; i < 3; ++i) {
+      boxes.lo[i] = recv_box_[i];
+      boxes.hi[i] = recv_box_[3 + i];
+    }
+    if (!lazy) {
+      ScopedPhase t(timers, Phase::contact_search);
+      update_candidate_lists(*search_nodes_, face_in_, boxes, opt, search_);
+    }
+  }
+  {
     ScopedPhase t(timers, Phase::contact_search);
-    find_contacts(*search_nodes_, *search_faces_, opt, search_, pairs_);
+    find_pairs(*search_nodes_, *search_faces_, boxes, opt, search_, pairs_);
+  }
+  if (!alone && !lazy && !extra_somewhere) {
+    ScopedPhase t(timers, Phase::transfer);
+    set_shared_reference(boxes, live, !bound_ok);
+  } else if (extra_somewhere) {
+    shared_ = false;
   }
   stats_.list_builds = search_.builds;
+  stats_.lazy_cycles += lazy_cycle || lazy ? 1 : 0;
 }
 
 void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers) {

@@ -7,6 +7,12 @@
 // owner of the node it acts on; owners sum them in ascending pair id and pass the sums to
 // the other ranks that hold the node. The RCB is recomputed only when the load imbalance
 // exceeds a threshold (incrementally, from the previous cuts).
+//
+// Most cycles are lazy: while every item is within the budgets that the candidate lists
+// of its receivers and the ghosting allow (faces are ghosted by their capture box
+// enlarged by a margin), the last full cycle's destinations, plans and received layout
+// are kept, and only what the receivers' lists read is computed and sent (detect(),
+// set_shared_reference()). The pairs are those of the exact search on every cycle.
 #pragma once
 
 #include <cstdint>
@@ -38,6 +44,10 @@ struct ContactStats {
   double max_penetration = 0;   // largest gap behind a face, over all cycles, m
   std::int64_t list_builds = 0; // this rank's candidate-list builds (SearchWorkspace)
   std::int64_t plan_builds = 0; // node and face migration plans built (destinations changed)
+  // Cycles on which the bound held on every rank: only the faces in some candidate list
+  // got their capture box, and on several ranks the destinations, plans and received
+  // layout were kept and only what the lists read was sent.
+  std::int64_t lazy_cycles = 0;
   // Largest penetration beyond the pair's allowance, over all cycles, m: the part the
   // penalty force resists. max_penetration minus this is depth a pair already had when the
   // search first found it (docs/contact.md, "The can crush and its limits").
@@ -143,6 +153,46 @@ private:
   std::vector<double> ref_a_, ref_b_;   // per face: the bound's coefficients (lazy_bound_holds)
   std::vector<double> ref_face_budget_; // per face: how far its box sides may still move, m
   std::vector<double> point_move_;      // per point: |x* - ref_x| this cycle, m
+  // Several ranks: a bound of the same kind, per item, with budgets from the receivers'
+  // candidate lists and from the ghosting, lets a cycle keep the last full cycle's
+  // destinations, plans and received layout and send only what the receivers' lists read
+  // (detect()). Faces are ghosted by their capture box enlarged by ghost_margin_ (g),
+  // nodes by their position: while no node has moved 0.45 g and no box side 0.45 g since,
+  // every face whose box holds a node is held where the node is (set_shared_reference()).
+  // Each item has its own reference: a face whose bound fails is checked exactly and, if
+  // within its budget, gets a new reference on its own (rebase_faces()).
+  double ghost_margin_ = 0;                  // g, m (the same on every rank, set at construction)
+  bool shared_ = false;                      // the references are set
+  std::size_t live_ref_ = 0;                 // faces alive at the last full cycle
+  std::vector<double> sn_x_[3];              // per owned contact node: x* at its reference
+  std::vector<double> sn_budget_, sn_ghost_; // per node: how far it may move from there
+                                             // (largest coordinate), and for the ghosting
+  std::vector<double> sf_x_[12];             // per face (padded): corner a, coordinate i at
+                                             // its reference ([3 a + i])
+  std::vector<double> sf_box_[6];            // per face: capture box then (lo, then hi)
+  std::vector<double> sf_a_, sf_b_;          // per face (padded): the bound's coefficients
+  std::vector<double> sf_budget_, sf_ghost_; // per face (padded): how far its box sides may
+                                             // move from there, and for the ghosting, m
+  std::vector<char> sf_near_;                // per face: listed in near_
+  std::vector<int> near_;      // alive faces whose centre may leave its rank's box (contact_rank)
+  std::vector<int> fail_;      // faces whose bound failed this cycle
+  bool one_copy_each_ = false; // every live face has one copy (copy k is face k)
+  struct Feedback {            // a receiver's word on one item it holds:
+    double budget;             // how far it may move before the lists fail, m
+    std::int64_t keep;         // its lists read it (1) or not (0)
+  };
+  std::vector<Feedback> fb_recv_, fb_send_; // per received item, per local item (or copy)
+  std::vector<char> keep_recv_, keep_send_; // the keep flags, for the subset plans
+  std::vector<int> sub_faces_;              // faces with some kept copy, ascending
+  // What a lazy cycle sends of a face: the fields that change (those of pack_cycle()).
+  struct FaceMotion {
+    double x[4][3], v[4][3], mass[4];
+    double normal[3], offset, warp, lo[3], hi[3];
+  };
+  Migration node_sub_, face_sub_; // the kept part of node_plan_, face_plan_
+  std::vector<ContactNodeItem> node_sub_in_;
+  std::vector<FaceMotion> face_sub_in_;
+  std::vector<double> recv_box_[6]; // capture boxes of face_in_ (lo x, y, z, hi x, y, z)
 
   Rcb rcb_;
   std::vector<Box3> rank_box_; // rcb_.box(r) of every rank, since the last partition
@@ -175,11 +225,37 @@ private:
   void pack_face(std::size_t f, const ContactNodes& nodes);
   // The same fields, and the constant ones of face_local_[f], into another item.
   void pack_copy(std::size_t f, const ContactNodes& nodes, ContactFaceItem& it) const;
-  void pack_cycle(std::size_t f, const ContactNodes& nodes, ContactFaceItem& it) const;
+  template <class Item>
+  void pack_cycle(std::size_t f, const ContactNodes& nodes, Item& it) const;
+  // Writes this cycle's fields of owned contact node k (x*, v, mass, history) into it.
+  void pack_node(std::size_t k, const ContactNodes& nodes, ContactNodeItem& it) const;
   // The faces' corners and depths as compute_captures() reads them.
   FaceCorners corners() const;
   // Sets the bound's reference from this cycle's exact boxes and the lists just checked.
   void set_lazy_reference();
+  // The bound's geometric reference (positions, coefficients) from this cycle's points;
+  // the budgets are the caller's.
+  void set_bound_geometry();
+  // Several ranks, after a full cycle's search (collective): the receivers' budgets and
+  // keep flags back to the senders, the bound's reference, and the subset plans.
+  void set_shared_reference(const FaceBoxes& boxes, std::size_t live, bool recomputed);
+  // Several ranks: true when every node is within its budget; fail_ gets the faces whose
+  // bound fails.
+  bool shared_bound_holds();
+  // The faces of fail_ checked exactly: true when each is within its budget; each then
+  // gets this cycle as its reference, its budgets less what it used.
+  bool rebase_faces();
+  // Face f's reference: this cycle's corners and exact box (cap_), and its rank.
+  void set_face_reference(std::size_t f);
+  // A lazy cycle's fields of a received face, into face_in_[j] and its box.
+  void unpack_motion(const FaceMotion& m, std::size_t j);
+  // Face f's element has not eroded.
+  bool alive(std::size_t f) const;
+  // Several ranks: node and face destinations (faces by their enlarged capture box); true
+  // when they differ from those the plans were built for.
+  bool compute_destinations(std::size_t live);
+  // my_face_rank_ of face f from its centre c (Rcb::owner's answer).
+  void update_face_rank(std::size_t f, const double (&c)[3]);
   // True when the bound shows every node and every capture-box side within 0.45 skin of
   // where the candidate lists were built, without computing the boxes.
   bool lazy_bound_holds();

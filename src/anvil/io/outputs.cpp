@@ -470,6 +470,7 @@ void Outputs::write_summary(int status, const std::string& message) {
                     {"max_penetration_resisted", contact_stats.max_penetration_resisted},
                     {"candidate_list_builds_max", list_builds_max},
                     {"plan_builds", contact_stats.plan_builds},
+                    {"lazy_cycles", contact_stats.lazy_cycles},
                     {"bytes_sent_per_rank_per_cycle_max",
                      bytes_max / static_cast<double>(contact_stats.cycles)}};
   }

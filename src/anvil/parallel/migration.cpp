@@ -46,6 +46,7 @@ void permute(unsigned char* dst, const unsigned char* src, const std::int64_t* i
 void Migration::build(const Comm& comm, std::span<const int> dest) {
   comm_ = &comm;
   rank_ = comm.rank();
+  position_.clear();
   const int P = comm.size();
   const auto Pz = static_cast<std::size_t>(P);
   scount_.assign(Pz, 0);
@@ -64,9 +65,10 @@ void Migration::build(const Comm& comm, std::span<const int> dest) {
   // rank throw (a negative count cannot occur otherwise).
   if (bad) scount_.assign(Pz, -1);
   comm.alltoall_bytes(scount_.data(), sizeof(std::int64_t), rcount_.data());
+  // Every rank receives the -1 of a rank with a bad destination: no reduction is needed.
   bool any_bad = bad != 0;
   for (std::int64_t c : rcount_) any_bad |= c < 0;
-  if (comm.max(static_cast<std::int64_t>(any_bad)) != 0)
+  if (any_bad)
     throw std::invalid_argument("Migration::build: destination rank out of range on some rank");
 
   for (std::size_t q = 0; q < Pz; ++q) {
@@ -85,6 +87,42 @@ void Migration::build(const Comm& comm, std::span<const int> dest) {
   for (int q = 0; q < P; ++q)
     if (q != rank_ &&
         (scount_[static_cast<std::size_t>(q)] > 0 || rcount_[static_cast<std::size_t>(q)] > 0))
+      peers_.push_back(q);
+}
+
+void Migration::build_subset(const Migration& base, std::span<const char> send_keep,
+                             std::span<const char> recv_keep) {
+  if (!base.comm_) throw std::logic_error("Migration::build_subset: base was not built");
+  if (send_keep.size() != base.send_count() || recv_keep.size() != base.recv_count())
+    throw std::invalid_argument("Migration::build_subset: marks do not match the base plan");
+  comm_ = base.comm_;
+  rank_ = base.rank_;
+  const std::size_t Pz = base.scount_.size();
+  scount_.assign(Pz, 0);
+  rcount_.assign(Pz, 0);
+  sdispl_.assign(Pz + 1, 0);
+  rdispl_.assign(Pz + 1, 0);
+  // base's groups filtered: the kept items of each destination, in base's order.
+  order_.clear();
+  position_.clear();
+  order_.reserve(base.order_.size()); // a subset never outgrows its base
+  position_.reserve(base.recv_total_);
+  for (std::size_t q = 0; q < Pz; ++q) {
+    for (std::int64_t k = base.sdispl_[q]; k < base.sdispl_[q + 1]; ++k) {
+      const std::int64_t i = base.order_[static_cast<std::size_t>(k)];
+      if (send_keep[static_cast<std::size_t>(i)] != 0) order_.push_back(i);
+    }
+    for (std::int64_t j = base.rdispl_[q]; j < base.rdispl_[q + 1]; ++j)
+      if (recv_keep[static_cast<std::size_t>(j)] != 0) position_.push_back(j);
+    sdispl_[q + 1] = static_cast<std::int64_t>(order_.size());
+    rdispl_[q + 1] = static_cast<std::int64_t>(position_.size());
+    scount_[q] = sdispl_[q + 1] - sdispl_[q];
+    rcount_[q] = rdispl_[q + 1] - rdispl_[q];
+  }
+  recv_total_ = position_.size();
+  peers_.clear();
+  for (int q : base.peers_)
+    if (scount_[static_cast<std::size_t>(q)] > 0 || rcount_[static_cast<std::size_t>(q)] > 0)
       peers_.push_back(q);
 }
 

@@ -11,6 +11,10 @@
 // then every move sends one message per field to each rank that has items for it and to
 // no other (sparse). Items that stay on this rank are copied, not sent.
 //
+// Subsets. build_subset() makes, without communication, a plan that moves only the items
+// marked on both sides of a built plan (for example what the receivers still need, the
+// marks sent back with reverse()), into a compact layout mapped onto the full one.
+//
 // Memory. The plan keeps its buffers: once they have grown to the largest field moved,
 // build(), forward() and reverse() allocate nothing (rebuilding for new destinations
 // reuses them too).
@@ -35,6 +39,22 @@ public:
   // Builds the plan: local item i goes to rank dest[i] (0 <= dest[i] < comm.size()).
   // Collective over comm, which must outlive the plan's use.
   void build(const Comm& comm, std::span<const int> dest);
+  // Builds this plan as the part of `base` that moves only some items: local item i of
+  // base when send_keep[i] != 0, arriving at base's received position j when
+  // recv_keep[j] != 0. Sender and receiver must mark the same items (for example, the
+  // receiver's marks sent back along base.reverse()); nothing is exchanged to check it.
+  // forward() then fills a compact layout (source rank, then source index, as base's),
+  // whose item j belongs at base's received position base_position(j). Local; base must
+  // stay built while this plan is used, and a rebuild of base needs a new subset.
+  void build_subset(const Migration& base, std::span<const char> send_keep,
+                    std::span<const char> recv_keep);
+  // Grows the send buffer to `bytes` now (e.g. a subset's largest move, its base's item
+  // count times the item size), so that later moves of up to that size allocate nothing.
+  void reserve(std::size_t bytes) {
+    if (buffer_.size() < bytes) buffer_.resize(bytes);
+  }
+  // Subset plans: base's received position of this plan's received item j.
+  std::size_t base_position(std::size_t j) const { return static_cast<std::size_t>(position_[j]); }
 
   std::size_t send_count() const { return order_.size(); } // items held before (dest.size())
   std::size_t recv_count() const { return recv_total_; }   // items held after forward()
@@ -124,15 +144,16 @@ private:
 
   const Comm* comm_ = nullptr;
   int rank_ = 0;
-  std::vector<std::int64_t> order_;   // local item indices grouped by destination rank
-  std::vector<std::int64_t> scount_;  // items to each rank
-  std::vector<std::int64_t> sdispl_;  // start of each rank's group in order_ (size P + 1)
-  std::vector<std::int64_t> rcount_;  // items from each rank
-  std::vector<std::int64_t> rdispl_;  // start of each rank's items in the received layout
-  std::vector<int> peers_;            // ranks other than this one with items to or from us
-  std::size_t recv_total_ = 0;        // items received, this rank included
-  std::vector<unsigned char> buffer_; // packed items for other ranks (grows, never shrinks)
-  Requests requests_;                 // reused, so moves allocate nothing
+  std::vector<std::int64_t> order_;    // local item indices grouped by destination rank
+  std::vector<std::int64_t> scount_;   // items to each rank
+  std::vector<std::int64_t> sdispl_;   // start of each rank's group in order_ (size P + 1)
+  std::vector<std::int64_t> rcount_;   // items from each rank
+  std::vector<std::int64_t> rdispl_;   // start of each rank's items in the received layout
+  std::vector<int> peers_;             // ranks other than this one with items to or from us
+  std::size_t recv_total_ = 0;         // items received, this rank included
+  std::vector<std::int64_t> position_; // subset plans: base's received position of each item
+  std::vector<unsigned char> buffer_;  // packed items for other ranks (grows, never shrinks)
+  Requests requests_;                  // reused, so moves allocate nothing
 };
 
 } // namespace anvil
