@@ -108,6 +108,7 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
   cap_.resize(nf_all);
   last_face_.assign(fe.node_gid.size(), -1);
   allowance_.assign(fe.node_gid.size(), 0.0);
+  gathered_.assign(4 * static_cast<std::size_t>(comm.size()), 0.0);
   exchange_ = std::make_unique<NodeExchange>(fe, comm);
   // Several ranks: the ghosting margin g (set_shared_reference), the skin the candidate
   // lists use (SearchOptions::skin of the median capture-box extent) for the initial
@@ -801,20 +802,27 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
       deepest = std::max(deepest, -p.gap);
       resisted = std::max(resisted, -p.gap - p.allowance);
     }
-    // Load of this rank: nodes searched plus faces held; one reduction for the balance
-    // test, the pair count and the deepest penetrations.
-    double red[4] = {static_cast<double>(search_nodes_->size() + search_faces_->size()), 0,
-                     static_cast<double>(pairs_.size()), deepest};
-    red[1] = red[0];
-    double mx[3] = {red[0], red[3], resisted};
-    comm_.max(std::span<double>(mx, 3));
-    comm_.sum(std::span<double>(red + 1, 2));
-    const double mean = red[1] / comm_.size();
-    stats_.imbalance = mean > 0 ? mx[0] / mean : 1.0;
+    // Load of this rank: nodes searched plus faces held. One collective (an all-gather of
+    // four values per rank, reduced here in rank order) for the balance test, the pair
+    // count and the deepest penetrations, which need both sums and maxima.
+    const double mine[4] = {static_cast<double>(search_nodes_->size() + search_faces_->size()),
+                            static_cast<double>(pairs_.size()), deepest, resisted};
+    comm_.allgather_bytes(mine, sizeof mine, gathered_.data());
+    double load_max = 0, load_sum = 0, pair_sum = 0, deep_max = 0, resisted_max = 0;
+    for (int r = 0; r < comm_.size(); ++r) {
+      const double* g = gathered_.data() + 4 * static_cast<std::size_t>(r);
+      load_max = std::max(load_max, g[0]);
+      load_sum += g[0];
+      pair_sum += g[1];
+      deep_max = std::max(deep_max, g[2]);
+      resisted_max = std::max(resisted_max, g[3]);
+    }
+    const double mean = load_sum / comm_.size();
+    stats_.imbalance = mean > 0 ? load_max / mean : 1.0;
     stats_.imbalance_max = std::max(stats_.imbalance_max, stats_.imbalance);
-    stats_.pairs = static_cast<std::int64_t>(red[2]);
-    stats_.max_penetration = std::max(stats_.max_penetration, mx[1]);
-    stats_.max_penetration_resisted = std::max(stats_.max_penetration_resisted, mx[2]);
+    stats_.pairs = static_cast<std::int64_t>(pair_sum);
+    stats_.max_penetration = std::max(stats_.max_penetration, deep_max);
+    stats_.max_penetration_resisted = std::max(stats_.max_penetration_resisted, resisted_max);
     rebalance_due_ = stats_.imbalance > config_.rebalance_threshold;
   }
 

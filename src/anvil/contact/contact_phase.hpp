@@ -123,6 +123,7 @@ private:
   std::vector<int> my_nodes_;           // local node indices
   std::vector<std::int64_t> last_face_; // per local node: face contacted last cycle
   std::vector<double> allowance_;       // per local node: penetration allowed without force
+  std::vector<double> gathered_;        // forces(): four values per rank, all-gathered
   std::vector<std::int64_t> my_face_gid_;
   std::vector<std::array<int, 4>> my_face_nodes_;    // local node indices
   std::vector<std::array<int, 4>> my_face_opposite_; // the element's other four nodes

@@ -286,9 +286,8 @@ void Simulation::fe_forces() {
       throw PhysicsError(red[2] != none ? describe_element(static_cast<std::int64_t>(red[2]))
                                         : "the model",
                          clock_.time, "non-finite stress or force");
-    // The controlling element: smallest gid among the ranks that hold the global minimum.
-    dt_element_ = static_cast<std::int64_t>(
-        comm_.min(r.dt_stable == red[0] ? static_cast<double>(r.stable_gid) : none));
+    dt_stable_local_ = r.dt_stable;
+    stable_gid_local_ = r.stable_gid;
     dt_stable_ = red[0];
     corner_exchange_->exchange(
         {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()});
@@ -303,17 +302,26 @@ void Simulation::fe_forces() {
 void Simulation::predict() {
   ScopedPhase t(timers_, Phase::predict);
   double dt = config_.time_step_scale * dt_stable_;
-  if (clock_.cycle > 0 && dt < config_.time_step_minimum_fraction * clock_.dt_initial)
+  if (clock_.cycle > 0 && dt < config_.time_step_minimum_fraction * clock_.dt_initial) {
+    // Every rank takes this branch (dt is global). The controlling element: the smallest
+    // gid among the ranks that hold the global minimum (an element's step, unless a
+    // particle's was smaller).
+    const double none = std::numeric_limits<double>::infinity();
+    const bool mine = clock_.dt_particle < 0 && dt_stable_local_ == dt_stable_;
+    const double gid = comm_.min(mine ? static_cast<double>(stable_gid_local_) : none);
+    const std::int64_t element = gid == none ? -1 : static_cast<std::int64_t>(gid);
     throw PhysicsError(
-        describe_element(dt_element_), clock_.time,
+        clock_.dt_particle >= 0 ? fmt::format("particle {}", clock_.dt_particle + 1)
+                                : describe_element(element),
+        clock_.time,
         fmt::format("the time step collapsed to {:.3e} s, below {} of the initial {:.3e} s "
-                    "(this element controls it)",
+                    "(it controls the step)",
                     dt, config_.time_step_minimum_fraction, clock_.dt_initial));
+  }
   if (std::isfinite(config_.end_time) && clock_.time + dt > config_.end_time)
     dt = std::max(config_.end_time - clock_.time, 0.0);
   clock_.dt = dt;
   if (clock_.cycle == 0) clock_.dt_initial = dt;
-  clock_.dt_element = dt_element_;
   // Central difference with a varying step: the velocity advances over the average of
   // the intervals on either side of t(n).
   const double dt_avg = 0.5 * (clock_.dt_prev + dt);
@@ -391,7 +399,6 @@ void Simulation::sph_forces() {
                        clock_.time, "non-finite stress or force");
   if (red[0] < dt_stable_) {
     dt_stable_ = red[0];
-    dt_element_ = -1;
     clock_.dt_particle = static_cast<std::int64_t>(
         comm_.min(r.dt_stable == red[0] ? static_cast<double>(r.stable_gid) : none));
   }

@@ -40,8 +40,7 @@ struct Clock {
   double dt = 0;                 // dt(n + 1/2) of the last step taken
   double dt_prev = 0;            // dt(n - 1/2), the interval the stress update integrates over
   double dt_initial = 0;         // the first step's dt
-  std::int64_t dt_element = -1;  // element controlling dt
-  std::int64_t dt_particle = -1; // particle controlling dt (then dt_element is -1)
+  std::int64_t dt_particle = -1; // particle controlling dt, or -1 when an element does
 };
 
 // Global energies and probe values at one time (a history row).
@@ -204,7 +203,10 @@ private:
   double dt_stable_ = 0; // from the last fe_forces
   bool stop_local_ = false, stop_ = false;
   std::int64_t eroded_ = 0; // elements this rank has eroded
-  std::int64_t dt_element_ = -1;
+  // This rank's smallest element step and its element: the controlling element is found
+  // from them (one more reduction) only when a message needs it.
+  double dt_stable_local_ = 0;
+  std::int64_t stable_gid_local_ = -1;
   std::int64_t global_nodes_ = 0, global_elements_ = 0;
   std::vector<std::int64_t> block_offsets_;
   std::vector<double> part_mass_;
