@@ -426,11 +426,12 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       // matrix sum_al gamma_al gamma_al^T, m / 8 is this element's share of any of its
       // nodes' mass. Central differences with a lagged damping rate r and a frequency
       // omega are stable while dt^2 omega^2 + 2 dt r < 4, which is the bulk viscosity's
-      // form with r lc / 4 added to its rate term. lambda is first bounded cheaply by
-      // (sqrt 8 + |B| |h|)^2 (exact on a parallelepiped); Gershgorin's sharper bound
-      // (hex8::hourglass_damping_bound) is computed only where the cheap step is not above
-      // its lane's smallest so far, since only there can the element set the step. The
-      // step is the same as with the sharp bound everywhere.
+      // form with r lc / 4 added to its rate term. lambda is the smaller of two bounds:
+      // a cheap one (hex8::hourglass_damping_bound_frobenius, exact on parallelepipeds)
+      // and Gershgorin's (hex8::hourglass_damping_bound), which is formed only where the
+      // step from the cheap bound is not above its lane's smallest so far: elsewhere the
+      // element's step, at least that, cannot be the smallest. The step is therefore
+      // min(cheap, Gershgorin)'s wherever it matters, on any decomposition.
       vdouble dte;
       if (!stiff) {
         const vdouble kr = (0.25 * 8.0) * kv * lc / mass;
@@ -438,15 +439,15 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
         _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
             _Pragma("GCC unroll 12") for (int i = (al == 0 ? 1 : 0); i < 3; ++i) hh +=
             h[al][i] * h[al][i];
-        const vdouble root = 2.8284271247461903 + stdx::sqrt(bb * hh);
-        vdouble qh = qv + kr * root * root;
+        const vdouble cheap = hex8::hourglass_damping_bound_frobenius(bb, hh);
+        vdouble qh = qv + kr * cheap;
         dte = lc / (qh + stdx::sqrt(qh * qh + c * c));
         if (stdx::any_of(dte <= best_dt)) {
           vdouble Bc[3][8];
           _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a)
               _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) Bc[i][a] =
                   Bt(a, i) * (1.0 / 12.0);
-          qh = qv + kr * hex8::hourglass_damping_bound(Bc, h);
+          qh = qv + kr * stdx::min(cheap, hex8::hourglass_damping_bound(Bc, h));
           dte = lc / (qh + stdx::sqrt(qh * qh + c * c));
         }
       } else {
