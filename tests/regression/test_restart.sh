@@ -25,7 +25,11 @@ run 3 "$anvil" run deck.yaml -o stopped -q --restart stopped/checkpoint.anvil
 "$compare" full/checkpoint.anvil stopped/checkpoint.anvil
 
 # A real SIGTERM, mid-run: mpirun passes it to the ranks, which checkpoint and stop.
-run 2 "$anvil" run deck.yaml -o killed -q 2>/dev/null &
+# mpirun itself goes to the background, not the `run` function: a function in the
+# background is a subshell, whose SIGTERM kills only the subshell and leaves mpirun
+# running on, orphaned, writing into killed/ while the restart reads it (and hanging
+# when this script's trap removed the directory under it).
+mpirun --oversubscribe -np 2 "$anvil" run deck.yaml -o killed -q 2>/dev/null &
 pid=$!
 # Wait for the first periodic checkpoint (20% into the run), however loaded the machine:
 # a signal that came before the handlers are installed would kill the run outright.
