@@ -8,6 +8,23 @@
 
 namespace anvil {
 
+namespace {
+
+// The bound of a face's capture box (derived above set_lazy_reference()):
+// its sides move by at most m = delta (1 + A (B + 4 delta)) when no corner has moved more
+// than delta since the reference, with A and B from the reference geometry (len = |D1 x
+// D2|, diag = |D1| + |D2| of the diagonals, depth the face's contact depth). One rank and
+// several ranks, scalar and vector, use these two.
+inline double bound_a(double depth, double len) {
+  return 4 * depth / len + 0.025 / std::sqrt(0.5 * len);
+}
+template <class V>
+inline V side_move(const V& delta, const V& a, const V& b) {
+  return delta * (1 + a * (b + 4 * delta));
+}
+
+} // namespace
+
 ContactPhase::~ContactPhase() = default;
 
 ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const FeDecomposition& fe,
@@ -271,7 +288,7 @@ void ContactPhase::set_bound_geometry() {
   double* a = ref_a_.data();
   double* b = ref_b_.data();
   for (std::size_t f = 0; f < nf; ++f) {
-    a[f] = 4 * depth[f] / len[f] + 0.025 / std::sqrt(0.5 * len[f]);
+    a[f] = bound_a(depth[f], len[f]);
     b[f] = 2 * diag[f];
   }
   point_move_.resize(np);
@@ -404,7 +421,7 @@ void ContactPhase::set_face_reference(std::size_t f) {
     sf_box_[i][f] = cap_.lo[i][f];
     sf_box_[3 + i][f] = cap_.hi[i][f];
   }
-  sf_a_[f] = 4 * my_face_depth_[f] / cap_.len[f] + 0.025 / std::sqrt(0.5 * cap_.len[f]);
+  sf_a_[f] = bound_a(my_face_depth_[f], cap_.len[f]);
   sf_b_[f] = 2 * cap_.diag[f];
   if (!alive(f)) return;
   // The centre moves no more than the corners, at most 0.45 g while the bound holds: only
@@ -449,7 +466,7 @@ bool ContactPhase::shared_bound_holds() {
       where(d2 < s, d2) = s;
     }
     const simd::vdouble delta = sqrt(d2);
-    const simd::vdouble m = delta * (1 + simd::load(A + f) * (simd::load(B + f) + 4 * delta));
+    const simd::vdouble m = side_move(delta, simd::load(A + f), simd::load(B + f));
     const simd::vmask ok = 1.001 * m <= simd::load(budget + f);
     if (all_of(ok)) continue;
     for (int l = 0; l < simd::width; ++l)
@@ -549,7 +566,7 @@ bool ContactPhase::lazy_bound_holds() {
     double d = 0;
     for (int a = 0; a < 4; ++a)
       d = std::max(d, point_move_[static_cast<std::size_t>(corner_[a][f])]);
-    const double m = d * (1 + ref_a_[f] * (ref_b_[f] + 4 * d));
+    const double m = side_move(d, ref_a_[f], ref_b_[f]);
     bad |= static_cast<unsigned>(!(1.001 * m <= ref_face_budget_[f]));
   }
   return bad == 0;
