@@ -248,6 +248,86 @@ inline void keep_where(bool m, double& v, double other) {
   if (!m) v = other;
 }
 
+// The cube root by glibc's algorithm (sysdeps/ieee754/dbl-64/s_cbrt.c, as in glibc 2.36:
+// frexp, a degree-6 polynomial, one rational Newton-Halley step, a factor 2^(e mod 3 / 3),
+// ldexp), written out so that the vector form below gives the same bits lane by lane (the
+// library's own result where the library uses this algorithm; our own in any case, so the
+// bits do not depend on the libm either).
+inline double cbrt(double x) {
+  constexpr double cbrt2 = 1.2599210498948731648, sqr_cbrt2 = 1.5874010519681994748;
+  constexpr double factor[5] = {1.0 / sqr_cbrt2, 1.0 / cbrt2, 1.0, cbrt2, sqr_cbrt2};
+  int xe = 0;
+  const double xm = std::frexp(std::fabs(x), &xe);
+  if (xe == 0 && std::fpclassify(x) <= FP_ZERO) return x + x; // 0, NaN, infinity
+  const double u =
+      0.354895765043919860 +
+      (1.50819193781584896 +
+       (-2.11499494167371287 +
+        (2.44693122563534430 +
+         (-1.83469277483613086 + (0.784932344976639262 - 0.145263899385486377 * xm) * xm) * xm) *
+            xm) *
+           xm) *
+          xm;
+  const double t2 = u * u * u;
+  const double ym = u * (t2 + 2.0 * xm) / (2.0 * t2 + xm) * factor[2 + xe % 3];
+  return std::ldexp(x > 0.0 ? ym : -ym, xe / 3);
+}
+
+// cbrt(x) lane by lane, the same bits as the scalar cbrt above. With AVX2 the lanes go
+// together when all are positive, normal and finite (frexp and ldexp by exponent
+// arithmetic, exact as in the library); otherwise lane by lane.
+inline vdouble cbrt(const vdouble& x) {
+#if defined(__AVX2__)
+  if constexpr (width == 4) {
+    const __m256d v = static_cast<__m256d>(x);
+    const __m256d lo = _mm256_set1_pd(0x1p-1022), hi = _mm256_set1_pd(0x1.fffffffffffffp+1023);
+    const __m256d ok =
+        _mm256_and_pd(_mm256_cmp_pd(v, lo, _CMP_GE_OQ), _mm256_cmp_pd(v, hi, _CMP_LE_OQ));
+    if (_mm256_movemask_pd(ok) == 15) {
+      // frexp: x = xm 2^xe, xm in [0.5, 1).
+      const __m256i bits = _mm256_castpd_si256(v);
+      const __m256d xm = _mm256_castsi256_pd(
+          _mm256_or_si256(_mm256_and_si256(bits, _mm256_set1_epi64x(0x000fffffffffffffLL)),
+                          _mm256_set1_epi64x(0x3fe0000000000000LL)));
+      // The exponents (the upper 32 bits of each lane), as doubles: xe / 3 rounded is never
+      // within 1/3 of the next integer unless exact, so its truncation is C's xe / 3.
+      const __m128i e32 =
+          _mm_sub_epi32(_mm_srli_epi32(_mm256_castsi256_si128(_mm256_permutevar8x32_epi32(
+                                           bits, _mm256_setr_epi32(1, 3, 5, 7, 0, 0, 0, 0))),
+                                       20),
+                        _mm_set1_epi32(1022));
+      const __m256d xe = _mm256_cvtepi32_pd(e32);
+      const __m256d q = _mm256_round_pd(_mm256_div_pd(xe, _mm256_set1_pd(3.0)),
+                                        _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC);
+      const vdouble rem(_mm256_sub_pd(xe, _mm256_mul_pd(q, _mm256_set1_pd(3.0)))); // xe % 3
+      const vdouble m(xm);
+      const vdouble u =
+          0.354895765043919860 +
+          (1.50819193781584896 +
+           (-2.11499494167371287 +
+            (2.44693122563534430 +
+             (-1.83469277483613086 + (0.784932344976639262 - 0.145263899385486377 * m) * m) * m) *
+                m) *
+               m) *
+              m;
+      const vdouble t2 = u * u * u;
+      constexpr double cbrt2 = 1.2599210498948731648, sqr_cbrt2 = 1.5874010519681994748;
+      vdouble f = 1.0;
+      stdx::where(rem == -2.0, f) = 1.0 / sqr_cbrt2;
+      stdx::where(rem == -1.0, f) = 1.0 / cbrt2;
+      stdx::where(rem == 1.0, f) = cbrt2;
+      stdx::where(rem == 2.0, f) = sqr_cbrt2;
+      const vdouble ym = u * (t2 + 2.0 * m) / (2.0 * t2 + m) * f;
+      // ldexp(ym, q): times 2^q, exact (ym and the result are normal).
+      const __m256i scale = _mm256_slli_epi64(
+          _mm256_cvtepi32_epi64(_mm_add_epi32(_mm256_cvttpd_epi32(q), _mm_set1_epi32(1023))), 52);
+      return ym * vdouble(_mm256_castsi256_pd(scale));
+    }
+  }
+#endif
+  return vdouble([&](auto l) { return cbrt(static_cast<double>(x[l])); });
+}
+
 } // namespace anvil::simd
 
 namespace anvil::simd {
