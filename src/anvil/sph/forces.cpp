@@ -15,13 +15,6 @@ namespace stdx = simd::stdx;
 
 namespace {
 
-// The lanes' sum in lane order (a fixed order: the bits do not depend on the partition).
-inline double lane_sum(const vdouble& v) {
-  double s = v[0];
-  for (int l = 1; l < width; ++l) s += v[l];
-  return s;
-}
-
 // kernel_fast for `width` pairs at once (the same operations per lane).
 template <KernelType K, int D>
 [[gnu::always_inline]] inline void kernel_simd(const vdouble& r, const vdouble& h, vdouble& w,
@@ -218,7 +211,8 @@ inline vdouble artificial_factor(const vdouble& wk, const vdouble& hb, const Set
 // Pass 1's pair loop for one kernel (the kernel is a template parameter so that the
 // loop has no per-pair branch on it), over the half lists in ascending gid (forces.hpp):
 // each pair's kernel once, for both particles.
-template <KernelType K, int D>
+// Corr: some set normalises its gradient (the B sums are kept).
+template <KernelType K, int D, bool Corr>
 void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double dt,
                       SphWorkspace& w) {
   const std::size_t n = p.n_local;
@@ -226,11 +220,16 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
   const double* rdp = rd->x;
   constexpr int stride = sizeof(NeighbourRead1) / sizeof(double);
   const NeighbourList& nl = w.nl;
-  bool keep_w = false, any_summation = false, any_corrected = false;
+  // The arrays' addresses in locals (the partners' sums are stored through double
+  // pointers, which could alias the vectors' own).
+  const int* index = nl.index.data();
+  double* dwr_k = w.dwr.data();
+  double* wk_k = w.wk.data();
+  LowerSums1* low1 = w.low1.data();
+  bool keep_w = false, any_summation = false;
   for (const auto& st : sets) {
     keep_w = keep_w || st.epsilon > 0; // pass 2 needs W for the artificial stress
     any_summation = any_summation || st.summation;
-    any_corrected = any_corrected || st.corrected;
   }
   using S1 = LowerSums1;
   for (std::size_t r = 0; r < nl.row.size(); ++r) {
@@ -243,7 +242,7 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
     // the row, whose padding entries (i itself) add their partner terms to them. A
     // padding entry has zero distance, so zero gradient and no contribution to i's own
     // gradient sums (the summation density masks them).
-    const S1 lower = w.low1[i];
+    const S1 lower = low1[i];
     vdouble Lv[3][3], Bv[3][3], sum_mw = 0.0;
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) Lv[a][b] = Bv[a][b] = 0.0;
@@ -251,7 +250,7 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
     const vdouble mi = p.mass[i], vol_i = pi.volume;
     const std::int64_t k_begin = nl.start[r], k_end = k_begin + nl.len[r];
     for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
-      const int* idx = nl.index.data() + k0;
+      const int* idx = index + k0;
       vdouble q0[4], q1[4];
       simd::gather4(rdp, stride, idx, q0);     // x, h
       simd::gather4(rdp + 4, stride, idx, q1); // v, volume
@@ -261,8 +260,8 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
       vdouble wk, dwr;
       pair_kernel<K, D>(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2], hb, wk, dwr);
       const vdouble g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
-      simd::store(dwr, w.dwr.data() + k0);
-      if (keep_w) simd::store(wk, w.wk.data() + k0);
+      simd::store(dwr, dwr_k + k0);
+      if (keep_w) simd::store(wk, wk_k + k0);
       // Volume weights V_j = m_j / rho_j: consistent across density jumps (a gas
       // interface, particles of different sets). Particle j's terms are i's with V_i for
       // V_j (grad_j W_ji = -grad_i W_ij and v_i - v_j change sign together).
@@ -277,22 +276,23 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
         for (int b = 0; b < 3; ++b) Lv[a][b] += dv[a] * g[b];
       if (si.summation)
         sum_mw += valid_lanes(k0, k_end) * vdouble([&](auto l) { return p.mass[idx[l]]; }) * wk;
-      if (si.corrected)
+      if (Corr && si.corrected)
         for (int a = 0; a < 3; ++a)
           for (int b = 0; b < 3; ++b) Bv[a][b] -= (vj * dx[a]) * g[b];
       const vdouble mw = any_summation ? mi * wk : vdouble(0.0);
       double* q[width];
-      for (int l = 0; l < width; ++l) q[l] = w.low1[static_cast<std::size_t>(idx[l])].a;
+      for (int l = 0; l < width; ++l) q[l] = low1[static_cast<std::size_t>(idx[l])].a;
       const vdouble s0[4] = {dvj[0] * g[0], dvj[0] * g[1], dvj[0] * g[2], dvj[1] * g[0]};
       const vdouble s1[4] = {dvj[1] * g[1], dvj[1] * g[2], dvj[2] * g[0], dvj[2] * g[1]};
       const vdouble xj[3] = {vol_i * dx[0], vol_i * dx[1], vol_i * dx[2]};
-      const vdouble s2[4] = {dvj[2] * g[2], mw, xj[0] * g[0], xj[0] * g[1]};
+      const vdouble s2[4] = {dvj[2] * g[2], mw, Corr ? xj[0] * g[0] : vdouble(0.0),
+                             Corr ? xj[0] * g[1] : vdouble(0.0)};
       simd::scatter_add4(q, s0);
       for (auto& ql : q) ql += 4;
       simd::scatter_add4(q, s1);
       for (auto& ql : q) ql += 4;
       simd::scatter_add4(q, s2);
-      if (any_corrected) {
+      if constexpr (Corr) {
         const vdouble s3[4] = {xj[0] * g[2], xj[1] * g[0], xj[1] * g[1], xj[1] * g[2]};
         const vdouble s4[4] = {xj[2] * g[0], xj[2] * g[1], xj[2] * g[2], 0.0};
         for (auto& ql : q) ql += 4;
@@ -302,13 +302,23 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
       }
     }
     if (i >= n) continue; // a ghost's row: its partners' terms only
+    // The lanes' sums, four vectors at a time: L's nine and sum m W, then B's nine.
+    double ls[12], bs[12];
+    simd::lane_sums4({Lv[0][0], Lv[0][1], Lv[0][2], Lv[1][0]}, ls);
+    simd::lane_sums4({Lv[1][1], Lv[1][2], Lv[2][0], Lv[2][1]}, ls + 4);
+    simd::lane_sums4({Lv[2][2], sum_mw, 0.0, 0.0}, ls + 8);
+    if (Corr && si.corrected) {
+      simd::lane_sums4({Bv[0][0], Bv[0][1], Bv[0][2], Bv[1][0]}, bs);
+      simd::lane_sums4({Bv[1][1], Bv[1][2], Bv[2][0], Bv[2][1]}, bs + 4);
+      simd::lane_sums4({Bv[2][2], 0.0, 0.0, 0.0}, bs + 8);
+    }
     double L[3][3], B[3][3];
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) {
-        L[a][b] = lower.a[S1::L + 3 * a + b] + lane_sum(Lv[a][b]);
-        B[a][b] = si.corrected ? lane_sum(Bv[a][b]) - lower.a[S1::B + 3 * a + b] : 0.0;
+        L[a][b] = lower.a[S1::L + 3 * a + b] + ls[3 * a + b];
+        B[a][b] = Corr && si.corrected ? bs[3 * a + b] - lower.a[S1::B + 3 * a + b] : 0.0;
       }
-    if (si.corrected) {
+    if (Corr && si.corrected) {
       // Normalised gradient L B^-1, B = sum V_j (x_j - x_i) (x) grad W: exact for a
       // linear velocity field also near free surfaces. A particle with too few
       // neighbours (B nearly singular) keeps the plain gradient. Below 3 dimensions B
@@ -338,7 +348,7 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
     // integrated rate drifts from it, and the pressure with it; docs/sph.md, Sod).
     const double tr = (d[0] + d[1] + d[2]) * dt;
     if (si.summation) {
-      p.rho[i] = (lower.a[S1::mw] + lane_sum(sum_mw)) + p.mass[i] * self_weight<K, D>(pi.h);
+      p.rho[i] = (lower.a[S1::mw] + ls[9]) + p.mass[i] * self_weight<K, D>(pi.h);
     } else {
       p.rho[i] = p.rho[i] * (1 - 0.5 * tr) / (1 + 0.5 * tr);
     }
@@ -387,18 +397,25 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
   for (const auto& st : sets) any_epsilon = any_epsilon || st.epsilon > 0;
   if (any_epsilon) w.wk.resize(w.dwr.size());
   const int dim = sets.empty() ? 3 : sets[0].dimensions;
-  if (kernel == KernelType::cubic_spline) {
-    if (dim == 1)
-      kinematics_pairs<KernelType::cubic_spline, 1>(p, sets, dt, w);
-    else if (dim == 2)
-      kinematics_pairs<KernelType::cubic_spline, 2>(p, sets, dt, w);
+  auto run = [&]<KernelType K, int D>() {
+    if (any_corrected)
+      kinematics_pairs<K, D, true>(p, sets, dt, w);
     else
-      kinematics_pairs<KernelType::cubic_spline, 3>(p, sets, dt, w);
+      kinematics_pairs<K, D, false>(p, sets, dt, w);
+  };
+  using enum KernelType;
+  if (kernel == cubic_spline) {
+    if (dim == 1)
+      run.template operator()<cubic_spline, 1>();
+    else if (dim == 2)
+      run.template operator()<cubic_spline, 2>();
+    else
+      run.template operator()<cubic_spline, 3>();
   } else {
     if (dim == 2)
-      kinematics_pairs<KernelType::wendland_c2, 2>(p, sets, dt, w);
+      run.template operator()<wendland_c2, 2>();
     else
-      kinematics_pairs<KernelType::wendland_c2, 3>(p, sets, dt, w);
+      run.template operator()<wendland_c2, 3>();
   }
 
   // Constitutive update through the batch interface, one run of a set's particles at a
@@ -467,6 +484,12 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
   const R2* rd = w.read2.data();
   const double* rdp = rd->a;
   constexpr int stride = sizeof(R2) / sizeof(double);
+  // The arrays' addresses in locals: the partners' sums are stored through double
+  // pointers, which could otherwise alias the vectors' own pointers (reloaded every time).
+  const int* index = nl.index.data();
+  const double* dwr_k = w.dwr.data();
+  const double* wk_k = w.wk.data();
+  LowerSums2* low2 = w.low2.data();
   const bool same_visc = uniform(sets, [](const SetParams& st) {
     return std::array<double, 2>{st.alpha, st.beta};
   });
@@ -483,19 +506,20 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
     // lower sums (see pass 1). Entries past the row's end (i itself) have zero gradients
     // and no approach: they add nothing to i's sums (their partner terms go to i's lower
     // sums, already read).
-    const LowerSums2 lower = w.low2[i];
+    const LowerSums2 lower = low2[i];
     const double mu_lower = lower.mu;
     const vdouble mi = pi[R2::mass];
-    vdouble accv[3] = {0.0, 0.0, 0.0}, dev = 0.0, mumv = 0.0;
+    vdouble accv[4] = {0.0, 0.0, 0.0, 0.0}, mumv = 0.0; // force sums, energy rate
     const std::int64_t k_begin = nl.start[r], k_end = k_begin + nl.len[r];
     for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
-      const int* idx = nl.index.data() + k0;
-      // The neighbours' records group by group, each loaded where it is first used (fewer
-      // values live at once).
-      vdouble qx[4], qv[4], qr[4], qs[4], qt[4], qu[4] = {0.0, 0.0, 0.0, 0.0};
+      const int* idx = index + k0;
+      // In two stages, so that fewer values are live at once: first what the kinematics
+      // of the pair give (gradient, viscosity, the energy rate's dv . g), from the groups
+      // x, h; v, c; S4, S5, rho, m; then the stress groups and the pair's T.
+      vdouble qx[4], qv[4], qr[4];
       simd::gather4(rdp + R2::x, stride, idx, qx);   // x, h
       simd::gather4(rdp + R2::v, stride, idx, qv);   // v, c
-      simd::gather4(rdp + R2::rho, stride, idx, qr); // rho, 1/rho, m, has_r
+      simd::gather4(rdp + R2::S45, stride, idx, qr); // S4, S5, rho, m
       vdouble dx[3], dv[3];
       for (int a = 0; a < 3; ++a) {
         dx[a] = pi[R2::x + a] - qx[a];
@@ -503,10 +527,10 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
       }
       const vdouble hb = 0.5 * (pi[R2::h] + qx[3]);
       const vdouble r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
-      const vdouble dwr = simd::load(w.dwr.data() + k0);
+      const vdouble dwr = simd::load(dwr_k + k0);
       const vdouble g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
-      const vdouble fn = any_epsilon ? artificial_factor<K, D>(simd::load(w.wk.data() + k0), hb, si,
-                                                               sets, p.set, idx, same_as)
+      const vdouble fn = any_epsilon ? artificial_factor<K, D>(simd::load(wk_k + k0), hb, si, sets,
+                                                               p.set, idx, same_as)
                                      : vdouble(0.0);
       const vdouble vr = dv[0] * dx[0] + dv[1] * dx[1] + dv[2] * dx[2];
       vdouble visc = 0.0;
@@ -516,76 +540,80 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
         const vdouble cb = 0.5 * (pi[R2::c] + qv[3]);
         vdouble qa[4];
         if (same_visc) {
-          qa[0] = pi[R2::alpha];
-          qa[1] = pi[R2::beta];
+          qa[2] = pi[R2::alpha];
+          qa[3] = pi[R2::beta];
         } else {
-          simd::gather4(rdp + R2::alpha, stride, idx, qa);
+          simd::gather4(rdp + R2::R45, stride, idx, qa); // R4, R5, alpha, beta
         }
         // Pi_ij = (-alpha c mu + beta mu^2) / rho_ij with rho_ij = (rho_i + rho_j) / 2.
-        const vdouble pv = (-(pi[R2::alpha] + qa[0]) * cb * mu + (pi[R2::beta] + qa[1]) * mu * mu) /
-                           (pi[R2::rho] + qr[0]);
+        const vdouble pv = (-(pi[R2::alpha] + qa[2]) * cb * mu + (pi[R2::beta] + qa[3]) * mu * mu) /
+                           (pi[R2::rho] + qr[2]);
         stdx::where(approaching, visc) = pv;
         // The largest approach of the pair for both particles' stable steps.
         vdouble muj = 0.0;
         stdx::where(approaching, muj) = -mu;
         mumv = stdx::max(mumv, muj);
         double* qm[width];
-        for (int l = 0; l < width; ++l) qm[l] = &w.low2[static_cast<std::size_t>(idx[l])].mu;
+        for (int l = 0; l < width; ++l) qm[l] = &low2[static_cast<std::size_t>(idx[l])].mu;
         simd::scatter_max(qm, muj);
       }
+      // Half the viscous dissipation of the pair heats each particle.
+      const vdouble dvg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
+      const vdouble half_visc = 0.5 * visc * dvg;
+      vdouble qs[4], qu[4] = {0.0, 0.0, 0.0, 0.0};
       simd::gather4(rdp + R2::S, stride, idx, qs);                      // S0..S3
-      simd::gather4(rdp + R2::S + 4, stride, idx, qt);                  // S4..S7
-      if constexpr (Corr) simd::gather4(rdp + R2::S8, stride, idx, qu); // S8, R4, R5
-      const vdouble irr = pi[R2::inv_rho] * qr[1];
+      if constexpr (Corr) simd::gather4(rdp + R2::S6, stride, idx, qu); // S6..S8, has_r
+      const vdouble irr = pi[R2::inv_rho] * (1.0 / qr[2]);
       // T = (P_i + P_j + f^n (R_i + R_j)) / (rho_i rho_j) - Pi I; T[6..8] (yx zy zx)
       // differ from T[3..5] only where a gradient is normalised (Corr).
       constexpr int nt = Corr ? 9 : 6;
-      const vdouble Sj[9] = {qs[0], qs[1], qs[2], qs[3], qt[0], qt[1], qt[2], qt[3], qu[0]};
+      const vdouble Sj[9] = {qs[0], qs[1], qs[2], qs[3], qr[0], qr[1], qu[0], qu[1], qu[2]};
       vdouble T[nt];
-      for (int c = 0; c < nt; ++c) T[c] = (pi[R2::S + c] + Sj[c]) * irr;
+      for (int c = 0; c < nt; ++c) T[c] = (pi[c < 6 ? R2::S + c : R2::S6 + c - 6] + Sj[c]) * irr;
       vdouble rg = 0.0, rgj = 0.0;
-      if (stdx::any_of(fn > 0.0) && (pi[R2::has_r] != 0.0 || stdx::any_of(qr[3] > 0.0))) {
-        vdouble qR[4];
-        simd::gather4(rdp + R2::R, stride, idx, qR);
-        if constexpr (!Corr) simd::gather4(rdp + R2::S8, stride, idx, qu);
-        const vdouble Rj[6] = {qR[0], qR[1], qR[2], qR[3], qu[1], qu[2]};
-        const double Ri[6] = {pi[R2::R],     pi[R2::R + 1], pi[R2::R + 2],
-                              pi[R2::R + 3], pi[R2::R45],   pi[R2::R45 + 1]};
-        const vdouble fi = fn * irr;
-        for (int c = 0; c < 6; ++c) T[c] += fi * (Ri[c] + Rj[c]);
-        if constexpr (Corr)
-          for (int c = 6; c < 9; ++c) T[c] += fi * (Ri[c - 3] + Rj[c - 3]);
-        // The artificial stress's own work on particle i (the stress's is in pass 1).
-        rg = fi * (dv[0] * (Ri[0] * g[0] + Ri[3] * g[1] + Ri[5] * g[2]) +
-                   dv[1] * (Ri[3] * g[0] + Ri[1] * g[1] + Ri[4] * g[2]) +
-                   dv[2] * (Ri[5] * g[0] + Ri[4] * g[1] + Ri[2] * g[2]));
-        // And on particle j (v_ji and grad_j W_ji reverse together).
-        rgj = fi * (dv[0] * (Rj[0] * g[0] + Rj[3] * g[1] + Rj[5] * g[2]) +
-                    dv[1] * (Rj[3] * g[0] + Rj[1] * g[1] + Rj[4] * g[2]) +
-                    dv[2] * (Rj[5] * g[0] + Rj[4] * g[1] + Rj[2] * g[2]));
+      if (stdx::any_of(fn > 0.0)) {
+        if constexpr (!Corr) simd::gather4(rdp + R2::S6, stride, idx, qu); // has_r
+        if (pi[R2::has_r] != 0.0 || stdx::any_of(qu[3] > 0.0)) {
+          vdouble qR[4], qR45[4];
+          simd::gather4(rdp + R2::R, stride, idx, qR);
+          simd::gather4(rdp + R2::R45, stride, idx, qR45);
+          const vdouble Rj[6] = {qR[0], qR[1], qR[2], qR[3], qR45[0], qR45[1]};
+          const double Ri[6] = {pi[R2::R],     pi[R2::R + 1], pi[R2::R + 2],
+                                pi[R2::R + 3], pi[R2::R45],   pi[R2::R45 + 1]};
+          const vdouble fi = fn * irr;
+          for (int c = 0; c < 6; ++c) T[c] += fi * (Ri[c] + Rj[c]);
+          if constexpr (Corr)
+            for (int c = 6; c < 9; ++c) T[c] += fi * (Ri[c - 3] + Rj[c - 3]);
+          // The artificial stress's own work on particle i (the stress's is in pass 1).
+          rg = fi * (dv[0] * (Ri[0] * g[0] + Ri[3] * g[1] + Ri[5] * g[2]) +
+                     dv[1] * (Ri[3] * g[0] + Ri[1] * g[1] + Ri[4] * g[2]) +
+                     dv[2] * (Ri[5] * g[0] + Ri[4] * g[1] + Ri[2] * g[2]));
+          // And on particle j (v_ji and grad_j W_ji reverse together).
+          rgj = fi * (dv[0] * (Rj[0] * g[0] + Rj[3] * g[1] + Rj[5] * g[2]) +
+                      dv[1] * (Rj[3] * g[0] + Rj[1] * g[1] + Rj[4] * g[2]) +
+                      dv[2] * (Rj[5] * g[0] + Rj[4] * g[1] + Rj[2] * g[2]));
+        }
       }
       T[0] -= visc;
       T[1] -= visc;
       T[2] -= visc;
-      const vdouble mj = qr[2];
+      const vdouble mj = qr[3];
       const int yx = Corr ? 6 : 3, zy = Corr ? 7 : 4, zx = Corr ? 8 : 5;
       const vdouble tg[3] = {T[0] * g[0] + T[3] * g[1] + T[5] * g[2],
                              T[yx] * g[0] + T[1] * g[1] + T[4] * g[2],
                              T[zx] * g[0] + T[zy] * g[1] + T[2] * g[2]};
       for (int a = 0; a < 3; ++a) accv[a] += mj * tg[a];
-      // Half the viscous dissipation of the pair heats each particle.
-      const vdouble dvg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
-      const vdouble half_visc = 0.5 * visc * dvg;
-      dev += mj * (half_visc - rg);
+      accv[3] += mj * (half_visc - rg);
       // Particle j's terms: the same T with grad_j W_ji = -g (its force sum is reversed).
       const vdouble sj[4] = {mi * tg[0], mi * tg[1], mi * tg[2], mi * (half_visc - rgj)};
       double* q[width]; // the partners' lower sums
-      for (int l = 0; l < width; ++l) q[l] = w.low2[static_cast<std::size_t>(idx[l])].f;
+      for (int l = 0; l < width; ++l) q[l] = low2[static_cast<std::size_t>(idx[l])].f;
       simd::scatter_add4(q, sj);
     }
-    const double acc[3] = {lane_sum(accv[0]) - lower.f[0], lane_sum(accv[1]) - lower.f[1],
-                           lane_sum(accv[2]) - lower.f[2]};
-    const double de = lower.e + lane_sum(dev);
+    double sums[4];
+    simd::lane_sums4(accv, sums);
+    const double acc[3] = {sums[0] - lower.f[0], sums[1] - lower.f[1], sums[2] - lower.f[2]};
+    const double de = lower.e + sums[3];
     if (i >= n) continue; // a ghost's row: its partners' terms only
     double mu_max = mu_lower;
     for (int l = 0; l < width; ++l) mu_max = std::max(mu_max, static_cast<double>(mumv[l]));
@@ -625,8 +653,8 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
     r[R2::rho] = p.rho[i];
     r[R2::inv_rho] = 1 / p.rho[i];
     r[R2::mass] = p.mass[i];
-    for (int c = 0; c < 8; ++c) r[R2::S + c] = p.S[c][i];
-    r[R2::S8] = p.S[8][i];
+    for (int c = 0; c < 6; ++c) r[R2::S + c] = p.S[c][i];
+    for (int c = 6; c < 9; ++c) r[R2::S6 + c - 6] = p.S[c][i];
     int any = 0;
     for (int c = 0; c < 6; ++c) any |= p.R[c][i] != 0.0;
     for (int c = 0; c < 4; ++c) r[R2::R + c] = p.R[c][i];
@@ -635,7 +663,7 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
     r[R2::has_r] = any ? 1.0 : 0.0;
     r[R2::alpha] = si.alpha;
     r[R2::beta] = si.beta;
-    r[R2::S8 + 3] = r[R2::beta + 1] = r[R2::beta + 2] = 0; // unused
+    r[R2::inv_rho + 1] = r[R2::inv_rho + 2] = r[R2::inv_rho + 3] = 0; // unused
   }
   bool any_corrected = false;
   for (const auto& st : sets) any_corrected = any_corrected || st.corrected;

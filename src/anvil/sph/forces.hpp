@@ -112,12 +112,15 @@ struct alignas(64) NeighbourRead1 {
   double x[3], h;
   double v[3], volume; // m / rho
 };
-// Pass 2's record, by offsets (groups of four): the common path reads the first five
-// groups, a normalised gradient the sixth, the artificial stress the sixth and seventh,
-// sets of different viscosity the eighth.
+// Pass 2's record, by offsets (groups of four): the common path reads the first four
+// groups (x, h; v, c; S0-S3; S4, S5, rho, m: every value a pair needs without a
+// normalised gradient or an artificial stress; a neighbour's 1/rho is divided in the
+// loop, the same bits as the row particle's inv_rho), a normalised gradient the fifth
+// (S6-S8), the artificial stress the fifth (has_r), sixth and seventh, sets of
+// different viscosity the seventh (alpha, beta).
 struct alignas(64) NeighbourRead2 {
-  static constexpr int x = 0, h = 3, v = 4, c = 7, rho = 8, inv_rho = 9, mass = 10, has_r = 11,
-                       S = 12, S8 = 20, R45 = 21, R = 24, alpha = 28, beta = 29;
+  static constexpr int x = 0, h = 3, v = 4, c = 7, S = 8, S45 = 12, rho = 14, mass = 15, S6 = 16,
+                       has_r = 19, R = 20, R45 = 24, alpha = 26, beta = 27, inv_rho = 28;
   double a[32];
 };
 
