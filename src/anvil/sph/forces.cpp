@@ -509,6 +509,16 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
     const LowerSums2 lower = low2[i];
     const double mu_lower = lower.mu;
     const vdouble mi = pi[R2::mass];
+    // The row particle's values that the loop reads, as vectors in memory: operands of the
+    // arithmetic there instead of broadcasts again in every iteration (GCC has no
+    // registers to keep them in; the empty asm makes the array's address escape, so that
+    // it stays in memory).
+    alignas(32) vdouble pb[R2::inv_rho + 1];
+    for (int k = R2::x; k <= R2::rho; ++k) pb[k] = pi[k];
+    if constexpr (Corr)
+      for (int k = R2::S6; k < R2::S6 + 3; ++k) pb[k] = pi[k];
+    for (int k = R2::alpha; k <= R2::inv_rho; ++k) pb[k] = pi[k];
+    asm volatile("" : : "r"(pb) : "memory");
     vdouble accv[4] = {0.0, 0.0, 0.0, 0.0}, mumv = 0.0; // force sums, energy rate
     const std::int64_t k_begin = nl.start[r], k_end = k_begin + nl.len[r];
     for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
@@ -522,10 +532,10 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
       simd::gather4(rdp + R2::S45, stride, idx, qr); // S4, S5, rho, m
       vdouble dx[3], dv[3];
       for (int a = 0; a < 3; ++a) {
-        dx[a] = pi[R2::x + a] - qx[a];
-        dv[a] = pi[R2::v + a] - qv[a];
+        dx[a] = pb[R2::x + a] - qx[a];
+        dv[a] = pb[R2::v + a] - qv[a];
       }
-      const vdouble hb = 0.5 * (pi[R2::h] + qx[3]);
+      const vdouble hb = 0.5 * (pb[R2::h] + qx[3]);
       const vdouble r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
       const vdouble dwr = simd::load(dwr_k + k0);
       const vdouble g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
@@ -537,17 +547,17 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
       const auto approaching = vr < 0.0;
       if (stdx::any_of(approaching)) {
         const vdouble mu = hb * vr / (r2 + 0.01 * hb * hb);
-        const vdouble cb = 0.5 * (pi[R2::c] + qv[3]);
+        const vdouble cb = 0.5 * (pb[R2::c] + qv[3]);
         vdouble qa[4];
         if (same_visc) {
-          qa[2] = pi[R2::alpha];
-          qa[3] = pi[R2::beta];
+          qa[2] = pb[R2::alpha];
+          qa[3] = pb[R2::beta];
         } else {
           simd::gather4(rdp + R2::R45, stride, idx, qa); // R4, R5, alpha, beta
         }
         // Pi_ij = (-alpha c mu + beta mu^2) / rho_ij with rho_ij = (rho_i + rho_j) / 2.
-        const vdouble pv = (-(pi[R2::alpha] + qa[2]) * cb * mu + (pi[R2::beta] + qa[3]) * mu * mu) /
-                           (pi[R2::rho] + qr[2]);
+        const vdouble pv = (-(pb[R2::alpha] + qa[2]) * cb * mu + (pb[R2::beta] + qa[3]) * mu * mu) /
+                           (pb[R2::rho] + qr[2]);
         stdx::where(approaching, visc) = pv;
         // The largest approach of the pair for both particles' stable steps.
         vdouble muj = 0.0;
@@ -563,13 +573,13 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
       vdouble qs[4], qu[4] = {0.0, 0.0, 0.0, 0.0};
       simd::gather4(rdp + R2::S, stride, idx, qs);                      // S0..S3
       if constexpr (Corr) simd::gather4(rdp + R2::S6, stride, idx, qu); // S6..S8, has_r
-      const vdouble irr = pi[R2::inv_rho] * (1.0 / qr[2]);
+      const vdouble irr = pb[R2::inv_rho] * (1.0 / qr[2]);
       // T = (P_i + P_j + f^n (R_i + R_j)) / (rho_i rho_j) - Pi I; T[6..8] (yx zy zx)
       // differ from T[3..5] only where a gradient is normalised (Corr).
       constexpr int nt = Corr ? 9 : 6;
       const vdouble Sj[9] = {qs[0], qs[1], qs[2], qs[3], qr[0], qr[1], qu[0], qu[1], qu[2]};
       vdouble T[nt];
-      for (int c = 0; c < nt; ++c) T[c] = (pi[c < 6 ? R2::S + c : R2::S6 + c - 6] + Sj[c]) * irr;
+      for (int c = 0; c < nt; ++c) T[c] = (pb[c < 6 ? R2::S + c : R2::S6 + c - 6] + Sj[c]) * irr;
       vdouble rg = 0.0, rgj = 0.0;
       if (stdx::any_of(fn > 0.0)) {
         if constexpr (!Corr) simd::gather4(rdp + R2::S6, stride, idx, qu); // has_r
