@@ -28,17 +28,8 @@ std::uint64_t bits(double x) {
   return b;
 }
 
-// Equal bits to std::cbrt are expected where the libm is glibc up to 2.36 (the algorithm's
-// source, checked there); elsewhere one ulp.
-#if defined(__GLIBC__) && __GLIBC__ == 2 && __GLIBC_MINOR__ <= 36
-constexpr bool same_as_libm = true;
-#else
-constexpr bool same_as_libm = false;
-#endif
-
 // Checks the vector form against the scalar form on xs (taken `width` at a time) and the
-// scalar form against std::cbrt; returns how many differed from std::cbrt in the last bit
-// (0 where same_as_libm).
+// scalar form against std::cbrt; returns how many differed from std::cbrt in the last bit.
 int check(const std::vector<double>& xs) {
   int off_by_one = 0;
   for (std::size_t k = 0; k + width <= xs.size(); k += width) {
@@ -57,7 +48,7 @@ int check(const std::vector<double>& xs) {
       off_by_one += d != 0;
     }
   }
-  return same_as_libm ? off_by_one : 0;
+  return off_by_one;
 }
 
 TEST(SphSmoothingLength, CubeRootNearOne) {
