@@ -43,25 +43,6 @@ inline double self_weight(double h) {
 
 } // namespace
 
-void smoothing_lengths(std::span<const SetParams> sets, const int* set, const double* rho,
-                       double* h, std::size_t n) {
-  std::size_t i = 0;
-  for (; i + width <= n; i += width) {
-    bool all3 = true;
-    for (int l = 0; l < width; ++l)
-      all3 = all3 && sets[static_cast<std::size_t>(set[i + l])].dimensions == 3;
-    if (!all3) {
-      for (int l = 0; l < width; ++l)
-        h[i + l] = smoothing_length(sets[static_cast<std::size_t>(set[i + l])], rho[i + l]);
-      continue;
-    }
-    const vdouble rho0([&](auto l) { return sets[static_cast<std::size_t>(set[i + l])].rho0; });
-    const vdouble h0([&](auto l) { return sets[static_cast<std::size_t>(set[i + l])].h0; });
-    simd::store(h0 * simd::cbrt(rho0 / simd::load(rho + i)), h + i);
-  }
-  for (; i < n; ++i) h[i] = smoothing_length(sets[static_cast<std::size_t>(set[i])], rho[i]);
-}
-
 void principal(const double s[6], double lambda[3], double Q[3][3]) {
   double A[3][3] = {{s[0], s[3], s[5]}, {s[3], s[1], s[4]}, {s[5], s[4], s[2]}};
   for (int i = 0; i < 3; ++i)

@@ -41,7 +41,6 @@
 #include <span>
 #include <vector>
 
-#include "anvil/core/simd.hpp"
 #include "anvil/material/material.hpp"
 #include "anvil/sph/kernel.hpp"
 #include "anvil/sph/neighbours.hpp"
@@ -165,18 +164,11 @@ void sph_kinematics(const SphView& v, std::span<const SetParams> sets, KernelTyp
 void sph_forces(const SphView& v, std::span<const SetParams> sets, KernelType kernel,
                 SphWorkspace& work, SphResult& result);
 
-// Smoothing length at density rho: h0 (rho0 / rho)^(1/d) (constant mass in the support;
-// the cube root is simd::cbrt, glibc's algorithm, so that smoothing_lengths() can take
-// four at a time with the same bits).
+// Smoothing length at density rho: h0 (rho0 / rho)^(1/d) (constant mass in the support).
 inline double smoothing_length(const SetParams& s, double rho) {
   const double r = s.rho0 / rho;
-  return s.h0 * (s.dimensions == 3 ? simd::cbrt(r) : (s.dimensions == 2 ? std::sqrt(r) : r));
+  return s.h0 * (s.dimensions == 3 ? std::cbrt(r) : (s.dimensions == 2 ? std::sqrt(r) : r));
 }
-
-// h[i] = smoothing_length(sets[set[i]], rho[i]) for i < n, simd::width particles at a
-// time where all of them are 3-D (the same bits as the scalar form).
-void smoothing_lengths(std::span<const SetParams> sets, const int* set, const double* rho,
-                       double* h, std::size_t n);
 
 // Principal values and axes of a symmetric tensor (xx yy zz xy yz xz) by cyclic Jacobi
 // with a fixed number of sweeps (the same operations for every particle): s = Q diag Q^T,

@@ -388,7 +388,8 @@ void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
     result_ = SphResult{};
     sph_forces(view, sets_, kernel_, work_, result_);
     resize_neighbour_fields(n);
-    smoothing_lengths(sets_, p_.set.data(), p_.rho.data(), p_.h.data(), n);
+    for (std::size_t i = 0; i < n; ++i)
+      p_.h[i] = smoothing_length(sets_[static_cast<std::size_t>(p_.set[i])], p_.rho[i]);
     stats_.seconds_compute += seconds_since(t0);
   }
 }
