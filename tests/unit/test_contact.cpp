@@ -41,6 +41,48 @@ TEST(Contact, ExteriorFacesOfBoxesAndCans) {
   EXPECT_EQ(exterior_faces(two, {false, true}).size(), 2u * 12 * 5 + 2u * 12 * 2);
 }
 
+// The batched projection (simd::width faces at a time) is the scalar one, bit for bit, for
+// every kind of query: near and far points, warped, flat, degenerate (two corners equal,
+// all four equal) faces, feet inside and outside, and a count that leaves a partial
+// vector.
+TEST(Contact, BatchedProjectionIsTheScalarOneBitForBit) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.4, 0.4);
+  std::vector<QuadQuery> queries;
+  for (int trial = 0; trial < 403; ++trial) {
+    QuadQuery q;
+    q.x = {Vec3{0, 0, 0}, Vec3{1, 0, 0}, Vec3{1, 1, 0}, Vec3{0, 1, 0}};
+    const double warp = trial % 3 == 0 ? 0.0 : 1.0;
+    for (auto& c : q.x) c += Vec3{0.3 * u(rng), 0.3 * u(rng), warp * u(rng)};
+    if (trial % 17 == 0) q.x[2] = q.x[1];
+    if (trial % 29 == 0) q.x = {q.x[0], q.x[0], q.x[0], q.x[0]};
+    const double far = trial % 5 == 0 ? 20.0 : 1.0;
+    q.p = Vec3{0.5 + 2 * u(rng), 0.5 + 2 * u(rng), far * u(rng)};
+    queries.push_back(q);
+  }
+  std::vector<QuadProjection> batched(queries.size());
+  project_on_quads(queries, batched);
+  auto same = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  int converged = 0;
+  for (std::size_t k = 0; k < queries.size(); ++k) {
+    const QuadProjection s = project_on_quad(queries[k].x, queries[k].p);
+    const QuadProjection& b = batched[k];
+    converged += s.converged ? 1 : 0;
+    EXPECT_EQ(s.converged, b.converged) << k;
+    for (auto [x, y] : {std::pair{s.xi, b.xi},
+                        {s.eta, b.eta},
+                        {s.gap, b.gap},
+                        {s.point.x, b.point.x},
+                        {s.point.y, b.point.y},
+                        {s.point.z, b.point.z},
+                        {s.normal.x, b.normal.x},
+                        {s.normal.y, b.normal.y},
+                        {s.normal.z, b.normal.z}})
+      EXPECT_TRUE(same(x, y)) << k << ": " << x << " vs " << y;
+  }
+  EXPECT_GT(converged, 300); // most queries converge: the comparison covers the iteration
+}
+
 // The foot of the normal on a warped face is the closest point of the surface when it
 // lies inside the face: compare with a brute-force minimisation over a 401 x 401 grid
 // refined by a local search (tolerance 1e-9 of the face size on distance, 1e-6 on xi).

@@ -38,11 +38,8 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
   const ExteriorFaces surf = exterior_faces(mesh, selected);
   extra_offset_ = global_nodes_ + static_cast<std::int64_t>(surf.size());
 
-  auto local = [&](std::int64_t gid) {
-    const auto it = std::lower_bound(fe.node_gid.begin(), fe.node_gid.end(), gid);
-    return (it != fe.node_gid.end() && *it == gid) ? static_cast<int>(it - fe.node_gid.begin())
-                                                   : -1;
-  };
+  node_index_ = GidIndex(fe.node_gid);
+  auto local = [&](std::int64_t gid) { return node_index_.find(gid); };
   for (auto gid : surf.contact_nodes) {
     const int l = local(gid);
     if (l >= 0 && fe.node_owned[l]) my_nodes_.push_back(l);
@@ -854,34 +851,64 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
   {
     ScopedPhase t(timers, Phase::contact_force);
     // Owners add the contributions to each node in ascending (node, pair node): the sum
-    // no longer depends on where the pairs were found.
-    std::vector<ContactForceItem>& items = force_plan_.stays() ? force_out_ : force_in_;
-    std::sort(items.begin(), items.end(), [](const ContactForceItem& a, const ContactForceItem& b) {
-      return a.target != b.target ? a.target < b.target : a.slave < b.slave;
-    });
+    // no longer depends on where the pairs were found. The items are grouped by receiving
+    // node (a counting sort on its local index; extra nodes after the mesh's), and each
+    // group, a handful of items, is put in pair-node order by insertion: the order of
+    // std::sort by (node, pair node) within every node, in linear time.
+    const std::vector<ContactForceItem>& items = force_plan_.stays() ? force_out_ : force_in_;
+    const std::size_t ni = items.size(), nk = nn + extra_.size();
+    item_key_.resize(ni);
+    for (std::size_t j = 0; j < ni; ++j) {
+      const std::int64_t g = items[j].target;
+      if (g >= extra_offset_) {
+        item_key_[j] =
+            static_cast<int>(nn + static_cast<std::size_t>(
+                                      std::lower_bound(extra_.begin(), extra_.end(), g,
+                                                       [](const ContactNodeItem& a,
+                                                          std::int64_t x) { return a.gid < x; }) -
+                                      extra_.begin()));
+      } else {
+        item_key_[j] = node_index_.find(g); // an owned node: always found
+      }
+    }
+    key_start_.assign(nk + 1, 0);
+    for (int k : item_key_) ++key_start_[static_cast<std::size_t>(k) + 1];
+    for (std::size_t k = 0; k < nk; ++k) key_start_[k + 1] += key_start_[k];
+    item_order_.resize(ni);
+    for (std::size_t j = 0; j < ni; ++j)
+      item_order_[static_cast<std::size_t>(key_start_[static_cast<std::size_t>(item_key_[j])]++)] =
+          static_cast<int>(j);
     for (int l : my_nodes_) {
       last_face_[static_cast<std::size_t>(l)] = -1;
       allowance_[static_cast<std::size_t>(l)] = 0;
     }
     extra_force_.assign(extra_.size(), {0.0, 0.0, 0.0});
     extra_face_.assign(extra_.size(), -1);
-    for (const auto& it : items) {
-      if (it.target >= extra_offset_) {
-        const auto e = static_cast<std::size_t>(
-            std::lower_bound(extra_.begin(), extra_.end(), it.target,
-                             [](const ContactNodeItem& a, std::int64_t g) { return a.gid < g; }) -
-            extra_.begin());
-        for (int i = 0; i < 3; ++i) extra_force_[e][i] += it.f[i];
-        if (it.target == it.slave) extra_face_[e] = it.face;
-        continue;
+    // After the placement key_start_[k] is the end of group k, the start of group k + 1.
+    for (std::size_t j0 = 0; j0 < ni;) {
+      const auto k = static_cast<std::size_t>(item_key_[static_cast<std::size_t>(item_order_[j0])]);
+      const auto j1 = static_cast<std::size_t>(key_start_[k]);
+      for (std::size_t j = j0 + 1; j < j1; ++j) // insertion by pair node
+        for (std::size_t i = j;
+             i > j0 && items[static_cast<std::size_t>(item_order_[i])].slave <
+                           items[static_cast<std::size_t>(item_order_[i - 1])].slave;
+             --i)
+          std::swap(item_order_[i], item_order_[i - 1]);
+      double* sum = k >= nn ? extra_force_[k - nn].data() : nullptr;
+      for (std::size_t j = j0; j < j1; ++j) {
+        const auto& it = items[static_cast<std::size_t>(item_order_[j])];
+        if (sum) {
+          for (int i = 0; i < 3; ++i) sum[i] += it.f[i];
+          if (it.target == it.slave) extra_face_[k - nn] = it.face;
+          continue;
+        }
+        for (int i = 0; i < 3; ++i) nd.force[i][k] += it.f[i];
+        if (it.target == it.slave) {
+          last_face_[k] = it.face;
+          allowance_[k] = it.allowance;
+        }
       }
-      const auto pos = std::lower_bound(fe_.node_gid.begin(), fe_.node_gid.end(), it.target);
-      const auto l = static_cast<std::size_t>(pos - fe_.node_gid.begin());
-      for (int i = 0; i < 3; ++i) nd.force[i][l] += it.f[i];
-      if (it.target == it.slave) {
-        last_face_[l] = it.face;
-        allowance_[l] = it.allowance;
-      }
+      j0 = j1;
     }
   }
   {

@@ -24,6 +24,7 @@
 #include "anvil/contact/penalty.hpp"
 #include "anvil/contact/search.hpp"
 #include "anvil/contact/surface.hpp"
+#include "anvil/core/gid_index.hpp"
 #include "anvil/core/timer.hpp"
 #include "anvil/fe/hex_block.hpp"
 #include "anvil/io/config.hpp"
@@ -109,6 +110,7 @@ public:
 private:
   const ContactConfig config_;
   const FeDecomposition& fe_;
+  GidIndex node_index_; // fe_.node_gid[k] -> k
   const Comm& comm_;
   const std::vector<HexBlock>& blocks_; // the FE blocks (their `alive` flags)
   std::int64_t global_nodes_ = 0;       // offset that keeps face point ids apart from node ids
@@ -215,6 +217,7 @@ private:
   const std::vector<ContactFaceItem>* search_faces_ = &face_in_;
   std::vector<ContactPair> pairs_;
   std::vector<ContactForceItem> force_out_, force_in_;
+  std::vector<int> item_key_, key_start_, item_order_; // grouping of the force items by node
   std::vector<int> force_dest_;
   SearchWorkspace search_;
   Migration node_plan_, face_plan_, force_plan_;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "anvil/core/simd.hpp"
+
 namespace anvil {
 
 namespace {
@@ -16,50 +18,196 @@ std::array<double, 4> quad_shape(double xi, double eta) {
   return n;
 }
 
-QuadProjection project_on_quad(const std::array<Vec3, 4>& x, const Vec3& p) {
-  // x(xi, eta) = c + a xi + b eta + d xi eta.
-  const Vec3 c = 0.25 * (x[0] + x[1] + x[2] + x[3]);
-  const Vec3 a = 0.25 * (-1.0 * x[0] + x[1] + x[2] - x[3]);
-  const Vec3 b = 0.25 * (-1.0 * x[0] - x[1] + x[2] + x[3]);
-  const Vec3 d = 0.25 * (x[0] - x[1] + x[2] - x[3]);
-  QuadProjection r;
-  double xi = 0, eta = 0;
-  const double scale = dot(a, a) + dot(b, b);
-  for (int it = 0; it < 12; ++it) {
-    const Vec3 xs = c + xi * a + eta * b + (xi * eta) * d;
-    const Vec3 txi = a + eta * d, teta = b + xi * d;
-    const Vec3 res = xs - p;
-    const double g1 = dot(res, txi), g2 = dot(res, teta);
-    // Newton on the gradient of |x - p|^2 / 2; the Hessian's curvature term uses d.
-    double h11 = dot(txi, txi), h22 = dot(teta, teta), h12 = dot(txi, teta) + dot(res, d);
-    double det = h11 * h22 - h12 * h12;
-    if (!(det > 1e-12 * scale * scale)) { // far from the surface: Gauss-Newton
-      h12 = dot(txi, teta);
-      det = h11 * h22 - h12 * h12;
-      if (!(det > 0)) break;
+namespace {
+
+// The projection written once for one face (V = double) and for `simd::width` faces, one
+// per lane (V = simd::vdouble): every lane does the scalar operations in the scalar
+// order (no contraction in this file), so both give the same bits.
+namespace stdx = std::experimental;
+using simd::vdouble;
+using simd::vmask;
+inline bool any(bool m) {
+  return m;
+}
+inline bool any(const vmask& m) {
+  return stdx::any_of(m);
+}
+inline void set_where(bool m, double& v, double x) {
+  if (m) v = x;
+}
+inline void set_where(const vmask& m, vdouble& v, const vdouble& x) {
+  stdx::where(m, v) = x;
+}
+inline void set_where(bool m, bool& v, bool x) {
+  if (m) v = x;
+}
+inline void set_where(const vmask& m, vmask& v, bool x) {
+  v = (v && !m) || (m && vmask(x));
+}
+inline double abs_(double v) {
+  return std::abs(v);
+}
+inline vdouble abs_(const vdouble& v) {
+  return stdx::abs(v);
+}
+inline double sqrt_(double v) {
+  return std::sqrt(v);
+}
+inline vdouble sqrt_(const vdouble& v) {
+  return stdx::sqrt(v);
+}
+
+template <class V>
+struct V3 {
+  V x, y, z;
+};
+template <class V>
+V3<V> add(const V3<V>& a, const V3<V>& b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+template <class V>
+V3<V> sub(const V3<V>& a, const V3<V>& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+template <class V, class S>
+V3<V> mul(const V3<V>& a, const S& s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+template <class V>
+V dot3(const V3<V>& a, const V3<V>& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+template <class V, class M>
+struct Foot {
+  V xi, eta, gap;
+  V3<V> point, normal;
+  M converged;
+};
+
+// x(xi, eta) = c + a xi + b eta + d xi eta; Newton on the gradient of |x - p|^2 / 2 from
+// the centre, on dot products formed once.
+template <class V, class M>
+Foot<V, M> foot(const V3<V> (&x)[4], const V3<V>& p) {
+  const V3<V> c = mul(add(add(add(x[0], x[1]), x[2]), x[3]), 0.25);
+  const V3<V> a = mul(sub(add(add(mul(x[0], -1.0), x[1]), x[2]), x[3]), 0.25);
+  const V3<V> b = mul(add(add(sub(mul(x[0], -1.0), x[1]), x[2]), x[3]), 0.25);
+  const V3<V> d = mul(sub(add(sub(x[0], x[1]), x[2]), x[3]), 0.25);
+  const V3<V> r0 = sub(c, p);
+  const V aa = dot3(a, a), bb = dot3(b, b), dd = dot3(d, d);
+  const V ab = dot3(a, b), ad = dot3(a, d), bd = dot3(b, d);
+  const V ra = dot3(r0, a), rb = dot3(r0, b), rd = dot3(r0, d);
+  const V scale = aa + bb;
+  V xi = 0.0, eta = 0.0;
+  M active(true), converged(false);
+  for (int it = 0; it < 12 && any(active); ++it) {
+    // res = x(xi, eta) - p, t_xi = a + eta d, t_eta = b + xi d.
+    const V xe = xi * eta;
+    const V res_a = ra + xi * aa + eta * ab + xe * ad;
+    const V res_b = rb + xi * ab + eta * bb + xe * bd;
+    const V res_d = rd + xi * ad + eta * bd + xe * dd;
+    const V g1 = res_a + eta * res_d, g2 = res_b + xi * res_d;
+    // The Hessian's curvature term uses d. Newton converges quadratically: after a step
+    // below 1e-6 the error is of order 1e-12 times the face's relative curvature. Far
+    // from the surface (the Hessian not positive) Gauss-Newton, which converges only
+    // linearly, stops after a step below 1e-12, or gives up where even it is singular.
+    const V h11 = aa + eta * (2 * ad + eta * dd), h22 = bb + xi * (2 * bd + xi * dd);
+    const V tt = ab + xi * ad + eta * bd + xe * dd; // t_xi . t_eta
+    V h12 = tt + res_d;
+    V det = h11 * h22 - h12 * h12;
+    V done = 1e-6;
+    const M gauss = !(det > 1e-12 * scale * scale);
+    if (any(gauss)) {
+      set_where(gauss, h12, tt);
+      set_where(gauss, det, h11 * h22 - tt * tt);
+      set_where(gauss, done, V(1e-12));
+      set_where(gauss && !(det > 0.0), active, false);
     }
-    const double dxi = -(h22 * g1 - h12 * g2) / det;
-    const double deta = -(h11 * g2 - h12 * g1) / det;
-    xi = std::clamp(xi + dxi, -3.0, 3.0);
-    eta = std::clamp(eta + deta, -3.0, 3.0);
-    if (std::abs(dxi) + std::abs(deta) < 1e-12) {
-      r.converged = true;
-      break;
-    }
+    const V dxi = -(h22 * g1 - h12 * g2) / det;
+    const V deta = -(h11 * g2 - h12 * g1) / det;
+    V nxi = xi + dxi, neta = eta + deta;
+    set_where(nxi < -3.0, nxi, V(-3.0));
+    set_where(3.0 < nxi, nxi, V(3.0));
+    set_where(neta < -3.0, neta, V(-3.0));
+    set_where(3.0 < neta, neta, V(3.0));
+    set_where(active, xi, nxi);
+    set_where(active, eta, neta);
+    const M now = active && (abs_(dxi) + abs_(deta) < done);
+    set_where(now, converged, true);
+    set_where(now, active, false);
   }
+  Foot<V, M> r;
   r.xi = xi;
   r.eta = eta;
-  r.point = c + xi * a + eta * b + (xi * eta) * d;
-  const Vec3 n = cross(a + eta * d, b + xi * d);
-  const double len = norm(n);
-  r.normal = len > 0 ? n * (1 / len) : Vec3{};
-  r.gap = dot(p - r.point, r.normal);
-  if (!r.converged) { // accept a foot where the gradient vanishes to round-off
-    const Vec3 res = r.point - p;
-    const double g1 = dot(res, a + eta * d), g2 = dot(res, b + xi * d);
-    r.converged = std::abs(g1) + std::abs(g2) <= 1e-9 * (norm(res) + 1e-300) * std::sqrt(scale);
+  r.point = add(add(add(c, mul(a, xi)), mul(b, eta)), mul(d, xi * eta));
+  const V3<V> t1 = add(a, mul(d, eta)), t2 = add(b, mul(d, xi));
+  const V3<V> n = {t1.y * t2.z - t1.z * t2.y, t1.z * t2.x - t1.x * t2.z, t1.x * t2.y - t1.y * t2.x};
+  const V len = sqrt_(dot3(n, n));
+  r.normal = {V(0.0), V(0.0), V(0.0)};
+  const M has = len > 0.0;
+  if (any(has)) {
+    const V inv = 1 / len;
+    set_where(has, r.normal.x, n.x * inv);
+    set_where(has, r.normal.y, n.y * inv);
+    set_where(has, r.normal.z, n.z * inv);
+  }
+  r.gap = dot3(sub(p, r.point), r.normal);
+  r.converged = converged;
+  if (any(!converged)) { // accept a foot where the gradient vanishes to round-off
+    const V3<V> res = sub(r.point, p);
+    const V g1 = dot3(res, t1), g2 = dot3(res, t2);
+    const M flat = abs_(g1) + abs_(g2) <= 1e-9 * (sqrt_(dot3(res, res)) + 1e-300) * sqrt_(scale);
+    set_where(!converged && flat, r.converged, true);
   }
   return r;
+}
+
+} // namespace
+
+QuadProjection project_on_quad(const std::array<Vec3, 4>& x, const Vec3& p) {
+  const V3<double> xs[4] = {{x[0].x, x[0].y, x[0].z},
+                            {x[1].x, x[1].y, x[1].z},
+                            {x[2].x, x[2].y, x[2].z},
+                            {x[3].x, x[3].y, x[3].z}};
+  const Foot<double, bool> f = foot<double, bool>(xs, {p.x, p.y, p.z});
+  QuadProjection r;
+  r.xi = f.xi;
+  r.eta = f.eta;
+  r.point = {f.point.x, f.point.y, f.point.z};
+  r.normal = {f.normal.x, f.normal.y, f.normal.z};
+  r.gap = f.gap;
+  r.converged = f.converged;
+  return r;
+}
+
+void project_on_quads(std::span<const QuadQuery> queries, std::span<QuadProjection> out) {
+  constexpr int W = simd::width;
+  const std::size_t n = queries.size();
+  for (std::size_t k0 = 0; k0 < n; k0 += W) {
+    // Lanes past the end repeat the last query.
+    auto q = [&](int l) -> const QuadQuery& {
+      return queries[std::min(k0 + static_cast<std::size_t>(l), n - 1)];
+    };
+    V3<vdouble> x[4], p;
+    for (int a = 0; a < 4; ++a) {
+      x[a].x = vdouble([&](auto l) { return q(l).x[a].x; });
+      x[a].y = vdouble([&](auto l) { return q(l).x[a].y; });
+      x[a].z = vdouble([&](auto l) { return q(l).x[a].z; });
+    }
+    p.x = vdouble([&](auto l) { return q(l).p.x; });
+    p.y = vdouble([&](auto l) { return q(l).p.y; });
+    p.z = vdouble([&](auto l) { return q(l).p.z; });
+    const Foot<vdouble, vmask> f = foot<vdouble, vmask>(x, p);
+    for (int l = 0; l < W && k0 + static_cast<std::size_t>(l) < n; ++l) {
+      QuadProjection& r = out[k0 + static_cast<std::size_t>(l)];
+      r.xi = f.xi[l];
+      r.eta = f.eta[l];
+      r.point = {f.point.x[l], f.point.y[l], f.point.z[l]};
+      r.normal = {f.normal.x[l], f.normal.y[l], f.normal.z[l]};
+      r.gap = f.gap[l];
+      r.converged = f.converged[l];
+    }
+  }
 }
 
 } // namespace anvil

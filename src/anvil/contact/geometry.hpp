@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <span>
 
 #include "anvil/core/vec3.hpp"
 
@@ -24,5 +25,13 @@ std::array<double, 4> quad_shape(double xi, double eta);
 // seen from outside), by Newton's method on (x(xi, eta) - p) . x_xi = (x - p) . x_eta = 0
 // from the face centre, at most 12 iterations, parent coordinates kept within [-3, 3].
 QuadProjection project_on_quad(const std::array<Vec3, 4>& x, const Vec3& p);
+
+// The same for many points and faces, `simd::width` at a time: out[k] is, bit for bit,
+// project_on_quad(queries[k].x, queries[k].p).
+struct QuadQuery {
+  std::array<Vec3, 4> x;
+  Vec3 p;
+};
+void project_on_quads(std::span<const QuadQuery> queries, std::span<QuadProjection> out);
 
 } // namespace anvil

@@ -289,12 +289,17 @@ void find_pairs(const std::vector<ContactNodeItem>& nodes,
     return !((p.x < boxes.lo[0][k]) | (p.x > boxes.hi[0][k]) | (p.y < boxes.lo[1][k]) |
              (p.y > boxes.hi[1][k]) | (p.z < boxes.lo[2][k]) | (p.z > boxes.hi[2][k]));
   };
+  // Pass 1, node by node: the candidates whose capture box holds the node, then, if there
+  // are any, the node's own faces whose box holds it; of the candidates, those that face
+  // the node's surface and hold it within their depth are queued for the detailed check.
+  w.query_start.assign(w.active.size() + 1, 0);
+  w.query_face.clear();
+  w.queries.clear();
   for (std::size_t k = 0; k < w.active.size(); ++k) {
+    w.query_start[k] = static_cast<int>(w.queries.size());
     const auto n = static_cast<std::size_t>(w.active[k]);
     const auto& nd = nodes[n];
     const Vec3 p{nd.x[0], nd.x[1], nd.x[2]};
-    // Pass 1: the candidates whose capture box holds the node, then, if there are any, the
-    // node's own faces whose box holds it.
     cand.clear();
     for (int j = w.list_start[k]; j < w.own_start[k]; ++j)
       if (holds(w.list[static_cast<std::size_t>(j)], p))
@@ -309,10 +314,6 @@ void find_pairs(const std::vector<ContactNodeItem>& nodes,
     // the same face never coexist on a rank; kept for safety).
     std::sort(own.begin(), own.end(), by_gid);
     own.erase(std::unique(own.begin(), own.end(), same_gid), own.end());
-    // Pass 2: the detailed check of the candidates.
-    ContactPair best, tracked;
-    bool found = false, have_tracked = false;
-    std::int64_t best_gid = 0;
     for (int f : cand) {
       const auto& fc = faces[static_cast<std::size_t>(f)];
       // The surfaces must face each other (a node just outside a convex edge can be
@@ -322,10 +323,28 @@ void find_pairs(const std::vector<ContactNodeItem>& nodes,
       if (!faces_oppose(own, fn)) continue;
       const double side = dot(p, fn) - fc.offset;
       if (side > fc.warp || side < -(2 * fc.depth + fc.warp)) continue;
-      const std::array<Vec3, 4> x = {
-          Vec3{fc.x[0][0], fc.x[0][1], fc.x[0][2]}, Vec3{fc.x[1][0], fc.x[1][1], fc.x[1][2]},
-          Vec3{fc.x[2][0], fc.x[2][1], fc.x[2][2]}, Vec3{fc.x[3][0], fc.x[3][1], fc.x[3][2]}};
-      const QuadProjection q = project_on_quad(x, p);
+      w.queries.push_back(
+          {{Vec3{fc.x[0][0], fc.x[0][1], fc.x[0][2]}, Vec3{fc.x[1][0], fc.x[1][1], fc.x[1][2]},
+            Vec3{fc.x[2][0], fc.x[2][1], fc.x[2][2]}, Vec3{fc.x[3][0], fc.x[3][1], fc.x[3][2]}},
+           p});
+      w.query_face.push_back(f);
+    }
+  }
+  w.query_start[w.active.size()] = static_cast<int>(w.queries.size());
+  // Pass 2: the feet of the normals, `simd::width` at a time.
+  w.feet.resize(w.queries.size());
+  project_on_quads(w.queries, w.feet);
+  // Pass 3, node by node: the detailed check of its queued faces, in their order.
+  for (std::size_t k = 0; k < w.active.size(); ++k) {
+    const auto n = static_cast<std::size_t>(w.active[k]);
+    const auto& nd = nodes[n];
+    ContactPair best, tracked;
+    bool found = false, have_tracked = false;
+    std::int64_t best_gid = 0;
+    for (int j = w.query_start[k]; j < w.query_start[k + 1]; ++j) {
+      const int f = w.query_face[static_cast<std::size_t>(j)];
+      const auto& fc = faces[static_cast<std::size_t>(f)];
+      const QuadProjection& q = w.feet[static_cast<std::size_t>(j)];
       if (!q.converged || std::abs(q.xi) > tol || std::abs(q.eta) > tol || !(q.gap < 0)) continue;
       if (fc.gid == nd.last_face && -q.gap <= 2 * fc.depth) {
         tracked = {static_cast<int>(n),           f, q.xi, q.eta, q.gap, q.normal,

@@ -15,6 +15,8 @@
 #include <span>
 #include <vector>
 
+#include "anvil/contact/geometry.hpp"
+
 #include "anvil/core/vec3.hpp"
 
 namespace anvil {
@@ -108,6 +110,11 @@ struct SearchWorkspace {
   std::vector<CellEntry> entries;      // faces binned by cell
   std::vector<double> extent;          // largest side of each capture box
   std::vector<int> own, cand;          // a node's own faces and its candidates
+  // The detailed checks of a cycle, projected together (project_on_quads): per active
+  // node its range of queries (+ end), each query's face and the feet found.
+  std::vector<int> query_start, query_face;
+  std::vector<QuadQuery> queries;
+  std::vector<QuadProjection> feet;
 
   // Candidate lists (Verlet lists): for each node with at least one candidate (active),
   // the faces whose enlarged capture box held it at the last build, ascending: first the
