@@ -857,6 +857,8 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
     // std::sort by (node, pair node) within every node, in linear time.
     const std::vector<ContactForceItem>& items = force_plan_.stays() ? force_out_ : force_in_;
     const std::size_t ni = items.size(), nk = nn + extra_.size();
+    item_key_.reserve(items.capacity()); // grows only where the items did
+    item_order_.reserve(items.capacity());
     item_key_.resize(ni);
     for (std::size_t j = 0; j < ni; ++j) {
       const std::int64_t g = items[j].target;

@@ -219,6 +219,11 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
   w.needed.clear();
   for (std::size_t f = 0; f < nf; ++f)
     if (w.mark[f]) w.needed.push_back(static_cast<int>(f));
+  // Room for a cycle's detailed checks: at most one per candidate entry.
+  w.query_start.reserve(w.active.capacity() + 1);
+  w.query_face.reserve(w.list.capacity()); // capacities: they grow only where the lists did
+  w.queries.reserve(w.list.capacity());
+  w.feet.reserve(w.list.capacity());
   w.built = true;
   ++w.builds;
 }
