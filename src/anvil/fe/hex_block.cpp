@@ -60,6 +60,9 @@ constexpr int prefetch_ahead = 32; // elements
 constexpr int node_stride = 8;
 
 // Packs nodes [lo, hi) of the nodal arrays into p (node k at p + node_stride k).
+// A template only so that each of detail::block_forces' two instantiations has its own
+// copy, called once and inlined as when hex_forces was the only caller (as gather below).
+template <bool Asq>
 void pack_nodes(const NodalView& n, int lo, int hi, double* __restrict p) {
   const double* __restrict x0 = n.x[0];
   const double* __restrict x1 = n.x[1];
@@ -102,6 +105,7 @@ void pack_nodes(const NodalView& n, int lo, int hi, double* __restrict p) {
 // C, and writes the edge sums of the mid-step positions x - h v (and their x
 // coordinates) to the stage scratch t. conn: the block's eight corner index arrays;
 // ahead: the element to prefetch for.
+template <bool Asq>
 void gather(const int* const (&conn)[8], const double* packed, int e, int ahead, double h,
             double* __restrict xs, double* __restrict vs, double* __restrict t) {
   constexpr int C = HexWorkspace::chunk;
@@ -213,19 +217,17 @@ HexWorkspace::HexWorkspace()
     : buf_(static_cast<std::size_t>(s_count) * chunk + static_cast<std::size_t>(t_count) * width,
            0.0) {}
 
-namespace {
-
-using Scratch = std::vector<double, CacheAligned<double>>;
+namespace detail {
 
 // hex_forces for one block, compiled twice: Asq for the assumed-strain hourglass form, and
-// without it for the viscous and stiffness forms, which then run exactly the instructions
-// they ran before that form existed (it is not a branch in their code).
+// without it for the viscous and stiffness forms, which then run the instructions they
+// ran before that form existed (it is not a branch in their code).
 template <bool Asq>
-void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corners, Scratch& buf,
-                  Scratch& packed_nodes, HexResult& result) {
+void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corners,
+                  HexWorkspace& work, HexResult& result) {
   const int n = b.size();
   constexpr int C = HexWorkspace::chunk;
-  auto scratch = [&](int slot) { return buf.data() + static_cast<std::size_t>(slot) * C; };
+  auto scratch = [&](int slot) { return work.buf_.data() + static_cast<std::size_t>(slot) * C; };
   const double M = b.material->elastic().plane_wave_modulus();
   const bool stiff = !Asq && b.hourglass.model == HourglassControl::Model::stiffness;
   const double hg = b.hourglass.coefficient;
@@ -240,12 +242,12 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
     stream = stream && reinterpret_cast<std::uintptr_t>(f + b.corner_base) % 32 == 0;
   // Positions and velocities of the block's nodes, packed per node.
   const std::size_t packed_size = node_stride * static_cast<std::size_t>(b.node_end);
-  if (packed_nodes.size() < packed_size) packed_nodes.resize(packed_size); // first calls only
-  pack_nodes(nodes, b.node_begin, b.node_end, packed_nodes.data());
-  const double* packed = packed_nodes.data();
+  if (work.nodes_.size() < packed_size) work.nodes_.resize(packed_size); // first calls only
+  pack_nodes<Asq>(nodes, b.node_begin, b.node_end, work.nodes_.data());
+  const double* packed = work.nodes_.data();
   const int* conn[8];
   for (int a = 0; a < 8; ++a) conn[a] = b.conn[a].data();
-  double* t = buf.data() + static_cast<std::size_t>(s_count) * C; // stage scratch
+  double* t = work.buf_.data() + static_cast<std::size_t>(s_count) * C; // stage scratch
   constexpr int W = width;
   auto tmp = [t](int k) { return simd::load(t + k * W); };
   // The smallest stable step: the element's if it is smaller, or equal with a smaller id.
@@ -269,8 +271,8 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
     // rotate the old stress into the new frame.
     for (int l = 0; l < nc; l += width) {
       const int e = e0 + l;
-      gather(conn, packed, e, std::min(e + prefetch_ahead, padded_size(n) - width), 0.5 * dt,
-             scratch(s_x0) + l, scratch(s_v0) + l, t);
+      gather<Asq>(conn, packed, e, std::min(e + prefetch_ahead, padded_size(n) - width), 0.5 * dt,
+                  scratch(s_x0) + l, scratch(s_v0) + l, t);
       simd::stage_barrier();
       // 12 B(x(n-1/2)) one direction at a time, consumed at once: 12 V and 12 V L^T.
       vdouble L[3][3], vol12;
@@ -571,14 +573,14 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
     if (best_e[k] >= 0) take_step(best_dt[k], b.gid[static_cast<std::size_t>(best_e[k])]);
 }
 
-} // namespace
+} // namespace detail
 
 void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corners,
                 HexWorkspace& work, HexResult& result) {
   if (b.hourglass.model == HourglassControl::Model::assumed_strain)
-    block_forces<true>(b, nodes, dt, corners, work.buf_, work.nodes_, result);
+    detail::block_forces<true>(b, nodes, dt, corners, work, result);
   else
-    block_forces<false>(b, nodes, dt, corners, work.buf_, work.nodes_, result);
+    detail::block_forces<false>(b, nodes, dt, corners, work, result);
 }
 
 void hex_volumes(const HexBlock& b, const double* const x[3], std::span<double> out) {

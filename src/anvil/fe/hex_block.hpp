@@ -119,6 +119,12 @@ struct HexResult {
   std::int64_t eroded = 0;         // elements eroded in this call
 };
 
+class HexWorkspace;
+namespace detail {
+template <bool Asq>
+void block_forces(HexBlock&, const NodalView&, double, CornerView, HexWorkspace&, HexResult&);
+}
+
 // Scratch space reused by every call (the cycle allocates nothing).
 class HexWorkspace {
 public:
@@ -126,8 +132,9 @@ public:
   HexWorkspace();
 
 private:
-  friend void hex_forces(HexBlock&, const NodalView&, double, CornerView, HexWorkspace&,
-                         HexResult&);
+  template <bool Asq>
+  friend void detail::block_forces(HexBlock&, const NodalView&, double, CornerView, HexWorkspace&,
+                                   HexResult&);
   std::vector<double, CacheAligned<double>> buf_;   // chunk and stage scratch
   std::vector<double, CacheAligned<double>> nodes_; // x and v, 8 per node (grows to the
                                                     // largest block's node range)
