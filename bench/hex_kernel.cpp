@@ -81,12 +81,16 @@ void BM_FePhase_J2_Viscous(benchmark::State& s) {
 void BM_FePhase_J2_Stiffness(benchmark::State& s) {
   run(s, "j2_plasticity", HourglassControl::Model::stiffness);
 }
+void BM_FePhase_J2_AssumedStrain(benchmark::State& s) {
+  run(s, "j2_plasticity", HourglassControl::Model::assumed_strain);
+}
 void BM_FePhase_Elastic_Viscous(benchmark::State& s) {
   run(s, "elastic", HourglassControl::Model::viscous);
 }
 
 BENCHMARK(BM_FePhase_J2_Viscous)->Arg(20)->Arg(47)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FePhase_J2_Stiffness)->Arg(47)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FePhase_J2_AssumedStrain)->Arg(47)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FePhase_Elastic_Viscous)->Arg(47)->Unit(benchmark::kMillisecond);
 
 } // namespace

@@ -16,8 +16,9 @@ namespace {
 
 using namespace anvil;
 
-// An impact with plasticity, both hourglass forms, a prescribed velocity, a rotation
-// and non-trivial partitions: every code path of the FE cycle.
+// An impact with plasticity, the three hourglass forms (a clamped sheet one element thick
+// flaps with the assumed-strain form), a prescribed velocity, a rotation and non-trivial
+// partitions: every code path of the FE cycle.
 const char* deck_text = R"(
 termination: {cycles: 150}
 materials:
@@ -35,9 +36,15 @@ parts:
     mesh: {generate: box, min: [-0.01, -0.01, -0.004], max: [0.01, 0.01, -0.001], divisions: [8, 8, 3]}
     material: steel
     hourglass: {model: stiffness, coefficient: 0.05}
+  sheet:
+    mesh: {generate: box, min: [0.02, -0.01, 0], max: [0.04, 0.01, 0.001], divisions: [8, 8, 1]}
+    material: steel
+    hourglass: {model: assumed_strain}
 initial_conditions:
   - {part: bar, velocity: [0, 0, -400.0], angular_velocity: [0, 0, 2000.0], center: [0, 0, 0]}
+  - {part: sheet, velocity: [0, 0, 60.0], angular_velocity: [3000.0, 0, 0], center: [0.03, 0, 0]}
 boundary_conditions:
+  - {set: sheet.xmin, fix: all}
   - {set: bar.bottom, fix: [z]}
   - {set: plate.zmin, velocity: [0, 0, 30.0]}
 )";

@@ -68,6 +68,19 @@ TEST(Cli, BadDeckNamesFileLineKey) {
   EXPECT_NE(r.out.find("materials.m.density"), std::string::npos) << r.out;
 }
 
+TEST(Cli, BadHourglassCoefficientExitsTwo) {
+  const auto deck = write_temp(
+      "bad_hourglass.yaml",
+      "termination: {time: 1.0e-5}\nmaterials:\n  m: {model: elastic, density: 7850, "
+      "youngs_modulus: 2.0e11, poissons_ratio: 0.3}\nparts:\n  p:\n    mesh: {generate: box, "
+      "min: [0, 0, 0], max: [1, 1, 1], divisions: [1, 1, 1]}\n    material: m\n"
+      "    hourglass: {model: assumed_strain, coefficient: 2}\n");
+  const auto r = run("check " + deck);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("bad_hourglass.yaml:8"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("parts.p.hourglass.coefficient"), std::string::npos) << r.out;
+}
+
 const char* small_deck = R"(
 termination: {time: 2.0e-6}
 materials:

@@ -114,6 +114,31 @@ TEST(Deck, BrokenReferences) {
                {"deck.yaml:5", "j3_plasticity", "johnson_cook"});
 }
 
+// hourglass: {model: assumed_strain, coefficient: c}: c a scale on the physical stiffness,
+// 1 by default; bad values name file, line and key.
+TEST(Deck, AssumedStrainHourglass) {
+  std::string text = good;
+  const std::string from = "hourglass: {model: viscous, coefficient: 0.05}";
+  text.replace(text.find(from), from.size(), "hourglass: {model: assumed_strain}");
+  Config c = test::deck(text);
+  EXPECT_EQ(c.parts[0].hourglass.model, HourglassControl::Model::assumed_strain);
+  EXPECT_DOUBLE_EQ(c.parts[0].hourglass.coefficient, 1.0);
+  text = good;
+  text.replace(text.find(from), from.size(),
+               "hourglass: {coefficient: 0.5, model: assumed_strain}");
+  c = test::deck(text);
+  EXPECT_EQ(c.parts[0].hourglass.model, HourglassControl::Model::assumed_strain);
+  EXPECT_DOUBLE_EQ(c.parts[0].hourglass.coefficient, 0.5);
+  expect_error(from, "hourglass: {model: assumed_stain}",
+               {"deck.yaml:11", "parts.bar.hourglass.model", "assumed_stain", "assumed_strain"});
+  expect_error(from, "hourglass: {model: assumed_strain, coefficient: 1.5}",
+               {"deck.yaml:11", "parts.bar.hourglass.coefficient", "between 0 and 1"});
+  expect_error(from, "hourglass: {model: assumed_strain, coefficient: -0.1}",
+               {"deck.yaml:11", "parts.bar.hourglass.coefficient", "between 0 and 1"});
+  expect_error(from, "hourglass: {model: assumed_strain, coefficient: stiff}",
+               {"deck.yaml:11", "parts.bar.hourglass.coefficient"});
+}
+
 TEST(Deck, MalformedYaml) {
   expect_error("parts:\n", "parts: [\n", {"deck.yaml:", "malformed YAML"});
   expect_error("title: bar", "title: bar\ntitle: again", {"deck.yaml:2", "duplicate key"});

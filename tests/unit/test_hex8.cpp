@@ -185,3 +185,103 @@ TEST(Hex8, HughesWingetIsTheIncrementalRotation) {
 }
 
 } // namespace
+
+namespace {
+
+// A box with half-edges (a, b, c) along the columns of a rotation, and the energy 1/2 q . K q
+// that the assumed-strain stiffness gives a nodal displacement field u(local x, y, z)
+// (the code's q = sum_a u_a Gamma_a, a box being a parallelepiped).
+struct RotatedBox {
+  double R[3][3]; // columns: the box's axes
+  double half[3] = {0.3, 0.5, 0.2};
+  double x[8][3];
+  RotatedBox() {
+    const double n[3] = {1 / std::sqrt(14.0), 2 / std::sqrt(14.0), 3 / std::sqrt(14.0)};
+    const double t = 0.7, co = std::cos(t), si = std::sin(t);
+    const double K[3][3] = {{0, -n[2], n[1]}, {n[2], 0, -n[0]}, {-n[1], n[0], 0}};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) R[i][j] = co * (i == j) + (1 - co) * n[i] * n[j] + si * K[i][j];
+    for (int a = 0; a < 8; ++a)
+      for (int i = 0; i < 3; ++i) {
+        x[a][i] = 0.1 * (i + 1);
+        for (int d = 0; d < 3; ++d) x[a][i] += R[i][d] * half[d] * coord(a, d);
+      }
+  }
+  static double coord(int a, int d) {
+    static constexpr double s[3][8] = {
+        {-1, 1, 1, -1, -1, 1, 1, -1}, {-1, -1, 1, 1, -1, -1, 1, 1}, {-1, -1, -1, -1, 1, 1, 1, 1}};
+    return s[d][a];
+  }
+  template <class Field>
+  double energy(double E, double mu, Field&& u) const {
+    double J[3][3], col[8];
+    for (int i = 0; i < 3; ++i) {
+      for (int a = 0; a < 8; ++a) col[a] = x[a][i];
+      hex8::natural_sums(col, J[i]);
+    }
+    double e[3][3], len[3];
+    hex8::corotational_frame(J, e, len);
+    double q[3][4] = {}, ql[3][4] = {}, r[3][4];
+    for (int a = 0; a < 8; ++a) {
+      double ul[3], ug[3] = {0, 0, 0};
+      u(half[0] * coord(a, 0), half[1] * coord(a, 1), half[2] * coord(a, 2), ul);
+      for (int i = 0; i < 3; ++i)
+        for (int d = 0; d < 3; ++d) ug[i] += R[i][d] * ul[d];
+      for (int al = 0; al < 4; ++al)
+        for (int i = 0; i < 3; ++i) q[i][al] += hex8::gamma_base[al][a] * ug[i];
+    }
+    for (int d = 0; d < 3; ++d)
+      for (int al = 0; al < 4; ++al)
+        for (int i = 0; i < 3; ++i) ql[d][al] += e[d][i] * q[i][al];
+    hex8::assumed_strain_rate(E, mu, len, ql, r);
+    double U = 0;
+    for (int d = 0; d < 3; ++d)
+      for (int al = 0; al < 4; ++al) U += 0.5 * ql[d][al] * r[d][al];
+    return U;
+  }
+};
+
+// The frame of a rotated box is its axes, its extents 8 times its half-edges.
+TEST(Hex8, CorotationalFrameOfARotatedBox) {
+  const RotatedBox box;
+  double J[3][3], col[8], e[3][3], len[3];
+  for (int i = 0; i < 3; ++i) {
+    for (int a = 0; a < 8; ++a) col[a] = box.x[a][i];
+    hex8::natural_sums(col, J[i]);
+  }
+  hex8::corotational_frame(J, e, len);
+  for (int d = 0; d < 3; ++d) {
+    EXPECT_NEAR(len[d], 8 * box.half[d], 1e-14);
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(e[d][i], box.R[i][d], 1e-14);
+  }
+}
+
+// Pure bending u_x = k x y (the strain eps_xx = k y of a beam, the transverse displacement
+// quadratic and invisible to the element) stores the beam's energy 1/2 E I k^2 L, with E,
+// not lambda + 2 mu; a plate's twist (w = k x y: u = -k y z, v = -k x z, w = k x y) the
+// plate's D (1 - nu) k^2 A = (4/3) mu c^3 k^2 (4 a b), with no transverse shear. Round-off.
+TEST(Hex8, AssumedStrainStiffnessHasBeamBendingAndPlateTwist) {
+  const RotatedBox box;
+  const double E = 200e9, nu = 0.3, mu = E / (2 * (1 + nu)), k = 1e-3;
+  const double a = box.half[0], b = box.half[1], c = box.half[2], V = 8 * a * b * c;
+  const double bend = box.energy(E, mu, [&](double x, double y, double, double(&u)[3]) {
+    u[0] = k * x * y;
+    u[1] = u[2] = 0;
+  });
+  EXPECT_NEAR(bend, 0.5 * E * k * k * (b * b / 3) * V, 1e-12 * bend);
+  const double twist = box.energy(E, mu, [&](double x, double y, double z, double(&u)[3]) {
+    u[0] = -k * y * z;
+    u[1] = -k * x * z;
+    u[2] = k * x * y;
+  });
+  EXPECT_NEAR(twist, (4.0 / 3.0) * mu * c * c * c * k * k * 4 * a * b, 1e-12 * twist);
+  // A linear field (a rigid rotation plus a stretch) stores nothing.
+  const double lin = box.energy(E, mu, [&](double x, double y, double z, double(&u)[3]) {
+    u[0] = 0.01 * x - 0.02 * y;
+    u[1] = 0.02 * x + 0.03 * z;
+    u[2] = -0.03 * y;
+  });
+  EXPECT_NEAR(lin, 0.0, 1e-12 * bend);
+}
+
+} // namespace

@@ -298,6 +298,29 @@ TEST(Keyword, HourglassAndBulkViscosity) {
   EXPECT_EQ(c.parts[0].bulk_viscosity.linear, 0.05);
 }
 
+// IHQ 6 (Belytschko-Bindeman) is anvil's assumed-strain form, QM its scale; 9 and 10
+// (physical forms) are replaced by it with a warning, 7 and 8 by the stiffness form.
+TEST(Keyword, AssumedStrainHourglass) {
+  const std::string part = "         1         1         1         0         5\n";
+  Config c = kw(with(with(good, "         1         1         1\n", part), "*END",
+                     "*HOURGLASS\n         5         6       1.0\n*END"));
+  EXPECT_EQ(c.parts[0].hourglass.model, HourglassControl::Model::assumed_strain);
+  EXPECT_EQ(c.parts[0].hourglass.coefficient, 1.0);
+  EXPECT_TRUE(c.warnings.empty());
+  c = kw(with(with(good, "         1         1         1\n", part), "*END",
+              "*HOURGLASS\n         5         9\n*END"));
+  EXPECT_EQ(c.parts[0].hourglass.model, HourglassControl::Model::assumed_strain);
+  EXPECT_EQ(c.parts[0].hourglass.coefficient, 0.1); // LS-DYNA's default QM
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("IHQ 9"), std::string::npos) << c.warnings[0];
+  c = kw(with(with(good, "         1         1         1\n", part), "*END",
+              "*HOURGLASS\n         5         7      0.05\n*END"));
+  EXPECT_EQ(c.parts[0].hourglass.model, HourglassControl::Model::stiffness);
+  EXPECT_EQ(c.parts[0].hourglass.coefficient, 0.05);
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("IHQ 7"), std::string::npos) << c.warnings[0];
+}
+
 TEST(Keyword, ConstraintsVelocitiesContactWalls) {
   const std::string extra = R"(*BOUNDARY_SPC_NODE
         12         0         1         0         0

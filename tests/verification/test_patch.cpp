@@ -157,6 +157,7 @@ TEST_P(Patch, DrivenBoundaryCarriesInteriorAlongHomogeneousDeformation) {
 
 INSTANTIATE_TEST_SUITE_P(Hourglass, Patch,
                          ::testing::Values(HourglassControl::Model::viscous,
-                                           HourglassControl::Model::stiffness));
+                                           HourglassControl::Model::stiffness,
+                                           HourglassControl::Model::assumed_strain));
 
 } // namespace

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <random>
 
@@ -38,6 +39,7 @@ void rotation(const Vec3& a, double t, double (&R)[3][3]) {
 struct RigidRun {
   double max_abs_error = 0; // largest |sigma - R sigma0 R^T| over elements and components
   double scale = 0;
+  double max_hourglass = 0; // largest |Q_i,alpha| (stiffness forms), N
 };
 
 RigidRun spin(const double (&sigma0)[6], HourglassControl::Model hg) {
@@ -97,13 +99,24 @@ RigidRun spin(const double (&sigma0)[6], HourglassControl::Model hg) {
     for (int k = 0; k < 6; ++k)
       out.max_abs_error =
           std::max(out.max_abs_error, std::abs(rig.block.stress[k][e] - expected[k]));
+  for (const auto& q : rig.block.hourglass_force) // empty for the viscous form
+    for (std::size_t e = 0; e < q.size(); ++e)
+      out.max_hourglass = std::max(out.max_hourglass, std::abs(q[e]));
   return out;
 }
 
 TEST(RigidMotion, ZeroStressStaysZeroThrough120Degrees) {
   const double zero[6] = {0, 0, 0, 0, 0, 0};
-  for (auto hg : {HourglassControl::Model::viscous, HourglassControl::Model::stiffness})
-    EXPECT_LT(spin(zero, hg).max_abs_error, 1.0) << "Pa";
+  for (auto hg : {HourglassControl::Model::viscous, HourglassControl::Model::stiffness,
+                  HourglassControl::Model::assumed_strain}) {
+    const RigidRun r = spin(zero, hg);
+    EXPECT_LT(r.max_abs_error, 1.0) << "Pa";
+    // No hourglass force either: at most that of 1 Pa on a 5 mm face (2.5e-5 N).
+    EXPECT_LT(r.max_hourglass, 2.5e-5) << "N";
+    std::printf(
+        "rigid motion, hourglass model %d: largest stress %.2e Pa, hourglass force %.2e N\n",
+        static_cast<int>(hg), r.max_abs_error, r.max_hourglass);
+  }
 }
 
 TEST(RigidMotion, InitialStressRotatesWithTheBody) {

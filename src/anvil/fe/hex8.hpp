@@ -151,6 +151,77 @@ ANVIL_HEX8_INLINE void gamma_spread(const V (&q)[4], V (&out)[8]) {
   out[7] = B - C;
 }
 
+// 8 times the columns of the Jacobian at the centre, J_d = sum_a w_a dN_a/dxi_d at xi = 0,
+// for one coordinate direction of the nodal values w: out = (sum_a xi_a w_a, sum_a eta_a
+// w_a, sum_a zeta_a w_a) with the nodes' natural coordinates +-1 (additions only).
+template <class V>
+ANVIL_HEX8_INLINE void natural_sums(const V (&w)[8], V (&out)[3]) {
+  const V p01 = w[0] + w[1], p23 = w[2] + w[3], p45 = w[4] + w[5], p67 = w[6] + w[7];
+  out[0] = ((w[1] - w[0]) + (w[2] - w[3])) + ((w[5] - w[4]) + (w[6] - w[7]));
+  out[1] = (p23 - p01) + (p67 - p45);
+  out[2] = (p45 + p67) - (p01 + p23);
+}
+
+// The element's co-rotational frame: orthonormal axes e[d] (components e[d][i]) from the
+// centre Jacobian's columns (J[i][d] = 8 dx_i/dxi_d, natural_sums of the positions) by
+// Gram-Schmidt in the order xi, eta, zeta, and the element's extents along them,
+// len[d] = the diagonal of the triangular factor J = e^T R (8 times the half-edges a, b, c
+// of a box; len[0] len[1] len[2] = 64 V on any parallelepiped). The frame rotates with the
+// element, so quantities stored in it are objective.
+template <class V>
+ANVIL_HEX8_INLINE void corotational_frame(const V (&J)[3][3], V (&e)[3][3], V (&len)[3]) {
+  using std::abs;
+  using std::sqrt;
+  const V n0 = sqrt(J[0][0] * J[0][0] + J[1][0] * J[1][0] + J[2][0] * J[2][0]);
+  const V i0 = 1.0 / n0;
+  _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) e[0][i] = J[i][0] * i0;
+  const V p = J[0][1] * e[0][0] + J[1][1] * e[0][1] + J[2][1] * e[0][2];
+  V w[3];
+  _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) w[i] = J[i][1] - p * e[0][i];
+  const V n1 = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+  const V i1 = 1.0 / n1;
+  _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) e[1][i] = w[i] * i1;
+  e[2][0] = e[0][1] * e[1][2] - e[0][2] * e[1][1];
+  e[2][1] = e[0][2] * e[1][0] - e[0][0] * e[1][2];
+  e[2][2] = e[0][0] * e[1][1] - e[0][1] * e[1][0];
+  len[0] = n0;
+  len[1] = n1;
+  len[2] = abs(J[0][2] * e[2][0] + J[1][2] * e[2][1] + J[2][2] * e[2][2]);
+}
+
+// The assumed-strain hourglass stiffness (docs/element.md, "Assumed-strain hourglass
+// control"): the rate r[d][al] = dQ_d,al/dt of the generalized hourglass forces from the
+// hourglass velocities q[d][al] = sum_b v_db gamma_al,b, both in the co-rotational frame
+// (d = 0, 1, 2 along the element's xi, eta, zeta axes; al as gamma_base: eta zeta,
+// xi zeta, xi eta, xi eta zeta). len: the frame's extents (corotational_frame); E and mu:
+// Young's and shear modulus, already scaled by the deck's coefficient. With
+// w = len0 len1 len2 / 192 (= V / 3 on a parallelepiped) and il = 1 / len:
+//   the modes whose field depends on the direction's own coordinate (normal strain, a
+//   beam fibre bending):  r = E w il_d^2 q (al = 0..2), E w il_d^2 q / 3 (al = 3);
+//   the three "twist" modes t = (q[0][0], q[1][1], q[2][2]) (shear only), coupled through
+//   g_xy = t_x il_1 + t_y il_0, g_yz = t_y il_2 + t_z il_1, g_zx = t_z il_0 + t_x il_2:
+//   r[0][0] = mu w (g_xy il_1 + g_zx il_2), r[1][1] = mu w (g_xy il_0 + g_yz il_2),
+//   r[2][2] = mu w (g_yz il_1 + g_zx il_0).
+template <class V>
+ANVIL_HEX8_INLINE void assumed_strain_rate(double E, double mu, const V (&len)[3],
+                                           const V (&q)[3][4], V (&r)[3][4]) {
+  const V i01 = 1.0 / (len[0] * len[1]);
+  const V il[3] = {len[1] * i01, len[0] * i01, 1.0 / len[2]};
+  const V w = (1.0 / 192.0) * len[0] * len[1] * len[2];
+  _Pragma("GCC unroll 3") for (int d = 0; d < 3; ++d) {
+    const V k = (E * w) * (il[d] * il[d]);
+    _Pragma("GCC unroll 3") for (int al = 0; al < 3; ++al) if (al != d) r[d][al] = k * q[d][al];
+    r[d][3] = (1.0 / 3.0) * k * q[d][3];
+  }
+  const V gxy = q[0][0] * il[1] + q[1][1] * il[0];
+  const V gyz = q[1][1] * il[2] + q[2][2] * il[1];
+  const V gzx = q[2][2] * il[0] + q[0][0] * il[2];
+  const V mw = mu * w;
+  r[0][0] = mw * (gxy * il[1] + gzx * il[2]);
+  r[1][1] = mw * (gxy * il[0] + gyz * il[2]);
+  r[2][2] = mw * (gyz * il[1] + gzx * il[0]);
+}
+
 // Hourglass shape vectors gamma_alpha = Gamma_alpha - (1/V)(Gamma_alpha . x_i) B_i, which
 // are orthogonal to every linear velocity field on any shape (the property that lets the
 // element pass the patch test with hourglass control on).

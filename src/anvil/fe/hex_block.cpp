@@ -60,6 +60,9 @@ constexpr int prefetch_ahead = 32; // elements
 constexpr int node_stride = 8;
 
 // Packs nodes [lo, hi) of the nodal arrays into p (node k at p + node_stride k).
+// A template only so that each of detail::block_forces' two instantiations has its own
+// copy, called once and inlined as when hex_forces was the only caller (as gather below).
+template <bool Asq>
 void pack_nodes(const NodalView& n, int lo, int hi, double* __restrict p) {
   const double* __restrict x0 = n.x[0];
   const double* __restrict x1 = n.x[1];
@@ -102,6 +105,7 @@ void pack_nodes(const NodalView& n, int lo, int hi, double* __restrict p) {
 // C, and writes the edge sums of the mid-step positions x - h v (and their x
 // coordinates) to the stage scratch t. conn: the block's eight corner index arrays;
 // ahead: the element to prefetch for.
+template <bool Asq>
 void gather(const int* const (&conn)[8], const double* packed, int e, int ahead, double h,
             double* __restrict xs, double* __restrict vs, double* __restrict t) {
   constexpr int C = HexWorkspace::chunk;
@@ -202,7 +206,7 @@ int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array
   if (material->has_plastic_strain()) plastic_strain.assign(p, 0.0);
   if (material->has_temperature()) temperature.assign(p, material->initial_temperature());
   for (auto& h : hourglass_force) h.clear();
-  if (hourglass.model == HourglassControl::Model::stiffness)
+  if (hourglass.model != HourglassControl::Model::viscous)
     for (auto& h : hourglass_force) h.assign(p, 0.0);
   internal_energy.assign(p, 0.0);
   hourglass_energy.assign(p, 0.0);
@@ -213,14 +217,22 @@ HexWorkspace::HexWorkspace()
     : buf_(static_cast<std::size_t>(s_count) * chunk + static_cast<std::size_t>(t_count) * width,
            0.0) {}
 
-void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corners,
-                HexWorkspace& work, HexResult& result) {
+namespace detail {
+
+// hex_forces for one block, compiled twice: Asq for the assumed-strain hourglass form, and
+// without it for the viscous and stiffness forms, which then run the instructions they
+// ran before that form existed (it is not a branch in their code).
+template <bool Asq>
+void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corners,
+                  HexWorkspace& work, HexResult& result) {
   const int n = b.size();
   constexpr int C = HexWorkspace::chunk;
   auto scratch = [&](int slot) { return work.buf_.data() + static_cast<std::size_t>(slot) * C; };
   const double M = b.material->elastic().plane_wave_modulus();
-  const bool stiff = b.hourglass.model == HourglassControl::Model::stiffness;
+  const bool stiff = !Asq && b.hourglass.model == HourglassControl::Model::stiffness;
   const double hg = b.hourglass.coefficient;
+  [[maybe_unused]] const double hg_E = hg * b.material->elastic().youngs_modulus;
+  [[maybe_unused]] const double hg_mu = hg * b.material->elastic().shear;
   const double c1 = b.bulk_viscosity.linear, c2 = b.bulk_viscosity.quadratic;
   const bool has_ep = !b.plastic_strain.empty(), has_T = !b.temperature.empty();
   const bool erode_ep = b.erosion.plastic_strain > 0 && has_ep;
@@ -231,7 +243,7 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
   // Positions and velocities of the block's nodes, packed per node.
   const std::size_t packed_size = node_stride * static_cast<std::size_t>(b.node_end);
   if (work.nodes_.size() < packed_size) work.nodes_.resize(packed_size); // first calls only
-  pack_nodes(nodes, b.node_begin, b.node_end, work.nodes_.data());
+  pack_nodes<Asq>(nodes, b.node_begin, b.node_end, work.nodes_.data());
   const double* packed = work.nodes_.data();
   const int* conn[8];
   for (int a = 0; a < 8; ++a) conn[a] = b.conn[a].data();
@@ -259,8 +271,8 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
     // rotate the old stress into the new frame.
     for (int l = 0; l < nc; l += width) {
       const int e = e0 + l;
-      gather(conn, packed, e, std::min(e + prefetch_ahead, padded_size(n) - width), 0.5 * dt,
-             scratch(s_x0) + l, scratch(s_v0) + l, t);
+      gather<Asq>(conn, packed, e, std::min(e + prefetch_ahead, padded_size(n) - width), 0.5 * dt,
+                  scratch(s_x0) + l, scratch(s_v0) + l, t);
       simd::stage_barrier();
       // 12 B(x(n-1/2)) one direction at a time, consumed at once: 12 V and 12 V L^T.
       vdouble L[3][3], vol12;
@@ -360,11 +372,12 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       //   q_ia = sum_b v_ib Gamma_ab - G_ij h_aj (the hourglass velocities),
       //   f_ia = -(sigma_ij - q delta_ij - P_ij) B_ja - sum_al Q_i,al Gamma_al,a,
       //   P_ij = sum_al Q_i,al h_al,j.
-      vdouble h[4][3], vg[3][4];
+      vdouble h[4][3], vg[3][4], J[3][3];
       _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) {
         vdouble col[8], out[4];
         _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a) col[a] = xc(a, i, l);
         hex8::gamma_sums(col, out);
+        if constexpr (Asq) hex8::natural_sums(col, J[i]);
         _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al) h[al][i] = out[al] * inv;
         _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a) col[a] = vc(a, i, l);
         hex8::gamma_sums(col, vg[i]);
@@ -373,6 +386,9 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       vdouble hg_power = 0.0;
       const vdouble kv = (0.25 * hg) * rho * c * len * len;
       const vdouble ks = (hg * M / 3.0) * bb * inv;
+      // Assumed strain: the co-rotational axes and extents, and q in those axes.
+      vdouble ax[3][3], extent[3], ql[3][4];
+      if constexpr (Asq) hex8::corotational_frame(J, ax, extent);
       _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al) {
         vdouble qa[3];
         _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) qa[i] =
@@ -389,12 +405,33 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
             simd::store(Qh[i][al], &b.hourglass_force[3 * al + i][e]);
             hg_power += 0.5 * (rot + Qh[i][al]) * qa[i];
           }
+        } else if constexpr (Asq) {
+          _Pragma("GCC unroll 12") for (int d = 0; d < 3; ++d) ql[d][al] =
+              ax[d][0] * qa[0] + ax[d][1] * qa[1] + ax[d][2] * qa[2];
         } else {
           _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) {
             Qh[i][al] = kv * qa[i];
             hg_power += Qh[i][al] * qa[i];
           }
         }
+      }
+      if constexpr (Asq) {
+        // Assumed strain: the generalized forces advance in the co-rotational frame and are
+        // stored in it (so they turn with the element and need no rotation of their own),
+        // then go back to global components for the forces.
+        vdouble r[3][4];
+        hex8::assumed_strain_rate(hg_E, hg_mu, extent, ql, r);
+        _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
+            _Pragma("GCC unroll 12") for (int d = 0; d < 3; ++d) {
+          const vdouble old = simd::load(&b.hourglass_force[3 * al + d][e]);
+          const vdouble now = old + dt * r[d][al];
+          simd::store(now, &b.hourglass_force[3 * al + d][e]);
+          hg_power += 0.5 * (old + now) * ql[d][al];
+          r[d][al] = now;
+        }
+        _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
+            _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) Qh[i][al] =
+                ax[0][i] * r[0][al] + ax[1][i] * r[1][al] + ax[2][i] * r[2][al];
       }
       // -S/12 with S = sigma - q I - P (not symmetric once P is in): the corner forces
       // below are -S B - (hourglass) and the gradient in the scratch is 12 B.
@@ -433,7 +470,7 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
       // element's step, at least that, cannot be the smallest. The step is therefore
       // min(cheap, Gershgorin)'s wherever it matters, on any decomposition.
       vdouble dte;
-      if (!stiff) {
+      if (!stiff && !Asq) {
         const vdouble kr = (0.25 * 8.0) * kv * lc / mass;
         vdouble hh = h[0][0] * h[0][0];
         _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
@@ -451,6 +488,9 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
           dte = lc / (qh + stdx::sqrt(qh * qh + c * c));
         }
       } else {
+        // The stiffness forms take the plain step: their hourglass stiffness raises the
+        // element's largest frequency by under 2% even on warped elements, within the
+        // plain step's margin (test_element_step.cpp, docs/element.md).
         dte = lc / (qv + stdx::sqrt(qv * qv + c * c));
       }
 
@@ -531,6 +571,16 @@ void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corne
   if (stream) simd::stream_fence();
   for (int k = 0; k < width; ++k)
     if (best_e[k] >= 0) take_step(best_dt[k], b.gid[static_cast<std::size_t>(best_e[k])]);
+}
+
+} // namespace detail
+
+void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corners,
+                HexWorkspace& work, HexResult& result) {
+  if (b.hourglass.model == HourglassControl::Model::assumed_strain)
+    detail::block_forces<true>(b, nodes, dt, corners, work, result);
+  else
+    detail::block_forces<false>(b, nodes, dt, corners, work, result);
 }
 
 void hex_volumes(const HexBlock& b, const double* const x[3], std::span<double> out) {

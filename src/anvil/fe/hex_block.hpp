@@ -18,11 +18,14 @@
 namespace anvil {
 
 struct HourglassControl {
-  enum class Model { viscous, stiffness };
+  enum class Model { viscous, stiffness, assumed_strain };
   Model model = Model::viscous;
   // Viscous: Q = coefficient/4 rho c V^(2/3) q (LS-DYNA's scaling of its type 1-3).
   // Stiffness: dQ/dt = coefficient (lambda + 2 mu) (B:B) / (3 V) q (Flanagan-Belytschko).
-  double coefficient = 0.1;
+  // Assumed strain: dQ/dt = coefficient K q in the element's co-rotational frame, K the
+  // physical stiffness of the hourglass modes under the assumed-strain field of
+  // Belytschko and Bindeman (1993) (hex8::assumed_strain_rate, docs/element.md).
+  double coefficient = 0.1; // the deck's default is 1 for assumed_strain
 };
 
 // Artificial bulk viscosity q = rho l (quadratic l |tr D| - linear c) tr D when the
@@ -58,7 +61,10 @@ struct HexBlock {
   std::array<std::vector<double>, 6> stress;           // Cauchy stress, Pa
   std::vector<double> plastic_strain;                  // empty unless the material has it
   std::vector<double> temperature;                     // empty unless the material has it
-  std::array<std::vector<double>, 12> hourglass_force; // Q_i,alpha, stiffness form only
+  std::array<std::vector<double>, 12> hourglass_force; // Q_i,alpha (3 alpha + i), stiffness
+                                                       // forms only: global components for
+                                                       // `stiffness`, co-rotational ones for
+                                                       // `assumed_strain`
   std::vector<double> internal_energy;                 // J, stress work plus bulk viscosity work
   std::vector<double> hourglass_energy;                // J
   std::size_t corner_base = 0;                         // corner (e, a) of this block lives at slot
@@ -113,6 +119,12 @@ struct HexResult {
   std::int64_t eroded = 0;         // elements eroded in this call
 };
 
+class HexWorkspace;
+namespace detail {
+template <bool Asq>
+void block_forces(HexBlock&, const NodalView&, double, CornerView, HexWorkspace&, HexResult&);
+}
+
 // Scratch space reused by every call (the cycle allocates nothing).
 class HexWorkspace {
 public:
@@ -120,8 +132,9 @@ public:
   HexWorkspace();
 
 private:
-  friend void hex_forces(HexBlock&, const NodalView&, double, CornerView, HexWorkspace&,
-                         HexResult&);
+  template <bool Asq>
+  friend void detail::block_forces(HexBlock&, const NodalView&, double, CornerView, HexWorkspace&,
+                                   HexResult&);
   std::vector<double, CacheAligned<double>> buf_;   // chunk and stage scratch
   std::vector<double, CacheAligned<double>> nodes_; // x and v, 8 per node (grows to the
                                                     // largest block's node range)

@@ -373,9 +373,12 @@ PartConfig parse_part(const std::string& name, const Node& n, const std::string&
         p.hourglass.model = HourglassControl::Model::viscous;
       else if (m == "stiffness")
         p.hourglass.model = HourglassControl::Model::stiffness;
-      else
-        h.child("model").fail(
-            fmt::format("unknown hourglass model '{}' (expected viscous or stiffness)", m));
+      else if (m == "assumed_strain") {
+        p.hourglass.model = HourglassControl::Model::assumed_strain;
+        p.hourglass.coefficient = 1.0; // a scale on the physical stiffness
+      } else
+        h.child("model").fail(fmt::format(
+            "unknown hourglass model '{}' (expected viscous, stiffness or assumed_strain)", m));
     }
     if (h.has("coefficient")) {
       const double c = h.child("coefficient").number();

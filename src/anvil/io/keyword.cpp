@@ -1340,7 +1340,14 @@ private:
 
   HourglassControl hourglass_of(std::int64_t ihq, double qm) const {
     HourglassControl h;
-    h.model = ihq >= 4 ? HourglassControl::Model::stiffness : HourglassControl::Model::viscous;
+    // IHQ 1-3: viscous forms; 4, 5, 7 (7 with exact volume integration) and 8 (a shell
+    // form): Flanagan-Belytschko stiffness forms; 6: Belytschko-Bindeman's assumed-strain
+    // physical stabilisation, QM a scale on the physical stiffness (QM = 1 the full
+    // stiffness); 9 and 10 (Puso's and the Cosserat point element's physical forms): the
+    // assumed-strain form. 7-10 are replaced with a warning.
+    h.model = (ihq == 6 || ihq >= 9) ? HourglassControl::Model::assumed_strain
+              : ihq >= 4             ? HourglassControl::Model::stiffness
+                                     : HourglassControl::Model::viscous;
     h.coefficient = qm > 0 ? qm : 0.1; // LS-DYNA's default QM
     return h;
   }
@@ -1550,11 +1557,12 @@ Config KeywordReader::config(const std::string& deck_file) {
       if (h->second.q1 > 0) q1 = h->second.q1;
       if (h->second.q2 > 0) q2 = h->second.q2;
     }
-    if (ihq >= 6)
+    if (ihq >= 7)
       warnings.push_back(fmt::format("{}: part {}: hourglass type IHQ {} is replaced by anvil's "
-                                     "Flanagan-Belytschko stiffness form (IHQ 4) with the same "
-                                     "coefficient",
-                                     p.at.str(), p.pid, ihq));
+                                     "{} with the same coefficient",
+                                     p.at.str(), p.pid, ihq,
+                                     ihq >= 9 ? "assumed-strain form (IHQ 6)"
+                                              : "Flanagan-Belytschko stiffness form (IHQ 4)"));
     pc.hourglass = hourglass_of(ihq, qm);
     if (q1 > 0) pc.bulk_viscosity.quadratic = q1;
     if (q2 > 0) pc.bulk_viscosity.linear = q2;

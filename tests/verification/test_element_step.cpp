@@ -1,0 +1,116 @@
+// The element stable step against the element's largest frequency, for the hourglass
+// forms that add stiffness. Central differences are stable while dt <= 2 / omega_max
+// (e.g. Belytschko, Liu and Moran, "Nonlinear Finite Elements for Continua and
+// Structures", 2000, section 6.3); for one element with lumped mass, omega_max^2 is the
+// largest eigenvalue of M^-1 K. K is the kernel's own: from a zero state, one call with
+// a tiny displacement u (velocity u / dt over dt) gives the stress C eps(u) and the
+// hourglass forces dt dQ/dt, so its corner forces are -K u up to O(|u|^2). Power
+// iteration on u -> M^-1 K u (400 calls) gives omega_max^2 to 1e-6 here. Shapes: a cube,
+// a can-wall element (2.6 x 2.6 x 1), a thin plate element (10 x 10 x 1), a long one
+// (10 x 1 x 1), and distorted ones (every node moved by up to 20% or 40% of the smallest edge).
+// Tolerance: the reported element step times omega_max may not exceed 2 (no margin is
+// taken: the solver's time_step.scale, 0.9 by default, is the margin).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "anvil/mesh/generators.hpp"
+#include "kernel_rig.hpp"
+
+namespace {
+
+using namespace anvil;
+
+struct Shape {
+  const char* name;
+  Vec3 size;
+  double distortion; // node moves, fraction of the smallest edge
+  unsigned seed;
+};
+
+// The largest omega^2 of one element by power iteration on the kernel's forces, and the
+// element step the kernel reports for the undeformed element.
+void probe(const Shape& s, HourglassControl hg, double& omega2, double& dt_element) {
+  Mesh m = generate_box({{0, 0, 0}, s.size, {1, 1, 1}});
+  std::mt19937 rng(s.seed);
+  const double hmin = std::min({s.size.x, s.size.y, s.size.z});
+  std::uniform_real_distribution<double> u(-s.distortion * hmin, s.distortion * hmin);
+  for (auto& p : m.nodes) p += Vec3{u(rng), u(rng), u(rng)};
+  test::KernelRig rig(std::move(m), "elastic", test::elastic_steel(), hg, BulkViscosity{0, 0});
+  const std::size_t nn = rig.fe.node_gid.size();
+  std::array<std::vector<double>, 3> X = rig.x;
+  const double node_mass = rig.block.mass[0] / 8;
+  rig.forces(0.0);
+  dt_element = rig.result.dt_stable;
+
+  std::mt19937 r2(7);
+  std::uniform_real_distribution<double> w(-1, 1);
+  std::vector<double> d(3 * nn);
+  for (double& c : d) c = w(r2);
+  const double dt = 1e-9, amp = 1e-12; // displacement amplitude, m
+  double lambda = 0;
+  for (int it = 0; it < 400; ++it) {
+    double norm = 0;
+    for (double c : d) norm += c * c;
+    norm = std::sqrt(norm);
+    for (double& c : d) c /= norm;
+    for (auto& sk : rig.block.stress) std::fill(sk.begin(), sk.end(), 0.0);
+    for (auto& q : rig.block.hourglass_force) std::fill(q.begin(), q.end(), 0.0);
+    for (std::size_t k = 0; k < nn; ++k)
+      for (int i = 0; i < 3; ++i) {
+        rig.x[i][k] = X[i][k] + amp * d[3 * k + i];
+        rig.v[i][k] = amp * d[3 * k + i] / dt;
+      }
+    rig.forces(dt);
+    double rq = 0;
+    for (std::size_t k = 0; k < nn; ++k)
+      for (int i = 0; i < 3; ++i) {
+        const double a = -rig.f[i][k] / (amp * node_mass);
+        rq += a * d[3 * k + i];
+        d[3 * k + i] = a;
+      }
+    lambda = rq; // Rayleigh quotient of the normalised iterate
+  }
+  omega2 = lambda;
+}
+
+const Shape shapes[] = {
+    {"cube 1 mm", {1e-3, 1e-3, 1e-3}, 0.0, 1},
+    {"can wall 2.6 x 2.6 x 1", {2.6e-3, 2.6e-3, 1e-3}, 0.0, 1},
+    {"plate 10 x 10 x 1", {10e-3, 10e-3, 1e-3}, 0.0, 1},
+    {"bar 10 x 1 x 1", {10e-3, 1e-3, 1e-3}, 0.0, 1},
+    {"distorted cube", {1e-3, 1e-3, 1e-3}, 0.2, 3},
+    {"distorted cube", {1e-3, 1e-3, 1e-3}, 0.2, 4},
+    {"distorted wall", {2.6e-3, 2.6e-3, 1e-3}, 0.2, 5},
+    {"distorted wall", {2.6e-3, 2.6e-3, 1e-3}, 0.2, 6},
+    {"distorted plate", {10e-3, 10e-3, 1e-3}, 0.2, 7},
+    {"warped cube", {1e-3, 1e-3, 1e-3}, 0.4, 8},
+    {"warped wall", {2.6e-3, 2.6e-3, 1e-3}, 0.4, 9},
+    {"warped wall", {2.6e-3, 2.6e-3, 1e-3}, 0.4, 10},
+};
+
+void check(HourglassControl hg, const char* label) {
+  for (const Shape& s : shapes) {
+    double omega2 = 0, dte = 0, omega2_bare = 0, dt_bare = 0;
+    probe(s, hg, omega2, dte);
+    // The same element without hourglass stiffness (viscous form with coefficient 0).
+    probe(s, {HourglassControl::Model::viscous, 0.0}, omega2_bare, dt_bare);
+    const double ratio = dte * std::sqrt(omega2) / 2; // 1 at the stability limit
+    std::printf("%-16s %-24s dt %.3e s, 2/omega_max %.3e s, dt omega_max / 2 = %.3f "
+                "(omega_max / that without hourglass stiffness: %.4f)\n",
+                label, s.name, dte, 2 / std::sqrt(omega2), ratio, std::sqrt(omega2 / omega2_bare));
+    EXPECT_LE(ratio, 1.0) << label << " " << s.name;
+  }
+}
+
+TEST(ElementStep, StableWithAssumedStrainHourglass) {
+  check({HourglassControl::Model::assumed_strain, 1.0}, "assumed_strain 1");
+}
+
+TEST(ElementStep, StableWithStiffnessHourglass) {
+  check({HourglassControl::Model::stiffness, 0.1}, "stiffness 0.1");
+}
+
+} // namespace
