@@ -291,8 +291,9 @@ void find_pairs(const std::vector<ContactNodeItem>& nodes,
   };
   auto holds = [&](int f, const Vec3& p) {
     const auto k = static_cast<std::size_t>(f);
-    return !((p.x < boxes.lo[0][k]) | (p.x > boxes.hi[0][k]) | (p.y < boxes.lo[1][k]) |
-             (p.y > boxes.hi[1][k]) | (p.z < boxes.lo[2][k]) | (p.z > boxes.hi[2][k]));
+    using u = unsigned; // the six tests combined without branches
+    return (u(p.x < boxes.lo[0][k]) | u(p.x > boxes.hi[0][k]) | u(p.y < boxes.lo[1][k]) |
+            u(p.y > boxes.hi[1][k]) | u(p.z < boxes.lo[2][k]) | u(p.z > boxes.hi[2][k])) == 0;
   };
   // Pass 1, node by node: the candidates whose capture box holds the node, then, if there
   // are any, the node's own faces whose box holds it; of the candidates, those that face

@@ -137,8 +137,9 @@ void find_candidates(std::span<const double> x, std::span<const double> y,
           for (int l = 0; l < lanes; ++l) {
             const int j = w.order[static_cast<std::size_t>(k + l)];
             dst[pos] = j;
-            pos += static_cast<std::size_t>(in[l] & (w.gs[static_cast<std::size_t>(k + l)] > gi) &
-                                            (own | (static_cast<std::size_t>(j) < n_own)));
+            using u = std::size_t; // the tests combined without branches
+            pos += u(static_cast<bool>(in[l])) & u(w.gs[static_cast<std::size_t>(k + l)] > gi) &
+                   (u(own) | u(static_cast<std::size_t>(j) < n_own));
           }
         }
       }
