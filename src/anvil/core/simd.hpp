@@ -148,6 +148,20 @@ inline void gather4(const double* p, int stride, const int* idx, vdouble (&out)[
     out[a] = vdouble([&](auto l) { return p[static_cast<std::ptrdiff_t>(stride) * idx[l] + a]; });
 }
 
+#if defined(__AVX__)
+// The 4 x 4 transpose of four AVX vectors: row[l] holds lane l of v[0], v[1], v[2], v[3].
+inline void transpose4(const vdouble (&v)[4], __m256d (&row)[4]) {
+  const __m256d a = static_cast<__m256d>(v[0]), b = static_cast<__m256d>(v[1]);
+  const __m256d c = static_cast<__m256d>(v[2]), d = static_cast<__m256d>(v[3]);
+  const __m256d t0 = _mm256_unpacklo_pd(a, b), t1 = _mm256_unpackhi_pd(a, b);
+  const __m256d t2 = _mm256_unpacklo_pd(c, d), t3 = _mm256_unpackhi_pd(c, d);
+  row[0] = _mm256_permute2f128_pd(t0, t2, 0x20);
+  row[1] = _mm256_permute2f128_pd(t1, t3, 0x20);
+  row[2] = _mm256_permute2f128_pd(t0, t2, 0x31);
+  row[3] = _mm256_permute2f128_pd(t1, t3, 0x31);
+}
+#endif
+
 // The converse of gather4: adds lane l of v[0..3] to the four consecutive doubles at
 // q[l] (32-byte aligned; the caller forms the `width` record addresses once for all the
 // groups it adds: the stores may alias an index array, which would then be read again),
@@ -156,18 +170,9 @@ inline void gather4(const double* p, int stride, const int* idx, vdouble (&out)[
 inline void scatter_add4(double* const* q, const vdouble (&v)[4]) {
 #if defined(__AVX__)
   if constexpr (width == 4) {
-    const __m256d a = static_cast<__m256d>(v[0]), b = static_cast<__m256d>(v[1]);
-    const __m256d c = static_cast<__m256d>(v[2]), d = static_cast<__m256d>(v[3]);
-    const __m256d t0 = _mm256_unpacklo_pd(a, b), t1 = _mm256_unpackhi_pd(a, b);
-    const __m256d t2 = _mm256_unpacklo_pd(c, d), t3 = _mm256_unpackhi_pd(c, d);
-    _mm256_store_pd(q[0],
-                    _mm256_add_pd(_mm256_load_pd(q[0]), _mm256_permute2f128_pd(t0, t2, 0x20)));
-    _mm256_store_pd(q[1],
-                    _mm256_add_pd(_mm256_load_pd(q[1]), _mm256_permute2f128_pd(t1, t3, 0x20)));
-    _mm256_store_pd(q[2],
-                    _mm256_add_pd(_mm256_load_pd(q[2]), _mm256_permute2f128_pd(t0, t2, 0x31)));
-    _mm256_store_pd(q[3],
-                    _mm256_add_pd(_mm256_load_pd(q[3]), _mm256_permute2f128_pd(t1, t3, 0x31)));
+    __m256d row[4];
+    transpose4(v, row);
+    for (int l = 0; l < 4; ++l) _mm256_store_pd(q[l], _mm256_add_pd(_mm256_load_pd(q[l]), row[l]));
     return;
   }
 #endif
@@ -181,15 +186,10 @@ inline void scatter_add4(double* const* q, const vdouble (&v)[4]) {
 inline void lane_sums4(const vdouble (&v)[4], double* out) {
 #if defined(__AVX__)
   if constexpr (width == 4) {
-    const __m256d a = static_cast<__m256d>(v[0]), b = static_cast<__m256d>(v[1]);
-    const __m256d c = static_cast<__m256d>(v[2]), d = static_cast<__m256d>(v[3]);
-    const __m256d t0 = _mm256_unpacklo_pd(a, b), t1 = _mm256_unpackhi_pd(a, b);
-    const __m256d t2 = _mm256_unpacklo_pd(c, d), t3 = _mm256_unpackhi_pd(c, d);
-    const __m256d l0 = _mm256_permute2f128_pd(t0, t2, 0x20); // lane 0 of a, b, c, d
-    const __m256d l1 = _mm256_permute2f128_pd(t1, t3, 0x20);
-    const __m256d l2 = _mm256_permute2f128_pd(t0, t2, 0x31);
-    const __m256d l3 = _mm256_permute2f128_pd(t1, t3, 0x31);
-    _mm256_storeu_pd(out, _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(l0, l1), l2), l3));
+    __m256d row[4];
+    transpose4(v, row);
+    _mm256_storeu_pd(out,
+                     _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(row[0], row[1]), row[2]), row[3]));
     return;
   }
 #endif

@@ -141,6 +141,26 @@ bool uniform(std::span<const SetParams> sets, F field) {
   return true;
 }
 
+// Calls run.template operator()<K, D>() for the kernel and dimension of the model (the
+// passes are instantiated per kernel and dimension; the 1-D Wendland kernel is not there).
+template <class Run>
+void with_kernel(KernelType kernel, int dim, Run& run) {
+  using enum KernelType;
+  if (kernel == cubic_spline) {
+    if (dim == 1)
+      run.template operator()<cubic_spline, 1>();
+    else if (dim == 2)
+      run.template operator()<cubic_spline, 2>();
+    else
+      run.template operator()<cubic_spline, 3>();
+  } else {
+    if (dim == 2)
+      run.template operator()<wendland_c2, 2>();
+    else
+      run.template operator()<wendland_c2, 3>();
+  }
+}
+
 // Lane l: 1 where entry k0 + l is inside the row (k_end its end), else 0.
 inline vdouble valid_lanes(std::int64_t k0, std::int64_t k_end) {
   const vdouble lane([](auto l) { return static_cast<double>(l); });
@@ -384,20 +404,7 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
     else
       kinematics_pairs<K, D, false>(p, sets, dt, w);
   };
-  using enum KernelType;
-  if (kernel == cubic_spline) {
-    if (dim == 1)
-      run.template operator()<cubic_spline, 1>();
-    else if (dim == 2)
-      run.template operator()<cubic_spline, 2>();
-    else
-      run.template operator()<cubic_spline, 3>();
-  } else {
-    if (dim == 2)
-      run.template operator()<wendland_c2, 2>();
-    else
-      run.template operator()<wendland_c2, 3>();
-  }
+  with_kernel(kernel, dim, run);
 
   // Constitutive update through the batch interface, one run of a set's particles at a
   // time (own particles are in ascending gid, so each set is one contiguous run).
@@ -665,20 +672,7 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
     else
       forces_pairs<K, D, false>(p, sets, w, res);
   };
-  using enum KernelType;
-  if (kernel == cubic_spline) {
-    if (dim == 1)
-      run.template operator()<cubic_spline, 1>();
-    else if (dim == 2)
-      run.template operator()<cubic_spline, 2>();
-    else
-      run.template operator()<cubic_spline, 3>();
-  } else {
-    if (dim == 2)
-      run.template operator()<wendland_c2, 2>();
-    else
-      run.template operator()<wendland_c2, 3>();
-  }
+  with_kernel(kernel, dim, run);
 }
 
 } // namespace anvil::sph
