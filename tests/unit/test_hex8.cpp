@@ -285,3 +285,52 @@ TEST(Hex8, AssumedStrainStiffnessHasBeamBendingAndPlateTwist) {
 }
 
 } // namespace
+
+// hex8::assumed_strain_limit against the fully plastic resultants it states: in the
+// frame of a 10 x 6 x 2 mm box (len = 8 x the half-extents, V = len0 len1 len2 / 64), a
+// normal-strain mode's fibre stress is s = 2 Q len_d / V, a shear moment's 2 sqrt(3) T / V,
+// an xi eta zeta mode's 4 Q len_d / V. Exact to round-off (1e-12 relative).
+TEST(Hex8, AssumedStrainPlasticLimit) {
+  const double len[3] = {0.04, 0.024, 0.008};
+  const double V = len[0] * len[1] * len[2] / 64, sy = 250e6;
+  auto fibre = [&](double Q, int d) { return 2 * Q * len[d] / V; };
+  auto force = [&](double s, int d) { return s * V / (2 * len[d]); };
+  // Inside the surface: nothing changes, to the bit.
+  double Q[3][4] = {};
+  Q[0][1] = force(0.5 * sy, 0);
+  Q[1][0] = force(0.4 * sy, 1);
+  Q[2][3] = 0.9 * sy * len[0] * len[1] / 256;
+  double R[3][4];
+  std::copy(&Q[0][0], &Q[0][0] + 12, &R[0][0]);
+  hex8::assumed_strain_limit(sy, len, R);
+  for (int d = 0; d < 3; ++d)
+    for (int al = 0; al < 4; ++al) EXPECT_EQ(R[d][al], Q[d][al]) << d << " " << al;
+  // Uniaxial bending at three times the limit: back to sy, the other groups untouched.
+  double U[3][4] = {};
+  U[0][2] = force(3 * sy, 0);   // sigma_xx varying with eta
+  U[1][2] = force(0.5 * sy, 1); // sigma_yy varying with xi (another group)
+  hex8::assumed_strain_limit(sy, len, U);
+  EXPECT_NEAR(fibre(U[0][2], 0), sy, 1e-12 * sy);
+  EXPECT_EQ(U[1][2], force(0.5 * sy, 1));
+  // Equal biaxial bending (sigma_xx = sigma_yy, both with zeta): von Mises allows sy each.
+  double B[3][4] = {};
+  B[0][1] = force(2 * sy, 0);
+  B[1][0] = force(2 * sy, 1);
+  hex8::assumed_strain_limit(sy, len, B);
+  EXPECT_NEAR(fibre(B[0][1], 0), sy, 1e-12 * sy);
+  EXPECT_NEAR(fibre(B[1][0], 1), sy, 1e-12 * sy);
+  // Twist (tau_xy only, T_xy = 2 x its fully plastic value): Q_x = T il1, Q_y = T il0.
+  const double Tp = sy / std::sqrt(3.0) * V / 2;
+  double W[3][4] = {};
+  W[0][0] = 2 * Tp / len[1];
+  W[1][1] = 2 * Tp / len[0];
+  hex8::assumed_strain_limit(sy, len, W);
+  EXPECT_NEAR(W[0][0], Tp / len[1], 1e-12 * Tp / len[1]);
+  EXPECT_NEAR(W[1][1], Tp / len[0], 1e-12 * Tp / len[0]);
+  EXPECT_NEAR(W[2][2], 0.0, 1e-12 * Tp / len[0]);
+  // The xi eta zeta mode of z, past its limit either way: clipped to 4 |Q| len_2 / V = sy.
+  double P[3][4] = {};
+  P[2][3] = -5 * sy * len[0] * len[1] / 256;
+  hex8::assumed_strain_limit(sy, len, P);
+  EXPECT_NEAR(4 * P[2][3] * len[2] / V, -sy, 1e-12 * sy);
+}

@@ -272,6 +272,15 @@ inline void keep_where(const vmask& m, vdouble& v, double other) {
 inline void keep_where(bool m, double& v, double other) {
   if (!m) v = other;
 }
+// m ? a : b, lane by lane.
+inline vdouble select(const vmask& m, const vdouble& a, const vdouble& b) {
+  vdouble r = b;
+  stdx::where(m, r) = a;
+  return r;
+}
+inline double select(bool m, double a, double b) {
+  return m ? a : b;
+}
 
 } // namespace anvil::simd
 

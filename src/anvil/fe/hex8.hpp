@@ -8,6 +8,8 @@
 #include <array>
 #include <cmath>
 
+#include "anvil/core/simd.hpp"
+
 namespace anvil::hex8 {
 
 // Everything here is small, fixed-size arithmetic: fully unrolled and inlined, so that
@@ -220,6 +222,61 @@ ANVIL_HEX8_INLINE void assumed_strain_rate(double E, double mu, const V (&len)[3
   r[0][0] = mw * (gxy * il[1] + gzx * il[2]);
   r[1][1] = mw * (gxy * il[0] + gyz * il[2]);
   r[2][2] = mw * (gyz * il[1] + gzx * il[0]);
+}
+
+// The plastic limit of the assumed-strain hourglass forces (docs/element.md, "Plastic
+// limit"): Q[d][al] the generalized forces in the co-rotational frame (as r in
+// assumed_strain_rate), len the frame's extents, sy the material's current flow stress.
+// The hourglass stress field's first moments T (T = int sigma c dV, c the coordinate the
+// stress varies with; V = len0 len1 len2 / 64, the frame's box) are
+//   normal-strain modes: T = Q len_d, fully plastic (sigma = +-sy across the section) at
+//   sy V / 2, and sy V / 4 for the xi eta zeta modes (al = 3);
+//   twist modes: Q_twist = A T_s with T_s = (T_xy, T_yz, T_zx), the shear stresses' moments,
+//   A as in assumed_strain_rate (Q_x = T_xy il1 + T_zx il2, ...), fully plastic at
+//   (sy / sqrt 3) V / 2.
+// Written as fibre stresses s = 2 T / V (4 T / V for al = 3; 2 sqrt(3) T / V for shear),
+// which equal sy when fully plastic, the stresses that vary with one coordinate form a
+// group checked with von Mises' criterion, sa^2 - sa sb + sb^2 + ss^2 <= sy^2:
+//   zeta: sigma_xx (d 0, al 1), sigma_yy (1, 0), tau_xy;  eta: sigma_xx (0, 2),
+//   sigma_zz (2, 0), tau_zx;  xi: sigma_yy (1, 2), sigma_zz (2, 1), tau_yz;
+// and a group past it is scaled back onto it (radially). Each xi eta zeta mode is
+// clipped to |s| <= sy on its own. The groups are limited independently, and the
+// one-point stress (the membrane) does not enter: see docs/element.md.
+template <class V>
+ANVIL_HEX8_INLINE void assumed_strain_limit(const V& sy, const V (&len)[3], V (&Q)[3][4]) {
+  using std::sqrt;
+  const V iv = 128.0 / (len[0] * len[1] * len[2]); // 2 / V
+  const V il2 = 1.0 / len[2];
+  // Shear moments from the twist forces (A^-1 Q; det A = 2 il0 il1 il2).
+  const V qx = Q[0][0], qy = Q[1][1], qz = Q[2][2];
+  const V txy = 0.5 * (qx * len[1] + qy * len[0] - qz * (len[0] * len[1] * il2));
+  const V tyz = 0.5 * (qz * len[1] + qy * len[2] - qx * (len[1] * len[2] / len[0]));
+  const V tzx = 0.5 * (qx * len[2] + qz * len[0] - qy * (len[2] * len[0] / len[1]));
+  const V ks = 1.7320508075688772 * iv;
+  const V sy2 = sy * sy;
+  // One group: normal modes (d, al) and (e, be), shear moment t; returns the factor.
+  auto group = [&](int d, int al, int e, int be, const V& t) {
+    const V sa = Q[d][al] * len[d] * iv, sb = Q[e][be] * len[e] * iv, ss = t * ks;
+    const V phi = sa * sa - sa * sb + sb * sb + ss * ss;
+    // Past the surface (then phi > 0): back onto it; else unchanged.
+    const V k = simd::select(phi > sy2, sy / sqrt(phi), V(1.0));
+    Q[d][al] *= k;
+    Q[e][be] *= k;
+    return k;
+  };
+  const V kz = group(0, 1, 1, 0, txy);
+  const V ky = group(0, 2, 2, 0, tzx);
+  const V kx = group(1, 2, 2, 1, tyz);
+  const V sxy = txy * kz, syz = tyz * kx, szx = tzx * ky;
+  const V il0 = 1.0 / len[0], il1 = 1.0 / len[1];
+  const auto scaled = (kz < 1.0) || (ky < 1.0) || (kx < 1.0);
+  Q[0][0] = simd::select(scaled, sxy * il1 + szx * il2, Q[0][0]);
+  Q[1][1] = simd::select(scaled, sxy * il0 + syz * il2, Q[1][1]);
+  Q[2][2] = simd::select(scaled, syz * il1 + szx * il0, Q[2][2]);
+  _Pragma("GCC unroll 3") for (int d = 0; d < 3; ++d) {
+    const V cap = (sy * (1.0 / 256.0)) * (len[(d + 1) % 3] * len[(d + 2) % 3]); // |s| <= sy
+    Q[d][3] = simd::select(Q[d][3] > cap, cap, simd::select(Q[d][3] < -cap, -cap, Q[d][3]));
+  }
 }
 
 // Hourglass shape vectors gamma_alpha = Gamma_alpha - (1/V)(Gamma_alpha . x_i) B_i, which

@@ -29,6 +29,7 @@ enum Slot : int {
   s_power_old, // old (rotated) stress : D
   s_volume_mid,
   s_q0,
+  s_flow = s_q0, // flow stress (assumed strain; s_q* hold the stiffness form's rotation)
   s_q1,
   s_q2,
   s_q3,
@@ -233,6 +234,8 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
   const double hg = b.hourglass.coefficient;
   [[maybe_unused]] const double hg_E = hg * b.material->elastic().youngs_modulus;
   [[maybe_unused]] const double hg_mu = hg * b.material->elastic().shear;
+  // Assumed strain with a material that yields: the plastic limit of the hourglass forces.
+  [[maybe_unused]] const bool limit = Asq && b.material->has_plastic_strain();
   const double c1 = b.bulk_viscosity.linear, c2 = b.bulk_viscosity.quadratic;
   const bool has_ep = !b.plastic_strain.empty(), has_T = !b.temperature.empty();
   const bool erode_ep = b.erosion.plastic_strain > 0 && has_ep;
@@ -322,6 +325,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
     batch.temperature = has_T ? b.temperature.data() + e0 : nullptr;
     batch.wave_speed = scratch(s_wave_speed);
     b.material->update(batch);
+    if (limit) b.material->flow_stress(batch, scratch(s_flow));
 
     // Stage C: forces at x(n): stress divergence, bulk viscosity, hourglass; energies and
     // the stable time step.
@@ -419,15 +423,20 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         // Assumed strain: the generalized forces advance in the co-rotational frame and are
         // stored in it (so they turn with the element and need no rotation of their own),
         // then go back to global components for the forces.
-        vdouble r[3][4];
+        // With a flow stress, the forces are then limited to a fully plastic section's
+        // (hex8::assumed_strain_limit); the work of the forces includes what that dissipates.
+        vdouble r[3][4], old[3][4];
         hex8::assumed_strain_rate(hg_E, hg_mu, extent, ql, r);
         _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
             _Pragma("GCC unroll 12") for (int d = 0; d < 3; ++d) {
-          const vdouble old = simd::load(&b.hourglass_force[3 * al + d][e]);
-          const vdouble now = old + dt * r[d][al];
-          simd::store(now, &b.hourglass_force[3 * al + d][e]);
-          hg_power += 0.5 * (old + now) * ql[d][al];
-          r[d][al] = now;
+          old[d][al] = simd::load(&b.hourglass_force[3 * al + d][e]);
+          r[d][al] = old[d][al] + dt * r[d][al];
+        }
+        if (limit) hex8::assumed_strain_limit(simd::load(scratch(s_flow) + l), extent, r);
+        _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
+            _Pragma("GCC unroll 12") for (int d = 0; d < 3; ++d) {
+          simd::store(r[d][al], &b.hourglass_force[3 * al + d][e]);
+          hg_power += 0.5 * (old[d][al] + r[d][al]) * ql[d][al];
         }
         _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
             _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) Qh[i][al] =

@@ -96,4 +96,8 @@ void J2Plasticity::update(const MaterialBatch& b) const {
   }
 }
 
+void J2Plasticity::flow_stress(const MaterialBatch& b, double* out) const {
+  for (int p = 0; p < b.n; ++p) out[p] = yield_ + hardening_ * b.plastic_strain[p];
+}
+
 } // namespace anvil

@@ -12,6 +12,7 @@ public:
   explicit J2Plasticity(const ParamValues& p);
   void update(const MaterialBatch& b) const override;
   bool has_plastic_strain() const override { return true; }
+  void flow_stress(const MaterialBatch& b, double* out) const override;
   static std::span<const ParamSpec> params();
 
 private:

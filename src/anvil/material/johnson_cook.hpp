@@ -14,6 +14,7 @@ public:
   explicit JohnsonCook(const ParamValues& p);
   void update(const MaterialBatch& b) const override;
   bool has_plastic_strain() const override { return true; }
+  void flow_stress(const MaterialBatch& b, double* out) const override;
   bool has_temperature() const override { return true; }
   double initial_temperature() const override { return room_; }
   static std::span<const ParamSpec> params();

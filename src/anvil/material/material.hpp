@@ -64,6 +64,10 @@ public:
   // Advances the stress of every point in the batch by one step.
   virtual void update(const MaterialBatch& batch) const = 0;
   virtual bool has_plastic_strain() const { return false; }
+  // The current flow (yield) stress of each point after update(), Pa, into out[0..n):
+  // what the assumed-strain hourglass control limits its bending forces with. Models
+  // with plastic strain override it; the others have no yield surface and give +inf.
+  virtual void flow_stress(const MaterialBatch& batch, double* out) const;
   virtual bool has_temperature() const { return false; }
   virtual double initial_temperature() const { return 0; }
   // True when update() reads MaterialBatch::energy (equations of state, gases).

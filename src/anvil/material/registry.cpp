@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "anvil/material/elastic.hpp"
@@ -67,6 +68,9 @@ public:
     }
   }
   bool has_plastic_strain() const override { return strength_->has_plastic_strain(); }
+  void flow_stress(const MaterialBatch& b, double* out) const override {
+    strength_->flow_stress(b, out);
+  }
   bool has_temperature() const override { return strength_->has_temperature(); }
   double initial_temperature() const override { return strength_->initial_temperature(); }
   bool needs_energy() const override { return true; }
@@ -76,6 +80,10 @@ private:
   std::unique_ptr<Eos> eos_;
 };
 } // namespace
+
+void Material::flow_stress(const MaterialBatch& b, double* out) const {
+  std::fill(out, out + b.n, std::numeric_limits<double>::infinity());
+}
 
 std::span<const MaterialModel> material_models() {
   return models();

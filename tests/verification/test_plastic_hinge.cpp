@@ -1,0 +1,121 @@
+// The plastic limit of the assumed-strain hourglass control (docs/element.md, "Plastic
+// limit"): one element through the thickness, bent or twisted far past yield, must carry
+// the fully plastic moment of its section, not an elastic one.
+//
+// One hexahedron of J2 plasticity without hardening (E 200 GPa, nu 0.3, sigma_y 2 MPa: a
+// yield strain of 1e-5, so that at ten times the yield curvature the rotations, and the
+// membrane strains that they bring, stay negligible against it; the references are
+// small-strain theory) is moved through a prescribed motion whose centre strain is zero,
+// so that the one-point stress stays zero and the hourglass forces alone resist it:
+//   pure bending  u_x = -kappa X Z, u_z = kappa X^2 / 2 (curvature kappa about y; the
+//                 element l = 10 mm long, b = 10 mm wide, t = 2 mm thick);
+//   pure twist    u = k (-Y Z, -X Z, X Y) (w = k x y: a plate's twist; 10 x 10 x 2 mm).
+// The moment is the slope of the work done on the element (internal plus hourglass
+// energy, which the kernel accumulates from the forces it applies): dW/dkappa = M l in
+// bending, dW/dk = 2 M_xy A in twist (M_xy per unit width, A = l b). References,
+// elementary plasticity of an elastic-perfectly-plastic rectangular section (e.g. Lubliner,
+// "Plasticity Theory", 1990, section 4.5): elastic M = E I kappa, I = b t^3 / 12; past
+// yield M = M_p (1 - (kappa_y / kappa)^2 / 3), M_p = sigma_y b t^2 / 4, kappa_y =
+// 2 sigma_y / (E t); in twist the same with tau_y = sigma_y / sqrt 3 and shear modulus G:
+// M_xy = G t^3 k / 6 elastic (gamma_xy = 2 k z), M_xy,p = tau_y t^2 / 4, k_y = tau_y / (G t).
+// The element's limit is bilinear (elastic up to the fully plastic moment, reached at 1.5
+// kappa_y, then flat), so the comparison is made where the exact curve is within 0.4% of
+// M_p (10 times the yield curvature) and in the elastic range (half of it).
+// Tolerance: 1% on each moment.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "anvil/mesh/generators.hpp"
+#include "kernel_rig.hpp"
+
+namespace {
+
+using namespace anvil;
+
+constexpr double E = 200e9, nu = 0.3, sy = 2e6;
+
+// Work done on one element (internal plus hourglass energy) along u = s shape(X), s from 0
+// to each of the given values (increasing), in `steps` equal steps per unit of s_max.
+std::vector<double> work_along(Vec3 size, Vec3 (*shape)(const Vec3&), std::vector<double> at,
+                               int steps) {
+  Mesh m = generate_box(
+      {{-size.x / 2, -size.y / 2, -size.z / 2}, {size.x / 2, size.y / 2, size.z / 2}, {1, 1, 1}});
+  const ParamValues steel{{"density", 7850},
+                          {"youngs_modulus", E},
+                          {"poissons_ratio", nu},
+                          {"yield_stress", sy},
+                          {"hardening_modulus", 0.0}};
+  HourglassControl hg;
+  hg.model = HourglassControl::Model::assumed_strain;
+  hg.coefficient = 1.0;
+  test::KernelRig rig(std::move(m), "j2_plasticity", steel, hg, BulkViscosity{0, 0});
+  const std::size_t nn = rig.fe.node_gid.size();
+  const std::array<std::vector<double>, 3> X = rig.x;
+  const double dt = 1e-6, s_max = at.back();
+  const double ds = s_max / steps;
+  std::vector<double> out;
+  rig.forces(0.0);
+  double s = 0;
+  for (double target : at) {
+    while (s < target - 0.5 * ds) {
+      s += ds;
+      for (std::size_t k = 0; k < nn; ++k) {
+        const Vec3 u = shape({X[0][k], X[1][k], X[2][k]});
+        const double un[3] = {u.x, u.y, u.z};
+        for (int i = 0; i < 3; ++i) {
+          const double x_new = X[i][k] + s * un[i];
+          rig.v[i][k] = (x_new - rig.x[i][k]) / dt;
+          rig.x[i][k] = x_new;
+        }
+      }
+      rig.forces(dt);
+    }
+    out.push_back(rig.block.internal_energy[0] + rig.block.hourglass_energy[0]);
+  }
+  return out;
+}
+
+Vec3 bending(const Vec3& X) {
+  return {-X.x * X.z, 0.0, 0.5 * X.x * X.x};
+}
+Vec3 twist(const Vec3& X) {
+  return {-X.y * X.z, -X.x * X.z, X.x * X.y};
+}
+
+TEST(PlasticHinge, OneElementBendsAtTheFullyPlasticMoment) {
+  const double l = 0.01, b = 0.01, t = 0.002;
+  const double I = b * t * t * t / 12, Mp = sy * b * t * t / 4, ky = 2 * sy / (E * t);
+  // Slopes by central differences about 0.5 and 10 kappa_y.
+  const double h = 0.02 * ky;
+  const auto W =
+      work_along({l, b, t}, bending, {0.5 * ky - h, 0.5 * ky + h, 10 * ky - h, 10 * ky + h}, 20000);
+  const double M_el = (W[1] - W[0]) / (2 * h) / l, M_pl = (W[3] - W[2]) / (2 * h) / l;
+  const double M_el_ref = E * I * 0.5 * ky, M_pl_ref = Mp * (1 - 1.0 / 300.0);
+  std::printf("bending: M(0.5 kappa_y) = %.5g N m (E I kappa %.5g, %+.2f%%), M(10 kappa_y) = "
+              "%.5g N m (exact %.5g, %+.2f%%; M_p %.5g)\n",
+              M_el, M_el_ref, 100 * (M_el / M_el_ref - 1), M_pl, M_pl_ref,
+              100 * (M_pl / M_pl_ref - 1), Mp);
+  EXPECT_NEAR(M_el / M_el_ref, 1.0, 0.01);
+  EXPECT_NEAR(M_pl / M_pl_ref, 1.0, 0.01);
+}
+
+TEST(PlasticHinge, OneElementTwistsAtTheFullyPlasticMoment) {
+  const double l = 0.01, b = 0.01, t = 0.002;
+  const double G = E / (2 * (1 + nu)), tau_y = sy / std::sqrt(3.0);
+  const double Mp = tau_y * t * t / 4, ky = tau_y / (G * t), A = l * b;
+  const double h = 0.02 * ky;
+  const auto W =
+      work_along({l, b, t}, twist, {0.5 * ky - h, 0.5 * ky + h, 10 * ky - h, 10 * ky + h}, 20000);
+  const double M_el = (W[1] - W[0]) / (2 * h) / (2 * A), M_pl = (W[3] - W[2]) / (2 * h) / (2 * A);
+  const double M_el_ref = G * t * t * t * 0.5 * ky / 6, M_pl_ref = Mp * (1 - 1.0 / 300.0);
+  std::printf("twist: M_xy(0.5 k_y) = %.5g N (G t^3 k / 6 %.5g, %+.2f%%), M_xy(10 k_y) = %.5g N "
+              "(exact %.5g, %+.2f%%; M_p %.5g)\n",
+              M_el, M_el_ref, 100 * (M_el / M_el_ref - 1), M_pl, M_pl_ref,
+              100 * (M_pl / M_pl_ref - 1), Mp);
+  EXPECT_NEAR(M_el / M_el_ref, 1.0, 0.01);
+  EXPECT_NEAR(M_pl / M_pl_ref, 1.0, 0.01);
+}
+
+} // namespace
