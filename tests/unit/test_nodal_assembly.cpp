@@ -19,7 +19,7 @@ bool same_bits(double a, double b) {
   return std::memcmp(&a, &b, sizeof a) == 0;
 }
 
-// A cylinder (nodes with 1 to 8 corners; an O-grid, so also nodes with 6 or 10) and a
+// A cylinder (an O-grid: nodes with 2, 3, 4, 6 and 8 corners) and a
 // box on its end face as a second block, glued to it: the nodes of the box's bottom face
 // are the cylinder's (both blocks add to them).
 Mesh two_block_mesh() {
@@ -49,10 +49,11 @@ struct Phase {
 };
 
 // Two cycles of the FE phase on rank `rank` of `ranks` (elements dealt round-robin in
-// runs of 5): the forces by gather (assembly = false) or by the kernel's assembly.
+// runs of 24: nodes inside a rank and shared ones): the forces by the gather (assembly =
+// false) or by the kernel's assembly.
 Phase run(const Mesh& mesh, const Material& material, int rank, int ranks, bool assembly) {
   std::vector<int> owner(static_cast<std::size_t>(mesh.num_elements()));
-  for (std::size_t e = 0; e < owner.size(); ++e) owner[e] = static_cast<int>(e / 5) % ranks;
+  for (std::size_t e = 0; e < owner.size(); ++e) owner[e] = static_cast<int>(e / 24) % ranks;
   const FeDecomposition fe = decompose_fe(mesh, owner, rank, ranks);
   const std::size_t nn = fe.node_gid.size();
   std::array<std::vector<double>, 3> x, v;
