@@ -180,6 +180,30 @@ inline void scatter_add4(double* const* q, const vdouble (&v)[4]) {
     for (int a = 0; a < 4; ++a) q[l][a] += v[a][l];
 }
 
+// q[a][c] += f[c][a] for a = 0..3, c = 0..2, record after record (q[a] 32-byte aligned
+// records of four; a record that several q[a] name receives their values in order of a;
+// q[a][3] receives +0.0). Three component rows of four in, one vector add per record out:
+// the bits of the scalar adds.
+inline void add_columns4(double* const (&q)[4], const double* f0, const double* f1,
+                         const double* f2) {
+#if defined(__AVX__)
+  const __m256d a = _mm256_loadu_pd(f0), b = _mm256_loadu_pd(f1), c = _mm256_loadu_pd(f2);
+  const __m256d d = _mm256_setzero_pd();
+  const __m256d t0 = _mm256_unpacklo_pd(a, b), t1 = _mm256_unpackhi_pd(a, b);
+  const __m256d t2 = _mm256_unpacklo_pd(c, d), t3 = _mm256_unpackhi_pd(c, d);
+  const __m256d r[4] = {_mm256_permute2f128_pd(t0, t2, 0x20), _mm256_permute2f128_pd(t1, t3, 0x20),
+                        _mm256_permute2f128_pd(t0, t2, 0x31), _mm256_permute2f128_pd(t1, t3, 0x31)};
+  for (int k = 0; k < 4; ++k) _mm256_store_pd(q[k], _mm256_add_pd(_mm256_load_pd(q[k]), r[k]));
+#else
+  for (int k = 0; k < 4; ++k) {
+    q[k][0] += f0[k];
+    q[k][1] += f1[k];
+    q[k][2] += f2[k];
+    q[k][3] += 0.0;
+  }
+#endif
+}
+
 // out[a] = v[a][0] + v[a][1] + ... + v[a][width - 1], added in lane order (the bits of
 // summing each vector's lanes one after the other). With AVX: one 4 x 4 transpose and
 // three vector adds for the four sums instead of twelve scalar extracts and adds.

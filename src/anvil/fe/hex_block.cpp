@@ -1,5 +1,6 @@
 #include "anvil/fe/hex_block.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -51,7 +52,9 @@ enum Tmp : int {
   t_edge0 = 0,         // 36 edge sums (3 edge + i)
   t_b0 = t_edge0 + 36, // 24 gradient entries 12 B_ia (3 a + i), stage C
   t_xm0 = t_b0 + 24,   // 8 mid-step x coordinates, stage A
-  t_count = t_xm0 + 8
+  t_rows0 = t_xm0 + 8, // corner forces as in the corner slots, 8 per lane, component i
+                       // at (t_rows0 + 8 i) width: nodal assembly without the slots
+  t_count = t_rows0 + 24
 };
 
 constexpr int prefetch_ahead = 32; // elements
@@ -191,6 +194,7 @@ int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array
         node_end = std::max(node_end, k + 1);
       }
   }
+  corner_rows.assign(p / width, 1);
   volume.assign(p, 0.0);
   alive.assign(p, 1.0);
   hex_volumes(*this, x, volume);
@@ -218,6 +222,40 @@ HexWorkspace::HexWorkspace()
     : buf_(static_cast<std::size_t>(s_count) * chunk + static_cast<std::size_t>(t_count) * width,
            0.0) {}
 
+// The sums are zero between assemblies: end_nodal_forces clears what it reads (the lines
+// are in cache then) instead of a separate pass here. Only an assembly left unfinished
+// (an exception in between) leaves values behind, and the next begin clears them.
+void HexWorkspace::begin_nodal_forces(int nodes) {
+  const std::size_t size = 4 * static_cast<std::size_t>(nodes);
+  if (assembled_nodes_ >= 0) std::fill(sums_.begin(), sums_.end(), 0.0);
+  if (sums_.size() < size) sums_.resize(size, 0.0); // first calls only
+  assembled_nodes_ = nodes;
+}
+
+void HexWorkspace::end_nodal_forces(double* const f[3]) {
+  const int nn = std::max(assembled_nodes_, 0);
+  double* q = sums_.data();
+  int k = 0;
+#if defined(__AVX__)
+  if constexpr (width == 4) // four nodes at a time: four loads, the transpose, three stores
+    for (; k + 4 <= nn; k += 4) {
+      double* r = q + 4 * static_cast<std::size_t>(k);
+      const vdouble rows[4] = {vdouble(_mm256_load_pd(r)), vdouble(_mm256_load_pd(r + 4)),
+                               vdouble(_mm256_load_pd(r + 8)), vdouble(_mm256_load_pd(r + 12))};
+      __m256d c[4];
+      simd::transpose4(rows, c);
+      for (int i = 0; i < 3; ++i) _mm256_storeu_pd(f[i] + k, c[i]);
+      for (int j = 0; j < 4; ++j) _mm256_store_pd(r + 4 * j, _mm256_setzero_pd());
+    }
+#endif
+  for (; k < nn; ++k) {
+    double* r = q + 4 * static_cast<std::size_t>(k);
+    for (int i = 0; i < 3; ++i) f[i][k] = r[i];
+    for (int j = 0; j < 4; ++j) r[j] = 0.0;
+  }
+  assembled_nodes_ = -1;
+}
+
 namespace detail {
 
 // hex_forces for one block, compiled twice: Asq for the assumed-strain hourglass form, and
@@ -239,6 +277,9 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
   const double c1 = b.bulk_viscosity.linear, c2 = b.bulk_viscosity.quadratic;
   const bool has_ep = !b.plastic_strain.empty(), has_T = !b.temperature.empty();
   const bool erode_ep = b.erosion.plastic_strain > 0 && has_ep;
+  // Nodal assembly (HexWorkspace::begin_nodal_forces), or null.
+  double* const sums = work.assembled_nodes_ >= 0 ? work.sums_.data() : nullptr;
+  const std::uint8_t* rows = b.corner_rows.data();
   // Non-temporal corner stores need 32-byte aligned rows (every row is if the arrays are).
   bool stream = true;
   for (double* f : corners.f)
@@ -517,7 +558,11 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       // Corner forces f_a = -(S B_a + sum_al Q_al Gamma_al,a), formed and stored one
       // component at a time (the hourglass part of all eight corners comes from four
       // values), with their sum kept for the finiteness check.
+      // With nodal assembly, the rows go to the corner slots only where the block asks for
+      // them (corner_rows) and otherwise to the stage scratch, for the assembly after the
+      // bookkeeping (which may erode an element).
       vdouble check = dte;
+      const bool slots = !sums || rows[e / W] != 0;
       _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) {
         vdouble hgf[8], fa[8];
         hex8::gamma_spread(Qh[i], hgf);
@@ -529,7 +574,9 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         // Element-major slots: the lanes' eight corners are contiguous, whole rows that
         // the gather reads only after the kernel, streamed past the cache when aligned.
         double* row = corners.f[i] + b.corner_base + 8 * static_cast<std::size_t>(e);
-        if (stream)
+        if (!slots)
+          simd::store_transposed(fa, t + (t_rows0 + 8 * i) * W);
+        else if (stream)
           simd::store_transposed<true>(fa, row);
         else
           simd::store_transposed(fa, row);
@@ -544,16 +591,37 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       const auto live = (!dead) && real;
       auto report = !(vol > 0.0) || !(stdx::abs(check) <= std::numeric_limits<double>::max());
       if (erode_ep) report = report || simd::load(&b.plastic_strain[e]) >= b.erosion.plastic_strain;
+      const int lanes = std::min(width, n - e);
+      double* rows_of[3]; // where the rows went (corner slots or stage scratch)
+      _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) rows_of[i] =
+          slots ? corners.f[i] + b.corner_base + 8 * static_cast<std::size_t>(e)
+                : t + (t_rows0 + 8 * i) * W;
+      // Nodal assembly: each real lane's (element's) eight corners in turn, lane after
+      // lane, so that every node receives its corners in ascending (element, corner).
+      auto assemble = [&] {
+        if (!sums) return;
+        if (stream && slots) simd::stream_fence(); // the rows are read back at once
+        for (int k = 0; k < lanes; ++k) {
+          const double* f[3] = {rows_of[0] + 8 * k, rows_of[1] + 8 * k, rows_of[2] + 8 * k};
+          _Pragma("GCC unroll 2") for (int h = 0; h < 8; h += 4) {
+            double* const q[4] = {sums + 4 * static_cast<std::ptrdiff_t>(conn[h][e + k]),
+                                  sums + 4 * static_cast<std::ptrdiff_t>(conn[h + 1][e + k]),
+                                  sums + 4 * static_cast<std::ptrdiff_t>(conn[h + 2][e + k]),
+                                  sums + 4 * static_cast<std::ptrdiff_t>(conn[h + 3][e + k])};
+            simd::add_columns4(q, f[0] + h, f[1] + h, f[2] + h);
+          }
+        }
+      };
       if (stdx::none_of(report && live)) {
         const auto lower = live && dte < best_dt;
         stdx::where(lower, best_dt) = dte;
         stdx::where(lower, best_e) = lane + static_cast<double>(e);
+        assemble();
         continue;
       }
       // The scalar path may overwrite this vector's streamed corner rows (erosion): order
       // the non-temporal stores first.
       if (stream) simd::stream_fence();
-      const int lanes = std::min(width, n - e);
       for (int k = 0; k < lanes; ++k) {
         const std::int64_t id = b.gid[e + k];
         if (b.alive[e + k] == 0.0) continue;
@@ -562,8 +630,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         if (erode) { // delete it now: this cycle's forces already leave it out
           b.alive[e + k] = 0.0;
           for (int a = 0; a < 8; ++a)
-            for (int i = 0; i < 3; ++i)
-              corners.f[i][b.corner_base + 8 * static_cast<std::size_t>(e + k) + a] = 0.0;
+            for (double* r : rows_of) r[8 * k + a] = 0.0;
           for (auto& sk : b.stress) sk[e + k] = 0.0;
           ++result.eroded;
           continue;
@@ -575,6 +642,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         }
         take_step(dte[k], id);
       }
+      assemble();
     }
   }
   if (stream) simd::stream_fence();

@@ -71,6 +71,9 @@ struct HexBlock {
                                                        // corner_base + 8 e + a (element-major)
   int node_begin = 0, node_end = 0;                    // the local nodes the corners refer to
                                                        // lie in [node_begin, node_end)
+  std::vector<std::uint8_t> corner_rows;               // per vector of elements: 1 where the
+                                                       // kernel stores the corner slots (init:
+                                                       // all; see HexWorkspace::begin_nodal_forces)
 
   int size() const { return static_cast<int>(gid.size()); }
 
@@ -125,11 +128,27 @@ template <bool Asq>
 void block_forces(HexBlock&, const NodalView&, double, CornerView, HexWorkspace&, HexResult&);
 }
 
-// Scratch space reused by every call (the cycle allocates nothing).
+// Scratch space reused by every call (the cycle allocates nothing), and the optional
+// nodal assembly in the kernel.
 class HexWorkspace {
 public:
   static constexpr int chunk = 64; // elements per material batch
   HexWorkspace();
+
+  // Nodal assembly in the kernel: between begin_nodal_forces(nodes) and
+  // end_nodal_forces(f), every hex_forces call also adds each element's corner forces to
+  // its nodes (local indices below `nodes`), element after element and corner after
+  // corner (a node's sum starts from +0.0). When the calls come in ascending global
+  // element id, which the blocks of an FeDecomposition in their order do, a node's sum
+  // has the bits of gather_corners' for every node whose corners are all local: the
+  // same additions in the same order, made while the corners are in registers, not
+  // written to the corner slots and read back. The corner slots are then only stored for
+  // the vectors of elements whose HexBlock::corner_rows entry is set (those touching a
+  // node that needs the exchange and gather_corners; all of them unless the caller
+  // clears some). end_nodal_forces writes the sums to f[0..2][0..nodes) and ends the
+  // assembly. The buffer grows on the first call only.
+  void begin_nodal_forces(int nodes);
+  void end_nodal_forces(double* const f[3]);
 
 private:
   template <bool Asq>
@@ -138,6 +157,9 @@ private:
   std::vector<double, CacheAligned<double>> buf_;   // chunk and stage scratch
   std::vector<double, CacheAligned<double>> nodes_; // x and v, 8 per node (grows to the
                                                     // largest block's node range)
+  std::vector<double, CacheAligned<double>> sums_;  // nodal force sums f0 f1 f2 (pad), 4 per
+                                                    // node (zero between assemblies)
+  int assembled_nodes_ = -1;                        // nodes being assembled, or -1: none
 };
 
 // Cycle step 1 for one block: updates stress and state from the velocities over the

@@ -137,8 +137,22 @@ FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, in
   d.gather_ptr.assign(d.node_gid.size() + 1, 0);
   for (std::size_t i = 0; i < d.node_gid.size(); ++i) {
     const auto n = d.node_gid[i];
-    for (auto p = ptr[n]; p < ptr[n + 1]; ++p) d.gather_slot.push_back(slot_of[p]);
+    bool exchanged = false;
+    for (auto p = ptr[n]; p < ptr[n + 1]; ++p) {
+      d.gather_slot.push_back(slot_of[p]);
+      exchanged = exchanged || slot_of[p] >= static_cast<std::int64_t>(d.local_slots);
+    }
     d.gather_ptr[i + 1] = static_cast<int>(d.gather_slot.size());
+    if (exchanged) d.exchanged_nodes.push_back(static_cast<int>(i));
+  }
+  std::vector<std::uint8_t> is_exchanged(d.node_gid.size(), 0);
+  for (int i : d.exchanged_nodes) is_exchanged[static_cast<std::size_t>(i)] = 1;
+  constexpr int W = simd::width;
+  for (auto& b : d.blocks) {
+    b.exchanged_vectors.assign(static_cast<std::size_t>(b.stride / W), 0);
+    for (std::size_t e = 0; e < b.conn.size(); ++e)
+      for (int k : b.conn[e])
+        if (is_exchanged[static_cast<std::size_t>(k)]) b.exchanged_vectors[e / W] = 1;
   }
   return d;
 }
@@ -216,10 +230,12 @@ void NodeExchange::from_owners(std::initializer_list<double*> list) {
 namespace {
 
 // The gather for K components at once: the slot list is read once per node, and each
-// component is summed in slot order (the same bits as K separate passes).
+// component is summed in slot order (the same bits as K separate passes). The nodes are
+// list[0..count) or, with all, every local node.
 template <int K>
-void gather_components(const FeDecomposition& d, const double* const* corner, double* const* out) {
-  const std::size_t nn = d.node_gid.size();
+void gather_components(const FeDecomposition& d, const double* const* corner, double* const* out,
+                       bool all, const int* list, std::size_t count) {
+  const std::size_t nn = all ? d.node_gid.size() : count;
   const int* ptr = d.gather_ptr.data();
   const std::int64_t* slot = d.gather_slot.data();
   const double* src[K];
@@ -228,7 +244,8 @@ void gather_components(const FeDecomposition& d, const double* const* corner, do
     src[c] = corner[c];
     dst[c] = out[c];
   }
-  for (std::size_t n = 0; n < nn; ++n) {
+  for (std::size_t j = 0; j < nn; ++j) {
+    const std::size_t n = all ? j : static_cast<std::size_t>(list[j]);
     double s[K] = {};
     const int p0 = ptr[n], p1 = ptr[n + 1];
     if (p1 - p0 == 8) { // a node inside a hexahedral mesh: unrolled, the same order
@@ -248,14 +265,29 @@ void gather_components(const FeDecomposition& d, const double* const* corner, do
 
 } // namespace
 
-void gather_corners(const FeDecomposition& d, std::initializer_list<const double*> corner,
-                    std::initializer_list<double*> out) {
+namespace {
+
+void gather_list(const FeDecomposition& d, std::initializer_list<const double*> corner,
+                 std::initializer_list<double*> out, bool all, const int* list, std::size_t count) {
   if (corner.size() != out.size())
     throw std::invalid_argument("gather_corners: corner and out lists differ in length");
   std::size_t c = 0;
   for (; c + 3 <= corner.size(); c += 3)
-    gather_components<3>(d, corner.begin() + c, out.begin() + c);
-  for (; c < corner.size(); ++c) gather_components<1>(d, corner.begin() + c, out.begin() + c);
+    gather_components<3>(d, corner.begin() + c, out.begin() + c, all, list, count);
+  for (; c < corner.size(); ++c)
+    gather_components<1>(d, corner.begin() + c, out.begin() + c, all, list, count);
+}
+
+} // namespace
+
+void gather_corners(const FeDecomposition& d, std::initializer_list<const double*> corner,
+                    std::initializer_list<double*> out) {
+  gather_list(d, corner, out, true, nullptr, 0);
+}
+
+void gather_corners(const FeDecomposition& d, std::initializer_list<const double*> corner,
+                    std::initializer_list<double*> out, std::span<const int> nodes) {
+  gather_list(d, corner, out, false, nodes.data(), nodes.size());
 }
 
 } // namespace anvil

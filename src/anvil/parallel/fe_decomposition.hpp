@@ -13,6 +13,7 @@
 #include <array>
 #include <cstdint>
 #include <initializer_list>
+#include <span>
 #include <vector>
 
 #include "anvil/mesh/mesh.hpp"
@@ -35,6 +36,9 @@ struct FeDecomposition {
     // Corners are element-major: an element's eight corners are adjacent (64 bytes per
     // component), so the kernel writes, and the gather reads, few memory streams.
     std::size_t slot(std::size_t e, int a) const { return corner_base + 8 * e + a; }
+    // Per vector of simd::width elements: 1 if one of them touches an exchanged node (its
+    // corner slots are read after the exchange), else 0 (HexBlock::corner_rows).
+    std::vector<std::uint8_t> exchanged_vectors;
   };
   std::vector<Block> blocks; // one per mesh block, possibly empty
 
@@ -42,6 +46,8 @@ struct FeDecomposition {
   std::size_t remote_slots = 0;          // corner slots received from other ranks, after local ones
   std::vector<int> gather_ptr;           // per local node: range in gather_slot (CSR)
   std::vector<std::int64_t> gather_slot; // slots in ascending (element gid, corner)
+  std::vector<int> exchanged_nodes;      // local nodes with remote slots (shared with other
+                                         // ranks), ascending: their sums need the exchange
 
   struct Neighbor {
     int rank = 0;
@@ -98,5 +104,11 @@ private:
 // components are summed in one pass over the slot list (each still in slot order).
 void gather_corners(const FeDecomposition& d, std::initializer_list<const double*> corner,
                     std::initializer_list<double*> out);
+
+// The same for the listed local nodes only (the others' out entries are left alone): with
+// the nodal assembly in the kernel (HexWorkspace::begin_nodal_forces), the gather of
+// d.exchanged_nodes after the exchange completes the nodal forces.
+void gather_corners(const FeDecomposition& d, std::initializer_list<const double*> corner,
+                    std::initializer_list<double*> out, std::span<const int> nodes);
 
 } // namespace anvil

@@ -78,6 +78,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     for (int e = 0; e < hb.size(); ++e)
       for (int a = 0; a < 8; ++a)
         corner_mass[lb.slot(static_cast<std::size_t>(e), a)] = hb.mass[e] / 8;
+    hb.corner_rows = lb.exchanged_vectors; // the other nodes are summed in the kernel
     blocks_.push_back(std::move(hb));
   }
   corner_exchange_->exchange({corner_mass.data()});
@@ -264,8 +265,13 @@ void Simulation::fe_forces() {
                          {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()}};
     const CornerView corners{
         {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()}};
+    // The kernel sums the corner forces of every node in ascending global element id (the
+    // blocks in order); the corner slots it stores are those of the exchanged nodes.
+    workspace_.begin_nodal_forces(static_cast<int>(fe_.node_gid.size()));
     for (auto& b : blocks_)
       if (b.size() > 0) hex_forces(b, view, clock_.dt_prev, corners, workspace_, r);
+    double* const f[3] = {nodes_.f[0].data(), nodes_.f[1].data(), nodes_.f[2].data()};
+    workspace_.end_nodal_forces(f);
     eroded_ += r.eroded;
   }
   {
@@ -294,8 +300,10 @@ void Simulation::fe_forces() {
   }
   {
     ScopedPhase t(timers_, Phase::fe);
+    // The nodes shared with other ranks: the whole sum again, remote corners included.
     gather_corners(fe_, {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()},
-                   {nodes_.f[0].data(), nodes_.f[1].data(), nodes_.f[2].data()});
+                   {nodes_.f[0].data(), nodes_.f[1].data(), nodes_.f[2].data()},
+                   fe_.exchanged_nodes);
   }
 }
 
