@@ -164,11 +164,12 @@ void sph_kinematics(const SphView& v, std::span<const SetParams> sets, KernelTyp
 void sph_forces(const SphView& v, std::span<const SetParams> sets, KernelType kernel,
                 SphWorkspace& work, SphResult& result);
 
-// Smoothing length at density rho: h0 (rho0 / rho)^(1/d) (constant mass in the support).
-inline double smoothing_length(const SetParams& s, double rho) {
-  const double r = s.rho0 / rho;
-  return s.h0 * (s.dimensions == 3 ? std::cbrt(r) : (s.dimensions == 2 ? std::sqrt(r) : r));
-}
+// Smoothing lengths at the densities: h[i] = h0 (rho0 / rho[i])^(1/d) (constant mass in
+// the support) of set[i]'s h0 and rho0, for i < n, simd::width particles at a time (the
+// cube root by simd::cube_root: the same operations and bits for every particle). Every
+// set has the same dimensions d.
+void smoothing_lengths(std::span<const SetParams> sets, const int* set, const double* rho,
+                       std::size_t n, double* h);
 
 // Principal values and axes of a symmetric tensor (xx yy zz xy yz xz) by cyclic Jacobi
 // with a fixed number of sweeps (the same operations for every particle): s = Q diag Q^T,
