@@ -342,31 +342,116 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) w.binv[9 * i + 3 * a + b] = Bi[a][b];
     }
-    double d[6], spin[3];
-    hex8::rate_and_spin(L, d, spin);
-    // Continuity, time-centred: rho(n) = rho(n-1) (1 - tr D dt/2) / (1 + tr D dt/2); or
-    // the summation at x(n) (tied to the particles' spacing: across a shock the
-    // integrated rate drifts from it, and the pressure with it; docs/sph.md, Sod).
-    const double tr = (d[0] + d[1] + d[2]) * dt;
-    if (si.summation) {
-      p.rho[i] = (lower.a[S1::mw] + ls[9]) + p.mass[i] * self_weight<K, D>(pi.h);
-    } else {
-      p.rho[i] = p.rho[i] * (1 - 0.5 * tr) / (1 + 0.5 * tr);
-    }
-    // Objective stress rate: rotate the old stress by Hughes-Winget, as the element does.
-    double Q[3][3], s[6];
-    hex8::hughes_winget(spin, dt, Q);
-    for (int k = 0; k < 6; ++k) s[k] = p.stress[k][i];
-    hex8::rotate_symmetric(Q, s);
-    for (int k = 0; k < 6; ++k) {
-      p.stress[k][i] = s[k];
-      w.d[k][i] = d[k];
-    }
-    const double power =
-        s[0] * d[0] + s[1] * d[1] + s[2] * d[2] + 2 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
-    w.power_old[i] = power;
-    w.energy_pred[i] = p.energy[i] + power * dt / p.rho[i];
+    // The summation density at x(n) (tied to the particles' spacing: across a shock the
+    // integrated rate drifts from it, and the pressure with it; docs/sph.md, Sod); the
+    // continuity equation's density, and the rest, in kinematics_finish.
+    if (si.summation) p.rho[i] = (lower.a[S1::mw] + ls[9]) + p.mass[i] * self_weight<K, D>(pi.h);
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) w.lgrad[3 * a + b][i] = L[a][b];
   }
+}
+
+// The arrays of kinematics_finish, indexed by own particle: in, the velocity gradient
+// (row-major), the old density, stress and energy and (when some set sums its density)
+// 1 where the density is the summation's; out, the density, stress, rate of deformation,
+// the rotated stress's power and the predicted energy.
+struct FinishArrays {
+  const double* lgrad[9];
+  const double* summed; // null: no set sums its density
+  const double* energy;
+  double* rho;
+  double* stress[6];
+  double* d[6];
+  double* power_old;
+  double* energy_pred;
+};
+
+// kinematics_finish for particles i0 .. i0 + width - 1.
+[[gnu::always_inline]] inline void finish_vector(const FinishArrays& a, double dt, std::size_t i0) {
+  vdouble L[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) L[r][c] = simd::load(a.lgrad[3 * r + c] + i0);
+  vdouble d[6], spin[3];
+  hex8::rate_and_spin(L, d, spin);
+  // Continuity, time-centred: rho(n) = rho(n-1) (1 - tr D dt/2) / (1 + tr D dt/2).
+  const vdouble tr = (d[0] + d[1] + d[2]) * dt;
+  const vdouble rho_old = simd::load(a.rho + i0);
+  vdouble rho = rho_old * (1 - 0.5 * tr) / (1 + 0.5 * tr);
+  if (a.summed) stdx::where(simd::load(a.summed + i0) == 1.0, rho) = rho_old;
+  simd::store(rho, a.rho + i0);
+  // Objective stress rate: rotate the old stress by Hughes-Winget, as the element does.
+  vdouble Q[3][3], s[6];
+  hex8::hughes_winget(spin, dt, Q);
+  for (int k = 0; k < 6; ++k) s[k] = simd::load(a.stress[k] + i0);
+  hex8::rotate_symmetric(Q, s);
+  for (int k = 0; k < 6; ++k) {
+    simd::store(s[k], a.stress[k] + i0);
+    simd::store(d[k], a.d[k] + i0);
+  }
+  const vdouble power =
+      s[0] * d[0] + s[1] * d[1] + s[2] * d[2] + 2 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
+  simd::store(power, a.power_old + i0);
+  simd::store(simd::load(a.energy + i0) + power * dt / rho, a.energy_pred + i0);
+}
+
+// The rest of pass 1 for own particles [0, n) from their velocity gradients (w.lgrad),
+// `width` particles at a time: rate of deformation and spin, continuity (sets without
+// the summation density, whose density the rows have set), the old stress rotated by
+// Hughes-Winget as the element does, and its power. The same operations per particle as
+// one at a time (hex8's templates are the element's, for double and vdouble).
+void kinematics_finish(const SphView& p, std::span<const SetParams> sets, double dt,
+                       SphWorkspace& w) {
+  const std::size_t n = p.n_local;
+  bool any_summation = false;
+  for (const auto& st : sets) any_summation = any_summation || st.summation;
+  if (any_summation) {
+    w.summed.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      w.summed[i] = sets[static_cast<std::size_t>(p.set[i])].summation ? 1.0 : 0.0;
+  }
+  FinishArrays a;
+  for (int k = 0; k < 9; ++k) a.lgrad[k] = w.lgrad[k].data();
+  a.summed = any_summation ? w.summed.data() : nullptr;
+  a.energy = p.energy;
+  a.rho = p.rho;
+  for (int k = 0; k < 6; ++k) {
+    a.stress[k] = p.stress[k];
+    a.d[k] = w.d[k].data();
+  }
+  a.power_old = w.power_old.data();
+  a.energy_pred = w.energy_pred.data();
+  std::size_t i0 = 0;
+  for (; i0 + width <= n; i0 += width) finish_vector(a, dt, i0);
+  if (i0 == n) return;
+  // The last particles through a vector's worth of copies (the last one repeated).
+  constexpr int nin = 9 + 1 + 1 + 1 + 6, nout = 1 + 6 + 6 + 2;
+  alignas(32) double in[nin][width], out[nout][width];
+  const double* src[nin] = {a.lgrad[0],  a.lgrad[1],  a.lgrad[2],  a.lgrad[3],  a.lgrad[4],
+                            a.lgrad[5],  a.lgrad[6],  a.lgrad[7],  a.lgrad[8],  a.summed,
+                            a.energy,    a.rho,       a.stress[0], a.stress[1], a.stress[2],
+                            a.stress[3], a.stress[4], a.stress[5]};
+  for (int k = 0; k < nin; ++k)
+    for (int l = 0; l < width; ++l)
+      in[k][l] = src[k] ? src[k][std::min(i0 + static_cast<std::size_t>(l), n - 1)] : 0.0;
+  FinishArrays t;
+  for (int k = 0; k < 9; ++k) t.lgrad[k] = in[k];
+  t.summed = a.summed ? in[9] : nullptr;
+  t.energy = in[10];
+  t.rho = in[11];
+  for (int k = 0; k < 6; ++k) {
+    t.stress[k] = in[12 + k];
+    t.d[k] = out[1 + k];
+  }
+  t.power_old = out[13];
+  t.energy_pred = out[14];
+  finish_vector(t, dt, 0);
+  double* dst[nout] = {a.rho,       a.stress[0], a.stress[1], a.stress[2], a.stress[3],
+                       a.stress[4], a.stress[5], a.d[0],      a.d[1],      a.d[2],
+                       a.d[3],      a.d[4],      a.d[5],      a.power_old, a.energy_pred};
+  const double* res[nout] = {in[11], in[12], in[13], in[14], in[15], in[16],  in[17], out[1],
+                             out[2], out[3], out[4], out[5], out[6], out[13], out[14]};
+  for (int k = 0; k < nout; ++k)
+    for (std::size_t l = 0; i0 + l < n; ++l) dst[k][i0 + l] = res[k][l];
 }
 
 } // namespace
@@ -375,6 +460,7 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
                     const NeighbourList& candidates, double dt, SphWorkspace& w) {
   const std::size_t n = p.n_local;
   for (auto& d : w.d) d.resize(n);
+  for (auto& l : w.lgrad) l.resize(n);
   w.power_old.resize(n);
   w.energy_pred.resize(n);
   bool any_corrected = false;
@@ -405,6 +491,7 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
       kinematics_pairs<K, D, false>(p, sets, dt, w);
   };
   with_kernel(kernel, dim, run);
+  kinematics_finish(p, sets, dt, w);
 
   // Constitutive update through the batch interface, one run of a set's particles at a
   // time (own particles are in ascending gid, so each set is one contiguous run).

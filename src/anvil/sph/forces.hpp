@@ -146,6 +146,8 @@ struct SphWorkspace {
   std::vector<double> dwr, wk;     // per entry of nl: (1/r) dW/dr and (artificial stress) W
   std::vector<LowerSums1> low1;    // per particle (own and ghost), pass 1
   std::vector<LowerSums2> low2;    // and pass 2
+  std::vector<double> lgrad[9];    // velocity gradient of own particles (row-major)
+  std::vector<double> summed;      // 1 where an own particle's set sums its density
   std::vector<double> d[6];        // rate of deformation of own particles
   std::vector<double> binv;        // B^-1 of own particles, 9 per particle (row-major)
   std::vector<double> power_old;   // rotated old stress : D
