@@ -227,9 +227,11 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
   double* dwr_k = w.dwr.data();
   double* wk_k = w.wk.data();
   LowerSums1* low1 = w.low1.data();
+  double* g_row = w.g_row.data();
   bool keep_w = false, any_summation = false;
   for (const auto& st : sets) {
-    keep_w = keep_w || st.epsilon > 0; // pass 2 needs W for the artificial stress
+    // W: pass 2's artificial stress, the rows' sums of the summation density
+    keep_w = keep_w || st.epsilon > 0 || st.summation;
     any_summation = any_summation || st.summation;
   }
   using S1 = LowerSums1;
@@ -250,19 +252,36 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
     const vdouble xi[3] = {pi.x[0], pi.x[1], pi.x[2]}, vi[3] = {pi.v[0], pi.v[1], pi.v[2]};
     const vdouble mi = p.mass[i], vol_i = pi.volume;
     const std::int64_t k_begin = nl.start[r], k_end = k_begin + nl.len[r];
+    // First the kernel of every pair of the row, stored (pass 2 reads it too): a short
+    // loop whose square roots and divisions, independent from one iteration to the next,
+    // the processor overlaps. In one loop with the sums, the chain from the square root
+    // to dwr held back the dozens of products that wait for it (perf, 32^3 cube: a third
+    // of the loop's samples on the instructions after the square root and the division).
     for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
-      const int* idx = index + k0;
-      vdouble q0[4], q1[4];
-      simd::gather4(rdp, stride, idx, q0);     // x, h
-      simd::gather4(rdp + 4, stride, idx, q1); // v, volume
+      vdouble q0[4];
+      simd::gather4(rdp, stride, index + k0, q0); // x, h
       vdouble dx[3];
       for (int a = 0; a < 3; ++a) dx[a] = xi[a] - q0[a];
       const vdouble hb = 0.5 * (pi.h + q0[3]);
       vdouble wk, dwr;
       pair_kernel<K, D>(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2], hb, wk, dwr);
-      const vdouble g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
       simd::store(dwr, dwr_k + k0);
       if (keep_w) simd::store(wk, wk_k + k0);
+      for (int a = 0; a < 3; ++a) simd::store(dwr * dx[a], g_row + 3 * (k0 - k_begin) + a * width);
+    }
+    for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
+      const int* idx = index + k0;
+      vdouble q1[4];
+      simd::gather4(rdp + 4, stride, idx, q1); // v, volume
+      const double* gk = g_row + 3 * (k0 - k_begin);
+      const vdouble g[3] = {simd::load(gk), simd::load(gk + width), simd::load(gk + 2 * width)};
+      const vdouble wk = keep_w ? simd::load(wk_k + k0) : vdouble(0.0);
+      vdouble dx[3] = {0.0, 0.0, 0.0}; // the B sums only
+      if constexpr (Corr) {
+        vdouble q0[4];
+        simd::gather4(rdp, stride, idx, q0); // x, h
+        for (int a = 0; a < 3; ++a) dx[a] = xi[a] - q0[a];
+      }
       // Volume weights V_j = m_j / rho_j: consistent across density jumps (a gas
       // interface, particles of different sets). Particle j's terms are i's with V_i for
       // V_j (grad_j W_ji = -grad_i W_ij and v_i - v_j change sign together).
@@ -478,11 +497,16 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
   }
   filter_neighbours(w.read1.data()->x, sizeof(NeighbourRead1) / sizeof(double), candidates, w.nl);
   w.dwr.resize(static_cast<std::size_t>(w.nl.start.back()));
+  std::int64_t longest = 0;
+  for (const int len : w.nl.len) longest = std::max<std::int64_t>(longest, len);
+  w.g_row.resize(3 * static_cast<std::size_t>(simd::padded_size(static_cast<int>(longest))));
   w.low1.resize(p.n_all);
   std::fill(w.low1.begin(), w.low1.end(), LowerSums1{});
   bool any_epsilon = false;
   for (const auto& st : sets) any_epsilon = any_epsilon || st.epsilon > 0;
-  if (any_epsilon) w.wk.resize(w.dwr.size());
+  bool any_summation = false;
+  for (const auto& st : sets) any_summation = any_summation || st.summation;
+  if (any_epsilon || any_summation) w.wk.resize(w.dwr.size());
   const int dim = sets.empty() ? 3 : sets[0].dimensions;
   auto run = [&]<KernelType K, int D>() {
     if (any_corrected)

@@ -143,8 +143,10 @@ struct SphWorkspace {
   std::vector<NeighbourRead1> read1;
   std::vector<NeighbourRead2> read2;
   NeighbourList nl;                // this step's neighbours (filtered candidates, half lists)
-  std::vector<double> dwr, wk;     // per entry of nl: (1/r) dW/dr and (artificial stress) W
+  std::vector<double> dwr, wk;     // per entry of nl: (1/r) dW/dr and W (artificial stress,
+                                   // summation density)
   std::vector<LowerSums1> low1;    // per particle (own and ghost), pass 1
+  std::vector<double> g_row;       // pass 1: a row's kernel gradients, 3 vectors per entry
   std::vector<LowerSums2> low2;    // and pass 2
   std::vector<double> lgrad[9];    // velocity gradient of own particles (row-major)
   std::vector<double> summed;      // 1 where an own particle's set sums its density
