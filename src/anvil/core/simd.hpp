@@ -182,6 +182,21 @@ inline void scatter_add4(double* const* q, const vdouble (&v)[4]) {
     for (int a = 0; a < 4; ++a) q[l][a] += v[a][l];
 }
 
+// The converse of gather4 without the addition: q[l][a] = v[a][l], a = 0..3 (each q[l]
+// 32-byte aligned). Moves values, no arithmetic.
+inline void scatter4(double* const* q, const vdouble (&v)[4]) {
+#if defined(__AVX__)
+  if constexpr (width == 4) {
+    __m256d row[4];
+    transpose4(v, row);
+    for (int l = 0; l < 4; ++l) _mm256_store_pd(q[l], row[l]);
+    return;
+  }
+#endif
+  for (int l = 0; l < width; ++l)
+    for (int a = 0; a < 4; ++a) q[l][a] = v[a][l];
+}
+
 // out[a] = v[a][0] + v[a][1] + ... + v[a][width - 1], added in lane order (the bits of
 // summing each vector's lanes one after the other). With AVX: one 4 x 4 transpose and
 // three vector adds for the four sums instead of twelve scalar extracts and adds.

@@ -813,7 +813,39 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
   w.read2.resize(p.n_all);
   w.low2.resize(p.n_all);
   std::fill(w.low2.begin(), w.low2.end(), LowerSums2{});
-  for (std::size_t i = 0; i < p.n_all; ++i) {
+  // `width` records at a time: four fields of every record per 4 x 4 transpose.
+  std::size_t i0 = 0;
+  for (; i0 + width <= p.n_all; i0 += width) {
+    double* q[width];
+    for (int l = 0; l < width; ++l) q[l] = w.read2[i0 + static_cast<std::size_t>(l)].a;
+    auto put = [&](int offset, const vdouble& a, const vdouble& b, const vdouble& c,
+                   const vdouble& d) {
+      double* qo[width];
+      for (int l = 0; l < width; ++l) qo[l] = q[l] + offset;
+      simd::scatter4(qo, {a, b, c, d});
+    };
+    auto ld = [&](const double* a) { return simd::load(a + i0); };
+    auto per_set = [&](auto field) {
+      return vdouble([&](auto l) { return field(sets[static_cast<std::size_t>(p.set[i0 + l])]); });
+    };
+    const vdouble rho = ld(p.rho);
+    vdouble R[6];
+    for (int c = 0; c < 6; ++c) R[c] = ld(p.R[c]);
+    const auto any =
+        R[0] != 0.0 || R[1] != 0.0 || R[2] != 0.0 || R[3] != 0.0 || R[4] != 0.0 || R[5] != 0.0;
+    vdouble has_r = 0.0;
+    stdx::where(any, has_r) = 1.0;
+    put(R2::x, ld(p.x[0]), ld(p.x[1]), ld(p.x[2]), ld(p.h));
+    put(R2::v, ld(p.v[0]), ld(p.v[1]), ld(p.v[2]), ld(p.wave_speed));
+    put(R2::S, ld(p.S[0]), ld(p.S[1]), ld(p.S[2]), ld(p.S[3]));
+    put(R2::S45, ld(p.S[4]), ld(p.S[5]), rho, ld(p.mass));
+    put(R2::S6, ld(p.S[6]), ld(p.S[7]), ld(p.S[8]), has_r);
+    put(R2::R, R[0], R[1], R[2], R[3]);
+    put(R2::R45, R[4], R[5], per_set([](const SetParams& st) { return st.alpha; }),
+        per_set([](const SetParams& st) { return st.beta; }));
+    put(R2::inv_rho, 1 / rho, 0.0, 0.0, 0.0);
+  }
+  for (std::size_t i = i0; i < p.n_all; ++i) {
     double* r = w.read2[i].a;
     const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
     for (int a = 0; a < 3; ++a) {
