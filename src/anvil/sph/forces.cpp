@@ -227,9 +227,11 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
   double* dwr_k = w.dwr.data();
   double* wk_k = w.wk.data();
   LowerSums1* low1 = w.low1.data();
+  double* g_row = w.g_row.data();
   bool keep_w = false, any_summation = false;
   for (const auto& st : sets) {
-    keep_w = keep_w || st.epsilon > 0; // pass 2 needs W for the artificial stress
+    // W: pass 2's artificial stress, the rows' sums of the summation density
+    keep_w = keep_w || st.epsilon > 0 || st.summation;
     any_summation = any_summation || st.summation;
   }
   using S1 = LowerSums1;
@@ -250,19 +252,36 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
     const vdouble xi[3] = {pi.x[0], pi.x[1], pi.x[2]}, vi[3] = {pi.v[0], pi.v[1], pi.v[2]};
     const vdouble mi = p.mass[i], vol_i = pi.volume;
     const std::int64_t k_begin = nl.start[r], k_end = k_begin + nl.len[r];
+    // First the kernel of every pair of the row, stored (pass 2 reads it too): a short
+    // loop whose square roots and divisions, independent from one iteration to the next,
+    // the processor overlaps. In one loop with the sums, the chain from the square root
+    // to dwr held back the dozens of products that wait for it (perf, 32^3 cube: a third
+    // of the loop's samples on the instructions after the square root and the division).
     for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
-      const int* idx = index + k0;
-      vdouble q0[4], q1[4];
-      simd::gather4(rdp, stride, idx, q0);     // x, h
-      simd::gather4(rdp + 4, stride, idx, q1); // v, volume
+      vdouble q0[4];
+      simd::gather4(rdp, stride, index + k0, q0); // x, h
       vdouble dx[3];
       for (int a = 0; a < 3; ++a) dx[a] = xi[a] - q0[a];
       const vdouble hb = 0.5 * (pi.h + q0[3]);
       vdouble wk, dwr;
       pair_kernel<K, D>(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2], hb, wk, dwr);
-      const vdouble g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
       simd::store(dwr, dwr_k + k0);
       if (keep_w) simd::store(wk, wk_k + k0);
+      for (int a = 0; a < 3; ++a) simd::store(dwr * dx[a], g_row + 3 * (k0 - k_begin) + a * width);
+    }
+    for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
+      const int* idx = index + k0;
+      vdouble q1[4];
+      simd::gather4(rdp + 4, stride, idx, q1); // v, volume
+      const double* gk = g_row + 3 * (k0 - k_begin);
+      const vdouble g[3] = {simd::load(gk), simd::load(gk + width), simd::load(gk + 2 * width)};
+      const vdouble wk = keep_w ? simd::load(wk_k + k0) : vdouble(0.0);
+      vdouble dx[3] = {0.0, 0.0, 0.0}; // the B sums only
+      if constexpr (Corr) {
+        vdouble q0[4];
+        simd::gather4(rdp, stride, idx, q0); // x, h
+        for (int a = 0; a < 3; ++a) dx[a] = xi[a] - q0[a];
+      }
       // Volume weights V_j = m_j / rho_j: consistent across density jumps (a gas
       // interface, particles of different sets). Particle j's terms are i's with V_i for
       // V_j (grad_j W_ji = -grad_i W_ij and v_i - v_j change sign together).
@@ -342,31 +361,116 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) w.binv[9 * i + 3 * a + b] = Bi[a][b];
     }
-    double d[6], spin[3];
-    hex8::rate_and_spin(L, d, spin);
-    // Continuity, time-centred: rho(n) = rho(n-1) (1 - tr D dt/2) / (1 + tr D dt/2); or
-    // the summation at x(n) (tied to the particles' spacing: across a shock the
-    // integrated rate drifts from it, and the pressure with it; docs/sph.md, Sod).
-    const double tr = (d[0] + d[1] + d[2]) * dt;
-    if (si.summation) {
-      p.rho[i] = (lower.a[S1::mw] + ls[9]) + p.mass[i] * self_weight<K, D>(pi.h);
-    } else {
-      p.rho[i] = p.rho[i] * (1 - 0.5 * tr) / (1 + 0.5 * tr);
-    }
-    // Objective stress rate: rotate the old stress by Hughes-Winget, as the element does.
-    double Q[3][3], s[6];
-    hex8::hughes_winget(spin, dt, Q);
-    for (int k = 0; k < 6; ++k) s[k] = p.stress[k][i];
-    hex8::rotate_symmetric(Q, s);
-    for (int k = 0; k < 6; ++k) {
-      p.stress[k][i] = s[k];
-      w.d[k][i] = d[k];
-    }
-    const double power =
-        s[0] * d[0] + s[1] * d[1] + s[2] * d[2] + 2 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
-    w.power_old[i] = power;
-    w.energy_pred[i] = p.energy[i] + power * dt / p.rho[i];
+    // The summation density at x(n) (tied to the particles' spacing: across a shock the
+    // integrated rate drifts from it, and the pressure with it; docs/sph.md, Sod); the
+    // continuity equation's density, and the rest, in kinematics_finish.
+    if (si.summation) p.rho[i] = (lower.a[S1::mw] + ls[9]) + p.mass[i] * self_weight<K, D>(pi.h);
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) w.lgrad[3 * a + b][i] = L[a][b];
   }
+}
+
+// The arrays of kinematics_finish, indexed by own particle: in, the velocity gradient
+// (row-major), the old density, stress and energy and (when some set sums its density)
+// 1 where the density is the summation's; out, the density, stress, rate of deformation,
+// the rotated stress's power and the predicted energy.
+struct FinishArrays {
+  const double* lgrad[9];
+  const double* summed; // null: no set sums its density
+  const double* energy;
+  double* rho;
+  double* stress[6];
+  double* d[6];
+  double* power_old;
+  double* energy_pred;
+};
+
+// kinematics_finish for particles i0 .. i0 + width - 1.
+[[gnu::always_inline]] inline void finish_vector(const FinishArrays& a, double dt, std::size_t i0) {
+  vdouble L[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) L[r][c] = simd::load(a.lgrad[3 * r + c] + i0);
+  vdouble d[6], spin[3];
+  hex8::rate_and_spin(L, d, spin);
+  // Continuity, time-centred: rho(n) = rho(n-1) (1 - tr D dt/2) / (1 + tr D dt/2).
+  const vdouble tr = (d[0] + d[1] + d[2]) * dt;
+  const vdouble rho_old = simd::load(a.rho + i0);
+  vdouble rho = rho_old * (1 - 0.5 * tr) / (1 + 0.5 * tr);
+  if (a.summed) stdx::where(simd::load(a.summed + i0) == 1.0, rho) = rho_old;
+  simd::store(rho, a.rho + i0);
+  // Objective stress rate: rotate the old stress by Hughes-Winget, as the element does.
+  vdouble Q[3][3], s[6];
+  hex8::hughes_winget(spin, dt, Q);
+  for (int k = 0; k < 6; ++k) s[k] = simd::load(a.stress[k] + i0);
+  hex8::rotate_symmetric(Q, s);
+  for (int k = 0; k < 6; ++k) {
+    simd::store(s[k], a.stress[k] + i0);
+    simd::store(d[k], a.d[k] + i0);
+  }
+  const vdouble power =
+      s[0] * d[0] + s[1] * d[1] + s[2] * d[2] + 2 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
+  simd::store(power, a.power_old + i0);
+  simd::store(simd::load(a.energy + i0) + power * dt / rho, a.energy_pred + i0);
+}
+
+// The rest of pass 1 for own particles [0, n) from their velocity gradients (w.lgrad),
+// `width` particles at a time: rate of deformation and spin, continuity (sets without
+// the summation density, whose density the rows have set), the old stress rotated by
+// Hughes-Winget as the element does, and its power. The same operations per particle as
+// one at a time (hex8's templates are the element's, for double and vdouble).
+void kinematics_finish(const SphView& p, std::span<const SetParams> sets, double dt,
+                       SphWorkspace& w) {
+  const std::size_t n = p.n_local;
+  bool any_summation = false;
+  for (const auto& st : sets) any_summation = any_summation || st.summation;
+  if (any_summation) {
+    w.summed.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      w.summed[i] = sets[static_cast<std::size_t>(p.set[i])].summation ? 1.0 : 0.0;
+  }
+  FinishArrays a;
+  for (int k = 0; k < 9; ++k) a.lgrad[k] = w.lgrad[k].data();
+  a.summed = any_summation ? w.summed.data() : nullptr;
+  a.energy = p.energy;
+  a.rho = p.rho;
+  for (int k = 0; k < 6; ++k) {
+    a.stress[k] = p.stress[k];
+    a.d[k] = w.d[k].data();
+  }
+  a.power_old = w.power_old.data();
+  a.energy_pred = w.energy_pred.data();
+  std::size_t i0 = 0;
+  for (; i0 + width <= n; i0 += width) finish_vector(a, dt, i0);
+  if (i0 == n) return;
+  // The last particles through a vector's worth of copies (the last one repeated).
+  constexpr int nin = 9 + 1 + 1 + 1 + 6, nout = 1 + 6 + 6 + 2;
+  alignas(32) double in[nin][width], out[nout][width];
+  const double* src[nin] = {a.lgrad[0],  a.lgrad[1],  a.lgrad[2],  a.lgrad[3],  a.lgrad[4],
+                            a.lgrad[5],  a.lgrad[6],  a.lgrad[7],  a.lgrad[8],  a.summed,
+                            a.energy,    a.rho,       a.stress[0], a.stress[1], a.stress[2],
+                            a.stress[3], a.stress[4], a.stress[5]};
+  for (int k = 0; k < nin; ++k)
+    for (int l = 0; l < width; ++l)
+      in[k][l] = src[k] ? src[k][std::min(i0 + static_cast<std::size_t>(l), n - 1)] : 0.0;
+  FinishArrays t;
+  for (int k = 0; k < 9; ++k) t.lgrad[k] = in[k];
+  t.summed = a.summed ? in[9] : nullptr;
+  t.energy = in[10];
+  t.rho = in[11];
+  for (int k = 0; k < 6; ++k) {
+    t.stress[k] = in[12 + k];
+    t.d[k] = out[1 + k];
+  }
+  t.power_old = out[13];
+  t.energy_pred = out[14];
+  finish_vector(t, dt, 0);
+  double* dst[nout] = {a.rho,       a.stress[0], a.stress[1], a.stress[2], a.stress[3],
+                       a.stress[4], a.stress[5], a.d[0],      a.d[1],      a.d[2],
+                       a.d[3],      a.d[4],      a.d[5],      a.power_old, a.energy_pred};
+  const double* res[nout] = {in[11], in[12], in[13], in[14], in[15], in[16],  in[17], out[1],
+                             out[2], out[3], out[4], out[5], out[6], out[13], out[14]};
+  for (int k = 0; k < nout; ++k)
+    for (std::size_t l = 0; i0 + l < n; ++l) dst[k][i0 + l] = res[k][l];
 }
 
 } // namespace
@@ -375,6 +479,7 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
                     const NeighbourList& candidates, double dt, SphWorkspace& w) {
   const std::size_t n = p.n_local;
   for (auto& d : w.d) d.resize(n);
+  for (auto& l : w.lgrad) l.resize(n);
   w.power_old.resize(n);
   w.energy_pred.resize(n);
   bool any_corrected = false;
@@ -392,11 +497,22 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
   }
   filter_neighbours(w.read1.data()->x, sizeof(NeighbourRead1) / sizeof(double), candidates, w.nl);
   w.dwr.resize(static_cast<std::size_t>(w.nl.start.back()));
+  std::int64_t longest = 0;
+  for (const int len : w.nl.len) longest = std::max<std::int64_t>(longest, len);
+  w.g_row.resize(3 * static_cast<std::size_t>(simd::padded_size(static_cast<int>(longest))));
   w.low1.resize(p.n_all);
-  std::fill(w.low1.begin(), w.low1.end(), LowerSums1{});
+  // Zeros by vector stores (std::fill copied the 160-byte value by a call to memcpy per
+  // particle; a plain loop becomes one memset, which callgrind counts by the byte).
+  constexpr int nl1 = sizeof(LowerSums1::a) / sizeof(double), nv1 = nl1 / width * width;
+  for (LowerSums1& ls : w.low1) {
+    for (int k = 0; k < nv1; k += width) simd::store(0.0, ls.a + k);
+    for (int k = nv1; k < nl1; ++k) ls.a[k] = 0.0;
+  }
   bool any_epsilon = false;
   for (const auto& st : sets) any_epsilon = any_epsilon || st.epsilon > 0;
-  if (any_epsilon) w.wk.resize(w.dwr.size());
+  bool any_summation = false;
+  for (const auto& st : sets) any_summation = any_summation || st.summation;
+  if (any_epsilon || any_summation) w.wk.resize(w.dwr.size());
   const int dim = sets.empty() ? 3 : sets[0].dimensions;
   auto run = [&]<KernelType K, int D>() {
     if (any_corrected)
@@ -405,6 +521,7 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
       kinematics_pairs<K, D, false>(p, sets, dt, w);
   };
   with_kernel(kernel, dim, run);
+  kinematics_finish(p, sets, dt, w);
 
   // Constitutive update through the batch interface, one run of a set's particles at a
   // time (own particles are in ascending gid, so each set is one contiguous run).
@@ -429,7 +546,36 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
     i0 = i1;
   }
 
-  for (std::size_t i = 0; i < n; ++i) {
+  // The energy, time-centred, and pass 2's stress P and artificial stress R: `width`
+  // particles at a time where none normalises its gradient or has an artificial stress
+  // (P = sigma, R = 0: the same operations per particle), else one at a time.
+  auto plain = [&](std::size_t i) {
+    const SetParams& st = sets[static_cast<std::size_t>(p.set[i])];
+    return !st.corrected && !(st.epsilon > 0);
+  };
+  for (std::size_t i = 0; i < n;) {
+    bool vector = i + width <= n;
+    for (int l = 0; l < width && vector; ++l) vector = plain(i + static_cast<std::size_t>(l));
+    if (vector) {
+      vdouble s[6], d[6];
+      for (int k = 0; k < 6; ++k) {
+        s[k] = simd::load(p.stress[k] + i);
+        d[k] = simd::load(w.d[k].data() + i);
+      }
+      const vdouble power =
+          s[0] * d[0] + s[1] * d[1] + s[2] * d[2] + 2 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
+      const vdouble rho = simd::load(p.rho + i);
+      simd::store(simd::load(p.energy + i) +
+                      0.5 * (simd::load(w.power_old.data() + i) + power) * dt / rho,
+                  p.energy + i);
+      for (int k = 0; k < 6; ++k) {
+        simd::store(s[k], p.S[k] + i);
+        simd::store(0.0, p.R[k] + i);
+      }
+      for (int k = 6; k < 9; ++k) simd::store(s[k - 3], p.S[k] + i);
+      i += width;
+      continue;
+    }
     const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
     double s[6];
     for (int k = 0; k < 6; ++k) s[k] = p.stress[k][i];
@@ -457,6 +603,7 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
     double R[6] = {0, 0, 0, 0, 0, 0};
     if (si.epsilon > 0) artificial_stress(s, si.epsilon, R);
     for (int k = 0; k < 6; ++k) p.R[k][i] = R[k];
+    ++i;
   }
 }
 
@@ -633,13 +780,78 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
 
 } // namespace
 
+void smoothing_lengths(std::span<const SetParams> sets, const int* set, const double* rho,
+                       std::size_t n, double* h) {
+  if (n == 0) return;
+  const int dim = sets[0].dimensions;
+  auto lengths = [dim](const vdouble& rho0, const vdouble& h0, const vdouble& rho_v) {
+    const vdouble r = rho0 / rho_v;
+    return h0 * (dim == 3 ? simd::cube_root(r) : (dim == 2 ? stdx::sqrt(r) : r));
+  };
+  std::size_t i0 = 0;
+  for (; i0 + width <= n; i0 += width) {
+    const int s0 = set[i0];
+    bool one_set = true;
+    for (int l = 1; l < width; ++l) one_set = one_set && set[i0 + l] == s0;
+    vdouble rho0, h0;
+    if (one_set) { // the usual case: sets are runs of ascending gid
+      rho0 = sets[static_cast<std::size_t>(s0)].rho0;
+      h0 = sets[static_cast<std::size_t>(s0)].h0;
+    } else {
+      rho0 = vdouble([&](auto l) { return sets[static_cast<std::size_t>(set[i0 + l])].rho0; });
+      h0 = vdouble([&](auto l) { return sets[static_cast<std::size_t>(set[i0 + l])].h0; });
+    }
+    simd::store(lengths(rho0, h0, simd::load(rho + i0)), h + i0);
+  }
+  if (i0 < n) { // the last particles, repeated in the unused lanes
+    auto at = [&](auto l) { return std::min(i0 + static_cast<std::size_t>(l), n - 1); };
+    const vdouble hv =
+        lengths(vdouble([&](auto l) { return sets[static_cast<std::size_t>(set[at(l)])].rho0; }),
+                vdouble([&](auto l) { return sets[static_cast<std::size_t>(set[at(l)])].h0; }),
+                vdouble([&](auto l) { return rho[at(l)]; }));
+    for (std::size_t l = 0; i0 + l < n; ++l) h[i0 + l] = hv[l];
+  }
+}
+
 void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType kernel,
                 SphWorkspace& w, SphResult& res) {
   using R2 = NeighbourRead2;
   w.read2.resize(p.n_all);
   w.low2.resize(p.n_all);
   std::fill(w.low2.begin(), w.low2.end(), LowerSums2{});
-  for (std::size_t i = 0; i < p.n_all; ++i) {
+  // `width` records at a time: four fields of every record per 4 x 4 transpose.
+  std::size_t i0 = 0;
+  for (; i0 + width <= p.n_all; i0 += width) {
+    double* q[width];
+    for (int l = 0; l < width; ++l) q[l] = w.read2[i0 + static_cast<std::size_t>(l)].a;
+    auto put = [&](int offset, const vdouble& a, const vdouble& b, const vdouble& c,
+                   const vdouble& d) {
+      double* qo[width];
+      for (int l = 0; l < width; ++l) qo[l] = q[l] + offset;
+      simd::scatter4(qo, {a, b, c, d});
+    };
+    auto ld = [&](const double* a) { return simd::load(a + i0); };
+    auto per_set = [&](auto field) {
+      return vdouble([&](auto l) { return field(sets[static_cast<std::size_t>(p.set[i0 + l])]); });
+    };
+    const vdouble rho = ld(p.rho);
+    vdouble R[6];
+    for (int c = 0; c < 6; ++c) R[c] = ld(p.R[c]);
+    const auto any =
+        R[0] != 0.0 || R[1] != 0.0 || R[2] != 0.0 || R[3] != 0.0 || R[4] != 0.0 || R[5] != 0.0;
+    vdouble has_r = 0.0;
+    stdx::where(any, has_r) = 1.0;
+    put(R2::x, ld(p.x[0]), ld(p.x[1]), ld(p.x[2]), ld(p.h));
+    put(R2::v, ld(p.v[0]), ld(p.v[1]), ld(p.v[2]), ld(p.wave_speed));
+    put(R2::S, ld(p.S[0]), ld(p.S[1]), ld(p.S[2]), ld(p.S[3]));
+    put(R2::S45, ld(p.S[4]), ld(p.S[5]), rho, ld(p.mass));
+    put(R2::S6, ld(p.S[6]), ld(p.S[7]), ld(p.S[8]), has_r);
+    put(R2::R, R[0], R[1], R[2], R[3]);
+    put(R2::R45, R[4], R[5], per_set([](const SetParams& st) { return st.alpha; }),
+        per_set([](const SetParams& st) { return st.beta; }));
+    put(R2::inv_rho, 1 / rho, 0.0, 0.0, 0.0);
+  }
+  for (std::size_t i = i0; i < p.n_all; ++i) {
     double* r = w.read2[i].a;
     const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
     for (int a = 0; a < 3; ++a) {

@@ -143,9 +143,13 @@ struct SphWorkspace {
   std::vector<NeighbourRead1> read1;
   std::vector<NeighbourRead2> read2;
   NeighbourList nl;                // this step's neighbours (filtered candidates, half lists)
-  std::vector<double> dwr, wk;     // per entry of nl: (1/r) dW/dr and (artificial stress) W
+  std::vector<double> dwr, wk;     // per entry of nl: (1/r) dW/dr and W (artificial stress,
+                                   // summation density)
   std::vector<LowerSums1> low1;    // per particle (own and ghost), pass 1
+  std::vector<double> g_row;       // pass 1: a row's kernel gradients, 3 vectors per entry
   std::vector<LowerSums2> low2;    // and pass 2
+  std::vector<double> lgrad[9];    // velocity gradient of own particles (row-major)
+  std::vector<double> summed;      // 1 where an own particle's set sums its density
   std::vector<double> d[6];        // rate of deformation of own particles
   std::vector<double> binv;        // B^-1 of own particles, 9 per particle (row-major)
   std::vector<double> power_old;   // rotated old stress : D
@@ -164,11 +168,12 @@ void sph_kinematics(const SphView& v, std::span<const SetParams> sets, KernelTyp
 void sph_forces(const SphView& v, std::span<const SetParams> sets, KernelType kernel,
                 SphWorkspace& work, SphResult& result);
 
-// Smoothing length at density rho: h0 (rho0 / rho)^(1/d) (constant mass in the support).
-inline double smoothing_length(const SetParams& s, double rho) {
-  const double r = s.rho0 / rho;
-  return s.h0 * (s.dimensions == 3 ? std::cbrt(r) : (s.dimensions == 2 ? std::sqrt(r) : r));
-}
+// Smoothing lengths at the densities: h[i] = h0 (rho0 / rho[i])^(1/d) (constant mass in
+// the support) of set[i]'s h0 and rho0, for i < n, simd::width particles at a time (the
+// cube root by simd::cube_root: the same operations and bits for every particle). Every
+// set has the same dimensions d.
+void smoothing_lengths(std::span<const SetParams> sets, const int* set, const double* rho,
+                       std::size_t n, double* h);
 
 // Principal values and axes of a symmetric tensor (xx yy zz xy yz xz) by cyclic Jacobi
 // with a fixed number of sweeps (the same operations for every particle): s = Q diag Q^T,

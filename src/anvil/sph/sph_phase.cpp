@@ -388,8 +388,7 @@ void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
     result_ = SphResult{};
     sph_forces(view, sets_, kernel_, work_, result_);
     resize_neighbour_fields(n);
-    for (std::size_t i = 0; i < n; ++i)
-      p_.h[i] = smoothing_length(sets_[static_cast<std::size_t>(p_.set[i])], p_.rho[i]);
+    smoothing_lengths(sets_, p_.set.data(), p_.rho.data(), n, p_.h.data());
     stats_.seconds_compute += seconds_since(t0);
   }
 }
