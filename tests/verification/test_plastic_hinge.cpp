@@ -35,6 +35,7 @@ namespace {
 using namespace anvil;
 
 constexpr double E = 200e9, nu = 0.3, sy = 2e6;
+constexpr double l = 0.01, b = 0.01, t = 0.002; // the element: length, width, thickness
 
 // Work done on one element (internal plus hourglass energy) along u = s shape(X), s from 0
 // to each of the given values (increasing), in `steps` equal steps per unit of s_max.
@@ -84,38 +85,34 @@ Vec3 twist(const Vec3& X) {
   return {-X.y * X.z, -X.x * X.z, X.x * X.y};
 }
 
-TEST(PlasticHinge, OneElementBendsAtTheFullyPlasticMoment) {
-  const double l = 0.01, b = 0.01, t = 0.002;
-  const double I = b * t * t * t / 12, Mp = sy * b * t * t / 4, ky = 2 * sy / (E * t);
-  // Slopes by central differences about 0.5 and 10 kappa_y.
+// The moments at half and ten times the yield value k_y of the load parameter (central
+// differences of the work, step 0.02 k_y, divided by `per`: the work per unit moment and
+// load), against the elastic moment at half of it (el_ref) and the exact
+// elastic-perfectly-plastic moment at ten times it, M_p (1 - 1/300).
+void check_moments(const char* name, Vec3 (*shape)(const Vec3&), double ky, double per,
+                   double el_ref, double Mp) {
   const double h = 0.02 * ky;
   const auto W =
-      work_along({l, b, t}, bending, {0.5 * ky - h, 0.5 * ky + h, 10 * ky - h, 10 * ky + h}, 20000);
-  const double M_el = (W[1] - W[0]) / (2 * h) / l, M_pl = (W[3] - W[2]) / (2 * h) / l;
-  const double M_el_ref = E * I * 0.5 * ky, M_pl_ref = Mp * (1 - 1.0 / 300.0);
-  std::printf("bending: M(0.5 kappa_y) = %.5g N m (E I kappa %.5g, %+.2f%%), M(10 kappa_y) = "
-              "%.5g N m (exact %.5g, %+.2f%%; M_p %.5g)\n",
-              M_el, M_el_ref, 100 * (M_el / M_el_ref - 1), M_pl, M_pl_ref,
-              100 * (M_pl / M_pl_ref - 1), Mp);
-  EXPECT_NEAR(M_el / M_el_ref, 1.0, 0.01);
-  EXPECT_NEAR(M_pl / M_pl_ref, 1.0, 0.01);
+      work_along({l, b, t}, shape, {0.5 * ky - h, 0.5 * ky + h, 10 * ky - h, 10 * ky + h}, 20000);
+  const double M_el = (W[1] - W[0]) / (2 * h) / per, M_pl = (W[3] - W[2]) / (2 * h) / per;
+  const double pl_ref = Mp * (1 - 1.0 / 300.0);
+  std::printf("%s: M(0.5 k_y) = %.5g (elastic %.5g, %+.2f%%), M(10 k_y) = %.5g (exact %.5g, "
+              "%+.2f%%; M_p %.5g)\n",
+              name, M_el, el_ref, 100 * (M_el / el_ref - 1), M_pl, pl_ref,
+              100 * (M_pl / pl_ref - 1), Mp);
+  EXPECT_NEAR(M_el / el_ref, 1.0, 0.01);
+  EXPECT_NEAR(M_pl / pl_ref, 1.0, 0.01);
+}
+
+TEST(PlasticHinge, OneElementBendsAtTheFullyPlasticMoment) {
+  const double I = b * t * t * t / 12, ky = 2 * sy / (E * t);
+  check_moments("bending (N m)", bending, ky, l, E * I * 0.5 * ky, sy * b * t * t / 4);
 }
 
 TEST(PlasticHinge, OneElementTwistsAtTheFullyPlasticMoment) {
-  const double l = 0.01, b = 0.01, t = 0.002;
-  const double G = E / (2 * (1 + nu)), tau_y = sy / std::sqrt(3.0);
-  const double Mp = tau_y * t * t / 4, ky = tau_y / (G * t), A = l * b;
-  const double h = 0.02 * ky;
-  const auto W =
-      work_along({l, b, t}, twist, {0.5 * ky - h, 0.5 * ky + h, 10 * ky - h, 10 * ky + h}, 20000);
-  const double M_el = (W[1] - W[0]) / (2 * h) / (2 * A), M_pl = (W[3] - W[2]) / (2 * h) / (2 * A);
-  const double M_el_ref = G * t * t * t * 0.5 * ky / 6, M_pl_ref = Mp * (1 - 1.0 / 300.0);
-  std::printf("twist: M_xy(0.5 k_y) = %.5g N (G t^3 k / 6 %.5g, %+.2f%%), M_xy(10 k_y) = %.5g N "
-              "(exact %.5g, %+.2f%%; M_p %.5g)\n",
-              M_el, M_el_ref, 100 * (M_el / M_el_ref - 1), M_pl, M_pl_ref,
-              100 * (M_pl / M_pl_ref - 1), Mp);
-  EXPECT_NEAR(M_el / M_el_ref, 1.0, 0.01);
-  EXPECT_NEAR(M_pl / M_pl_ref, 1.0, 0.01);
+  const double G = E / (2 * (1 + nu)), tau_y = sy / std::sqrt(3.0), ky = tau_y / (G * t);
+  check_moments("twist (N m per m)", twist, ky, 2 * l * b, G * t * t * t * 0.5 * ky / 6,
+                tau_y * t * t / 4);
 }
 
 } // namespace
