@@ -418,11 +418,10 @@ struct FinishArrays {
 // the summation density, whose density the rows have set), the old stress rotated by
 // Hughes-Winget as the element does, and its power. The same operations per particle as
 // one at a time (hex8's templates are the element's, for double and vdouble).
+// any_summation: some set sums its density.
 void kinematics_finish(const SphView& p, std::span<const SetParams> sets, double dt,
-                       SphWorkspace& w) {
+                       bool any_summation, SphWorkspace& w) {
   const std::size_t n = p.n_local;
-  bool any_summation = false;
-  for (const auto& st : sets) any_summation = any_summation || st.summation;
   if (any_summation) {
     w.summed.resize(n);
     for (std::size_t i = 0; i < n; ++i)
@@ -521,7 +520,7 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
       kinematics_pairs<K, D, false>(p, sets, dt, w);
   };
   with_kernel(kernel, dim, run);
-  kinematics_finish(p, sets, dt, w);
+  kinematics_finish(p, sets, dt, any_summation, w);
 
   // Constitutive update through the batch interface, one run of a set's particles at a
   // time (own particles are in ascending gid, so each set is one contiguous run).
