@@ -43,7 +43,9 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
   for (auto gid : surf.contact_nodes) {
     const int l = local(gid);
     if (l >= 0 && fe.node_owned[l]) my_nodes_.push_back(l);
+    if (l >= 0) force_nodes_.push_back(l);
   }
+  std::sort(force_nodes_.begin(), force_nodes_.end());
   // Faces of owned elements, with the penalty stiffness k = scale K A^2 / V and the
   // contact depth fraction V / A of their element, from the initial geometry.
   const auto offsets = mesh.block_offsets();
@@ -584,9 +586,19 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
   bool bound_ok = false;   // several ranks: this rank's items are within their budgets
   {
     ScopedPhase t(timers, Phase::transfer);
-    for (std::size_t k = 0; k < surf_local_.size(); ++k) {
-      const auto l = static_cast<std::size_t>(surf_local_[k]);
-      for (int i = 0; i < 3; ++i) xs_[i][k] = nd.x[i][l] + dt * nd.v[i][l];
+    const std::size_t np = surf_local_.size();
+    if (np == fe_.node_gid.size()) { // every local node is a surface point (point k is node k)
+      for (int i = 0; i < 3; ++i) {
+        const double *x = nd.x[i], *v = nd.v[i];
+        double* out = xs_[i].data();
+#pragma omp simd
+        for (std::size_t k = 0; k < np; ++k) out[k] = x[k] + dt * v[k];
+      }
+    } else {
+      for (std::size_t k = 0; k < np; ++k) {
+        const auto l = static_cast<std::size_t>(surf_local_[k]);
+        for (int i = 0; i < 3; ++i) xs_[i][k] = nd.x[i][l] + dt * nd.v[i][l];
+      }
     }
     for (std::size_t f = 0; f < nf; ++f) live += alive(f) ? 1 : 0;
     // While the bound shows the candidate lists valid (and, on several ranks, the
@@ -601,7 +613,11 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       if (bound_ok && !fail_.empty()) bound_ok = rebase_faces();
     }
     if (!lazy_cycle && !bound_ok) compute_captures(corners(), cap_);
-    if (!bound_ok) {
+    if (lazy_cycle) {
+      // One rank, the lists valid: the search reads the nodes with candidates only (in
+      // place: the item of node k is node_out_[k]).
+      for (int k : search_.active) pack_node(static_cast<std::size_t>(k), nd, node_out_[k]);
+    } else if (!bound_ok) {
       node_out_.resize(my_nodes_.size());
       for (std::size_t k = 0; k < my_nodes_.size(); ++k) pack_node(k, nd, node_out_[k]);
       node_out_.insert(node_out_.end(), extra_.begin(), extra_.end());
@@ -804,7 +820,14 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
 
 void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers) {
   const std::size_t nn = fe_.node_gid.size();
-  for (int i = 0; i < 3; ++i) std::fill(nd.force[i], nd.force[i] + nn, 0.0);
+  // Only contact nodes receive forces (the owners' sums below, their copies through the
+  // exchange); every other entry stays at the zero the caller keeps there.
+  if (force_nodes_.size() == nn) { // (every node is on the surface: a thin wall)
+    for (int i = 0; i < 3; ++i) std::fill(nd.force[i], nd.force[i] + nn, 0.0);
+  } else {
+    for (int l : force_nodes_)
+      for (int i = 0; i < 3; ++i) nd.force[i][l] = 0.0;
+  }
   {
     ScopedPhase t(timers, Phase::contact_force);
     force_out_.clear();

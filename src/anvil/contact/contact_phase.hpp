@@ -60,7 +60,10 @@ struct ContactNodes {
   const double* x[3]; // positions at t(n)
   const double* v[3]; // predicted velocities v(n+1/2)
   const double* mass;
-  double* force[3]; // out: contact force per local node (N), zero where none
+  // out: contact force per local node (N). forces() writes the entries of
+  // ContactPhase::force_nodes() only (zero where no pair acts); the caller keeps the others
+  // at zero.
+  double* force[3];
 };
 
 class ContactPhase {
@@ -89,6 +92,9 @@ public:
   std::span<const std::int64_t> extra_faces() const { return extra_face_; }
 
   const ContactStats& stats() const { return stats_; }
+  // Local indices, ascending, of the nodes that a contact force can act on here: the
+  // contact nodes this rank holds, owned or not. forces() writes nodes.force there only.
+  std::span<const int> force_nodes() const { return force_nodes_; }
   // Contact history per local node (meaningful on the node's owner): the face it touched
   // last cycle (-1 for none) and its allowance. For checkpoints; set_history restores it.
   const std::vector<std::int64_t>& last_face() const { return last_face_; }
@@ -123,6 +129,7 @@ private:
 
   // FE side (this rank): contact nodes it owns and faces of elements it owns.
   std::vector<int> my_nodes_;           // local node indices
+  std::vector<int> force_nodes_;        // every local contact node, owned or not, ascending
   std::vector<std::int64_t> last_face_; // per local node: face contacted last cycle
   std::vector<double> allowance_;       // per local node: penetration allowed without force
   std::vector<double> gathered_;        // forces(): four values per rank, all-gathered

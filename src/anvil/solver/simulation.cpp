@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "anvil/contact/rigid_wall.hpp"
+#include "anvil/core/simd.hpp"
 #include "anvil/io/checkpoint.hpp"
 #include "anvil/parallel/graph_partition.hpp"
 #include "anvil/solver/model.hpp"
@@ -307,6 +308,27 @@ void Simulation::fe_forces() {
   }
 }
 
+namespace {
+
+// Central difference for the velocity of one node, or of a vector of nodes: v(n+1/2) from
+// old = v(n-1/2) and the force f, or the prescribed velocity bc in the directions where
+// `fixed` holds; returns 1/2 m |v(n)|^2 with v(n) the mean of the two half-step
+// velocities. One template for the vector body and the scalar rest: the same operations.
+template <class V, class Mask>
+V advance_velocity(const V (&old)[3], const V (&f)[3], const V (&bc)[3], const Mask (&fixed)[3],
+                   const V& m, double dt_avg, V (&nv)[3]) {
+  const V inv_m = 1.0 / m;
+  V avg2 = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    nv[i] = simd::select(fixed[i], bc[i], old[i] + dt_avg * f[i] * inv_m);
+    const V a = 0.5 * (old[i] + nv[i]);
+    avg2 += a * a;
+  }
+  return 0.5 * m * avg2;
+}
+
+} // namespace
+
 void Simulation::predict() {
   ScopedPhase t(timers_, Phase::predict);
   double dt = config_.time_step_scale * dt_stable_;
@@ -362,18 +384,45 @@ void Simulation::predict() {
   const double* m = nodes_.mass.data();
   const std::uint8_t* owned = fe_.node_owned.data();
   const std::uint8_t* fixed = constrained_.data();
-  for (std::size_t n = 0; n < nn; ++n) {
-    const double inv_m = 1.0 / m[n];
-    double avg2 = 0;
+  // simd::width nodes at a time (the vector body), then one at a time (the rest): the
+  // same operations, so the same bits. The kinetic energy is summed node after node.
+  constexpr auto W = static_cast<std::size_t>(simd::width);
+  std::size_t n = 0;
+  for (; n + W <= nn; n += W) {
+    simd::vdouble old[3], force[3], bc[3], nv[3];
+    simd::vmask fx[3] = {simd::vmask(false), simd::vmask(false), simd::vmask(false)};
+    unsigned any = 0;
+    for (std::size_t l = 0; l < W; ++l) any |= fixed[n + l];
     for (int i = 0; i < 3; ++i) {
-      const double old = v[i][n];
-      v_prev[i][n] = old;
-      const double nv = (fixed[n] & (1u << i)) ? v_bc_[i][n] : old + dt_avg * f[i][n] * inv_m;
-      v[i][n] = nv;
-      const double a = 0.5 * (old + nv);
-      avg2 += a * a;
+      old[i] = simd::load(v[i] + n);
+      force[i] = simd::load(f[i] + n);
+      bc[i] = simd::load(v_bc_[i].data() + n);
+      if (any != 0)
+        fx[i] = simd::vdouble([&](auto l) { return double((fixed[n + l] >> i) & 1u); }) != 0.0;
     }
-    if (owned[n]) ke += 0.5 * m[n] * avg2;
+    const simd::vdouble e = advance_velocity(old, force, bc, fx, simd::load(m + n), dt_avg, nv);
+    for (int i = 0; i < 3; ++i) {
+      simd::store(old[i], v_prev[i] + n);
+      simd::store(nv[i], v[i] + n);
+    }
+    for (std::size_t l = 0; l < W; ++l)
+      if (owned[n + l]) ke += e[static_cast<int>(l)];
+  }
+  for (; n < nn; ++n) {
+    double old[3], force[3], bc[3], nv[3];
+    bool fx[3];
+    for (int i = 0; i < 3; ++i) {
+      old[i] = v[i][n];
+      force[i] = f[i][n];
+      bc[i] = v_bc_[i][n];
+      fx[i] = ((fixed[n] >> i) & 1u) != 0;
+    }
+    const double e = advance_velocity(old, force, bc, fx, m[n], dt_avg, nv);
+    for (int i = 0; i < 3; ++i) {
+      v_prev[i][n] = old[i];
+      v[i][n] = nv[i];
+    }
+    if (owned[n]) ke += e;
   }
   if (sph_) predict_particles(dt_avg, ke, work);
   external_work_ += work;
@@ -432,8 +481,13 @@ void Simulation::correct() {
     // The penalty impulse acts over the velocity step: dv = dt_avg f / m. Its work is the
     // impulse times the mean of the step's start and end velocities (attributing the
     // kinetic energy change of the step exactly among the impulses that make it).
+    // Only the contact nodes can carry a force (ascending: the sums' order is that of a
+    // pass over every node).
     double work = 0, reaction = 0;
-    for (std::size_t n = 0; n < nodes_.size(); ++n) {
+    for (const int l : contact_->force_nodes()) {
+      const auto n = static_cast<std::size_t>(l);
+      if (contact_force_[0][n] == 0.0 && contact_force_[1][n] == 0.0 && contact_force_[2][n] == 0.0)
+        continue; // most nodes: no pair acts on them
       const double inv_m = dt_avg_ / nodes_.mass[n];
       for (int i = 0; i < 3; ++i) {
         const double f = contact_force_[i][n];
