@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
     ok &= same("node contact faces", a.node_face, b.node_face, 1);
     ok &= same("element ids", a.element_gid, b.element_gid, 1);
     ok &= same("elements", a.element_data, b.element_data, Checkpoint::element_values);
+    ok &= same("eroded elements", a.element_eroded, b.element_eroded, 1);
     ok &= same("particle ids", a.particle_gid, b.particle_gid, 1);
     ok &= same("particles", a.particle_data, b.particle_data, Checkpoint::particle_values);
     ok &= same("particle contact faces", a.particle_face, b.particle_face, 1);

@@ -1,6 +1,7 @@
-// The checkpoint file format (io/checkpoint.hpp): a version 2 file keeps every section
-// bit for bit, particles and both .pvd lists included; a version 1 file (written before
-// particles were checkpointed) still reads, as a model without particles; a file whose
+// The checkpoint file format (io/checkpoint.hpp): a version 3 file keeps every section
+// bit for bit, particles, eroded elements and both .pvd lists included; a version 1 file
+// (written before particles and erosion were checkpointed) still reads, as a model without
+// particles whose elements are all alive; a file whose
 // sections disagree is an InputError naming it. The restart itself is tested end to end
 // by tests/regression (test_restart.sh, test_restart_sph.sh).
 #include <gtest/gtest.h>
@@ -49,6 +50,7 @@ Checkpoint sample() {
   c.model_elements = 1;
   c.element_gid = {0};
   for (int k = 0; k < Checkpoint::element_values; ++k) c.element_data.push_back(k / 7.0);
+  c.element_eroded = {1};
   c.model_particles = 3;
   c.particle_gid = {0, 1, 2};
   for (int k = 0; k < 3 * Checkpoint::particle_values; ++k)
@@ -102,6 +104,7 @@ TEST(Checkpoint, RoundTripKeepsParticlesAndBothSeries) {
   EXPECT_EQ(std::memcmp(&r.time, &c.time, sizeof c.time), 0);
   EXPECT_TRUE(same_bits(r.node_data, c.node_data));
   EXPECT_TRUE(same_bits(r.element_data, c.element_data));
+  EXPECT_EQ(r.element_eroded, c.element_eroded);
   EXPECT_EQ(r.model_particles, 3);
   EXPECT_TRUE(same_bits(r.particle_gid, c.particle_gid));
   EXPECT_TRUE(same_bits(r.particle_data, c.particle_data));
@@ -119,6 +122,7 @@ TEST(Checkpoint, VersionOneReadsWithoutParticles) {
   EXPECT_EQ(std::memcmp(&r.dt_prev, &c.dt_prev, sizeof c.dt_prev), 0);
   EXPECT_TRUE(same_bits(r.node_data, c.node_data));
   EXPECT_TRUE(same_bits(r.element_data, c.element_data));
+  EXPECT_EQ(r.element_eroded, std::vector<std::int64_t>{0});
   EXPECT_EQ(r.outputs.pvd, c.outputs.pvd);
   EXPECT_EQ(r.model_particles, 0);
   EXPECT_TRUE(r.particle_gid.empty());

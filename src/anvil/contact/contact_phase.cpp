@@ -600,7 +600,15 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
         for (int i = 0; i < 3; ++i) xs_[i][k] = nd.x[i][l] + dt * nd.v[i][l];
       }
     }
-    for (std::size_t f = 0; f < nf; ++f) live += alive(f) ? 1 : 0;
+    // The faces alive: counted again only when some element has eroded since.
+    std::int64_t eroded = 0;
+    for (const auto& b : blocks_) eroded += b.eroded;
+    if (eroded != eroded_seen_) {
+      live_ = 0;
+      for (std::size_t f = 0; f < nf; ++f) live_ += alive(f) ? 1 : 0;
+      eroded_seen_ = eroded;
+    }
+    live = live_;
     // While the bound shows the candidate lists valid (and, on several ranks, the
     // ghosting), only the faces some list reads need their box (below); otherwise every
     // face gets it.

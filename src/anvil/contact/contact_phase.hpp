@@ -140,6 +140,8 @@ private:
   std::vector<std::pair<std::int64_t, int>> my_face_element_; // (element gid, side)
   std::vector<std::pair<int, int>> my_face_slot_;             // (block, element index) of each face
   std::vector<int> my_face_rank_; // contact rank of the centroid, last cycle
+  std::size_t live_ = 0;          // faces alive (of elements not eroded)
+  std::int64_t eroded_seen_ = -1; // the blocks' eroded elements when live_ was counted
   // The surface's points on this rank: the owned contact nodes and the corners of the
   // faces above (local node indices, ascending), with their predicted positions, computed
   // once a cycle; the nodes' and the faces' corners as indices into them.

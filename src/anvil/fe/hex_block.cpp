@@ -629,6 +629,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
                            (erode_ep && b.plastic_strain[e + k] >= b.erosion.plastic_strain);
         if (erode) { // delete it now: this cycle's forces already leave it out
           b.alive[e + k] = 0.0;
+          ++b.eroded;
           for (int a = 0; a < 8; ++a)
             for (double* r : rows_of) r[8 * k + a] = 0.0;
           for (auto& sk : b.stress) sk[e + k] = 0.0;

@@ -58,6 +58,7 @@ struct HexBlock {
   std::vector<double> mass;                            // kg
   std::vector<double> volume;                          // current volume, m^3
   std::vector<double> alive;                           // 1, or 0 once eroded
+  std::int64_t eroded = 0;                             // elements with alive 0
   std::array<std::vector<double>, 6> stress;           // Cauchy stress, Pa
   std::vector<double> plastic_strain;                  // empty unless the material has it
   std::vector<double> temperature;                     // empty unless the material has it

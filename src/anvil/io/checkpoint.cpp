@@ -18,8 +18,10 @@ namespace {
 
 // The format's version is the magic's last character. Version 2 added the particle
 // sections after the element sections and the header keys model_particles and
-// particle_pvd; version 1 files (no particles) still load.
-constexpr char magic[8] = {'A', 'N', 'V', 'I', 'L', 'C', 'K', '2'};
+// particle_pvd; version 3 the eroded flag of every element, after the particle sections
+// (erosion survives a restart). Files of versions 1 (no particles) and 2 still load, with
+// every element alive.
+constexpr char magic[8] = {'A', 'N', 'V', 'I', 'L', 'C', 'K', '3'};
 constexpr std::size_t magic_version = 7;
 
 // Sends this rank's records to rank 0, which keeps them in ascending global id.
@@ -130,11 +132,10 @@ Checkpoint capture(const Simulation& sim, const OutputState& outputs) {
       data.push_back(b.hourglass_energy[e]);
       for (int k = 0; k < 12; ++k)
         data.push_back(b.hourglass_force[k].empty() ? 0.0 : b.hourglass_force[k][e]);
-      face.push_back(0);
+      face.push_back(b.alive[e] == 0.0 ? 1 : 0);
     }
-  std::vector<std::int64_t> unused;
   gather_sorted<Checkpoint::element_values>(comm, gid, data, face, c.element_gid, c.element_data,
-                                            unused);
+                                            c.element_eroded);
   if (const sph::SphPhase* sph = sim.sph()) {
     c.model_particles = sph->global_count();
     gid.clear();
@@ -201,6 +202,7 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
   put(s, c.particle_gid);
   put(s, c.particle_data);
   put(s, c.particle_face);
+  put(s, c.element_eroded);
   write_file_atomic(path, s);
 }
 
@@ -213,8 +215,8 @@ Checkpoint read_checkpoint(const std::string& path) {
   if (s.size() < sizeof magic || std::memcmp(s.data(), magic, magic_version) != 0)
     throw InputError("'" + path + "' is not an anvil checkpoint");
   const char version = s[magic_version];
-  if (version != '1' && version != '2')
-    throw InputError(fmt::format("checkpoint '{}' has format version {}; this anvil reads 1 and 2",
+  if (version < '1' || version > '3')
+    throw InputError(fmt::format("checkpoint '{}' has format version {}; this anvil reads 1 to 3",
                                  path, version));
   std::size_t pos = sizeof magic;
   Checkpoint c;
@@ -234,6 +236,10 @@ Checkpoint read_checkpoint(const std::string& path) {
     get(s, pos, c.particle_data, path);
     get(s, pos, c.particle_face, path);
   }
+  if (version >= '3')
+    get(s, pos, c.element_eroded, path);
+  else // earlier versions did not record erosion: every element alive
+    c.element_eroded.assign(c.element_gid.size(), 0);
   try {
     const auto h = nlohmann::json::parse(std::string(header.begin(), header.end()));
     c.deck = h.at("deck").get<std::string>();
@@ -254,6 +260,7 @@ Checkpoint read_checkpoint(const std::string& path) {
       c.node_data.size() != c.node_gid.size() * Checkpoint::node_values ||
       c.node_face.size() != c.node_gid.size() ||
       c.element_data.size() != c.element_gid.size() * Checkpoint::element_values ||
+      c.element_eroded.size() != c.element_gid.size() ||
       c.particle_data.size() != c.particle_gid.size() * Checkpoint::particle_values ||
       c.particle_face.size() != c.particle_gid.size() ||
       c.model_particles != static_cast<std::int64_t>(c.particle_gid.size()))

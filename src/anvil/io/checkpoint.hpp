@@ -41,6 +41,7 @@ struct Checkpoint {
   std::vector<std::int64_t> node_face;              // contact history: last face per node
   std::vector<std::int64_t> element_gid;            // ascending
   std::vector<double> element_data;                 // element_values per element
+  std::vector<std::int64_t> element_eroded;         // 1 for an eroded element (version 3)
   std::vector<std::int64_t> particle_gid;           // ascending (empty without particles)
   std::vector<double> particle_data;                // particle_values per particle
   std::vector<std::int64_t> particle_face;          // contact history: last face per particle

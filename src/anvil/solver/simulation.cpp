@@ -634,7 +634,15 @@ void Simulation::restore(const Checkpoint& c) {
       b.hourglass_energy[e] = d[9];
       for (int j = 0; j < 12; ++j)
         if (!b.hourglass_force[j].empty()) b.hourglass_force[j][e] = d[10 + j];
+      b.alive[e] = c.element_eroded[static_cast<std::size_t>(k)] != 0 ? 0.0 : 1.0;
     }
+  // The eroded elements (padding lanes stay alive, as HexBlock::init made them).
+  eroded_ = 0;
+  for (auto& b : blocks_) {
+    b.eroded = 0;
+    for (int e = 0; e < b.size(); ++e) b.eroded += b.alive[e] == 0.0 ? 1 : 0;
+    eroded_ += b.eroded;
+  }
   // The padding lanes of each block repeat its last element (see HexBlock::init).
   for (auto& b : blocks_) {
     const int n = b.size();
