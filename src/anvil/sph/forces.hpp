@@ -111,16 +111,22 @@ struct alignas(64) NeighbourRead1 {
   double x[3], h;
   double v[3], volume; // m / rho
 };
-// Pass 2's record, by offsets (groups of four): the common path reads the first four
-// groups (x, h; v, c; S0-S3; S4, S5, rho, m: every value a pair needs without a
-// normalised gradient or an artificial stress; a neighbour's 1/rho is divided in the
-// loop, the same bits as the row particle's inv_rho), a normalised gradient the fifth
-// (S6-S8), the artificial stress the fifth (has_r), sixth and seventh, sets of
-// different viscosity the seventh (alpha, beta).
+// Pass 2's record, by offsets (groups of four), in two arrays so that the loop's common
+// path reads only the first, 128 bytes per neighbour (the whole record was 256 bytes: at
+// 32^3 particles the records of the +2 lattice planes a sweep of rows reads no longer fit
+// in a 1 MB L2 cache). NeighbourRead2: x, h; v, c; S0-S3; S4, S5, rho, m: every value a
+// pair needs without a normalised gradient or an artificial stress (a neighbour's 1/rho
+// is divided in the loop, the same bits as the row particle's inv_rho).
+// NeighbourRead2Rest: a normalised gradient reads the first group (S6-S8), the artificial
+// stress the first (has_r), second and third, sets of different viscosity the third
+// (alpha, beta); the row particle reads its own alpha, beta and inv_rho.
 struct alignas(64) NeighbourRead2 {
-  static constexpr int x = 0, h = 3, v = 4, c = 7, S = 8, S45 = 12, rho = 14, mass = 15, S6 = 16,
-                       has_r = 19, R = 20, R45 = 24, alpha = 26, beta = 27, inv_rho = 28;
-  double a[32];
+  static constexpr int x = 0, h = 3, v = 4, c = 7, S = 8, S45 = 12, rho = 14, mass = 15;
+  double a[16];
+};
+struct alignas(64) NeighbourRead2Rest {
+  static constexpr int S6 = 0, has_r = 3, R = 4, R45 = 8, alpha = 10, beta = 11, inv_rho = 12;
+  double a[16];
 };
 
 // A particle's running sums over its lower neighbours (their rows' terms for it), in
@@ -142,6 +148,7 @@ struct alignas(64) LowerSums2 {
 struct SphWorkspace {
   std::vector<NeighbourRead1> read1;
   std::vector<NeighbourRead2> read2;
+  std::vector<NeighbourRead2Rest> read2r;
   NeighbourList nl;                // this step's neighbours (filtered candidates, half lists)
   std::vector<double> dwr, wk;     // per entry of nl: (1/r) dW/dr and W (artificial stress,
                                    // summation density)
