@@ -824,6 +824,11 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
                 SphWorkspace& w, SphResult& res) {
   using R2 = NeighbourRead2;
   using R2r = NeighbourRead2Rest;
+  bool any_corrected = false, any_epsilon = false;
+  for (const auto& st : sets) {
+    any_corrected = any_corrected || st.corrected;
+    any_epsilon = any_epsilon || st.epsilon > 0;
+  }
   w.read2.resize(p.n_all);
   w.read2r.resize(p.n_all);
   w.low2.resize(p.n_all);
@@ -853,16 +858,20 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
     const vdouble rho = ld(p.rho);
     vdouble R[6];
     for (int c = 0; c < 6; ++c) R[c] = ld(p.R[c]);
-    const auto any =
-        R[0] != 0.0 || R[1] != 0.0 || R[2] != 0.0 || R[3] != 0.0 || R[4] != 0.0 || R[5] != 0.0;
-    vdouble has_r = 0.0;
-    stdx::where(any, has_r) = 1.0;
     put(R2::x, ld(p.x[0]), ld(p.x[1]), ld(p.x[2]), ld(p.h));
     put(R2::v, ld(p.v[0]), ld(p.v[1]), ld(p.v[2]), ld(p.wave_speed));
     put(R2::S, ld(p.S[0]), ld(p.S[1]), ld(p.S[2]), ld(p.S[3]));
     put(R2::S45, ld(p.S[4]), ld(p.S[5]), rho, ld(p.mass));
-    put_r(R2r::S6, ld(p.S[6]), ld(p.S[7]), ld(p.S[8]), has_r);
-    put_r(R2r::R, R[0], R[1], R[2], R[3]);
+    // The groups only a normalised gradient or an artificial stress reads (forces_pairs
+    // reads them under the same conditions): not written otherwise.
+    if (any_corrected || any_epsilon) {
+      const auto any =
+          R[0] != 0.0 || R[1] != 0.0 || R[2] != 0.0 || R[3] != 0.0 || R[4] != 0.0 || R[5] != 0.0;
+      vdouble has_r = 0.0;
+      stdx::where(any, has_r) = 1.0;
+      put_r(R2r::S6, ld(p.S[6]), ld(p.S[7]), ld(p.S[8]), has_r);
+      put_r(R2r::R, R[0], R[1], R[2], R[3]);
+    }
     put_r(R2r::R45, R[4], R[5], per_set([](const SetParams& st) { return st.alpha; }),
           per_set([](const SetParams& st) { return st.beta; }));
     put_r(R2r::inv_rho, 1 / rho, 0.0, 0.0, 0.0);
@@ -892,8 +901,6 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
     rr[R2r::beta] = si.beta;
     rr[R2r::inv_rho + 1] = rr[R2r::inv_rho + 2] = rr[R2r::inv_rho + 3] = 0; // unused
   }
-  bool any_corrected = false;
-  for (const auto& st : sets) any_corrected = any_corrected || st.corrected;
   const int dim = sets.empty() ? 3 : sets[0].dimensions;
   auto run = [&]<KernelType K, int D>() {
     if (any_corrected)
