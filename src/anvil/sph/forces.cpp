@@ -613,11 +613,14 @@ template <KernelType K, int D, bool Corr>
 void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspace& w,
                   SphResult& res) {
   using R2 = NeighbourRead2;
+  using R2r = NeighbourRead2Rest;
   const std::size_t n = p.n_local;
   const NeighbourList& nl = w.nl;
   const R2* rd = w.read2.data();
+  const R2r* rdr = w.read2r.data();
   const double* rdp = rd->a;
-  constexpr int stride = sizeof(R2) / sizeof(double);
+  const double* rdrp = rdr->a;
+  constexpr int stride = sizeof(R2) / sizeof(double), stride_r = sizeof(R2r) / sizeof(double);
   // The arrays' addresses in locals: the partners' sums are stored through double
   // pointers, which could otherwise alias the vectors' own pointers (reloaded every time).
   const int* index = nl.index.data();
@@ -635,6 +638,7 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
   for (std::size_t r = 0; r < nl.row.size(); ++r) {
     const auto i = static_cast<std::size_t>(nl.row[r]);
     const double* pi = rd[i].a;
+    const double* pir = rdr[i].a;
     const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
     // The row's pairs `width` at a time, lanes summed in lane order at the end, after the
     // lower sums (see pass 1). Entries past the row's end (i itself) have zero gradients
@@ -647,11 +651,13 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
     // arithmetic there instead of broadcasts again in every iteration (GCC has no
     // registers to keep them in; the empty asm makes the array's address escape, so that
     // it stays in memory).
-    alignas(32) vdouble pb[R2::inv_rho + 1];
+    // pb[rest + k] holds the value at offset k of NeighbourRead2Rest.
+    constexpr int rest = sizeof(R2) / sizeof(double);
+    alignas(32) vdouble pb[rest + R2r::inv_rho + 1];
     for (int k = R2::x; k <= R2::rho; ++k) pb[k] = pi[k];
     if constexpr (Corr)
-      for (int k = R2::S6; k < R2::S6 + 3; ++k) pb[k] = pi[k];
-    for (int k = R2::alpha; k <= R2::inv_rho; ++k) pb[k] = pi[k];
+      for (int k = R2r::S6; k < R2r::S6 + 3; ++k) pb[rest + k] = pir[k];
+    for (int k = R2r::alpha; k <= R2r::inv_rho; ++k) pb[rest + k] = pir[k];
     asm volatile("" : : "r"(pb) : "memory");
     vdouble accv[4] = {0.0, 0.0, 0.0, 0.0}, mumv = 0.0; // force sums, energy rate
     const std::int64_t k_begin = nl.start[r], k_end = k_begin + nl.len[r];
@@ -684,13 +690,14 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
         const vdouble cb = 0.5 * (pb[R2::c] + qv[3]);
         vdouble qa[4];
         if (same_visc) {
-          qa[2] = pb[R2::alpha];
-          qa[3] = pb[R2::beta];
+          qa[2] = pb[rest + R2r::alpha];
+          qa[3] = pb[rest + R2r::beta];
         } else {
-          simd::gather4(rdp + R2::R45, stride, idx, qa); // R4, R5, alpha, beta
+          simd::gather4(rdrp + R2r::R45, stride_r, idx, qa); // R4, R5, alpha, beta
         }
         // Pi_ij = (-alpha c mu + beta mu^2) / rho_ij with rho_ij = (rho_i + rho_j) / 2.
-        const vdouble pv = (-(pb[R2::alpha] + qa[2]) * cb * mu + (pb[R2::beta] + qa[3]) * mu * mu) /
+        const vdouble pv = (-(pb[rest + R2r::alpha] + qa[2]) * cb * mu +
+                            (pb[rest + R2r::beta] + qa[3]) * mu * mu) /
                            (pb[R2::rho] + qr[2]);
         stdx::where(approaching, visc) = pv;
         // The largest approach of the pair for both particles' stable steps.
@@ -705,25 +712,26 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
       const vdouble dvg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
       const vdouble half_visc = 0.5 * visc * dvg;
       vdouble qs[4], qu[4] = {0.0, 0.0, 0.0, 0.0};
-      simd::gather4(rdp + R2::S, stride, idx, qs);                      // S0..S3
-      if constexpr (Corr) simd::gather4(rdp + R2::S6, stride, idx, qu); // S6..S8, has_r
-      const vdouble irr = pb[R2::inv_rho] * (1.0 / qr[2]);
+      simd::gather4(rdp + R2::S, stride, idx, qs);                          // S0..S3
+      if constexpr (Corr) simd::gather4(rdrp + R2r::S6, stride_r, idx, qu); // S6..S8, has_r
+      const vdouble irr = pb[rest + R2r::inv_rho] * (1.0 / qr[2]);
       // T = (P_i + P_j + f^n (R_i + R_j)) / (rho_i rho_j) - Pi I; T[6..8] (yx zy zx)
       // differ from T[3..5] only where a gradient is normalised (Corr).
       constexpr int nt = Corr ? 9 : 6;
       const vdouble Sj[9] = {qs[0], qs[1], qs[2], qs[3], qr[0], qr[1], qu[0], qu[1], qu[2]};
       vdouble T[nt];
-      for (int c = 0; c < nt; ++c) T[c] = (pb[c < 6 ? R2::S + c : R2::S6 + c - 6] + Sj[c]) * irr;
+      for (int c = 0; c < nt; ++c)
+        T[c] = (pb[c < 6 ? R2::S + c : rest + R2r::S6 + c - 6] + Sj[c]) * irr;
       vdouble rg = 0.0, rgj = 0.0;
       if (stdx::any_of(fn > 0.0)) {
-        if constexpr (!Corr) simd::gather4(rdp + R2::S6, stride, idx, qu); // has_r
-        if (pi[R2::has_r] != 0.0 || stdx::any_of(qu[3] > 0.0)) {
+        if constexpr (!Corr) simd::gather4(rdrp + R2r::S6, stride_r, idx, qu); // has_r
+        if (pir[R2r::has_r] != 0.0 || stdx::any_of(qu[3] > 0.0)) {
           vdouble qR[4], qR45[4];
-          simd::gather4(rdp + R2::R, stride, idx, qR);
-          simd::gather4(rdp + R2::R45, stride, idx, qR45);
+          simd::gather4(rdrp + R2r::R, stride_r, idx, qR);
+          simd::gather4(rdrp + R2r::R45, stride_r, idx, qR45);
           const vdouble Rj[6] = {qR[0], qR[1], qR[2], qR[3], qR45[0], qR45[1]};
-          const double Ri[6] = {pi[R2::R],     pi[R2::R + 1], pi[R2::R + 2],
-                                pi[R2::R + 3], pi[R2::R45],   pi[R2::R45 + 1]};
+          const double Ri[6] = {pir[R2r::R],     pir[R2r::R + 1], pir[R2r::R + 2],
+                                pir[R2r::R + 3], pir[R2r::R45],   pir[R2r::R45 + 1]};
           const vdouble fi = fn * irr;
           for (int c = 0; c < 6; ++c) T[c] += fi * (Ri[c] + Rj[c]);
           if constexpr (Corr)
@@ -765,7 +773,7 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
     p.energy_rate[i] = de;
     const double ci = pi[R2::c];
     const double dt =
-        courant * pi[R2::h] / (ci + 1.2 * (pi[R2::alpha] * ci + pi[R2::beta] * mu_max));
+        courant * pi[R2::h] / (ci + 1.2 * (pir[R2r::alpha] * ci + pir[R2r::beta] * mu_max));
     if (dt < res.dt_stable || (dt == res.dt_stable && p.gid[i] < res.stable_gid)) {
       res.dt_stable = dt;
       res.stable_gid = p.gid[i];
@@ -815,20 +823,34 @@ void smoothing_lengths(std::span<const SetParams> sets, const int* set, const do
 void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType kernel,
                 SphWorkspace& w, SphResult& res) {
   using R2 = NeighbourRead2;
+  using R2r = NeighbourRead2Rest;
+  bool any_corrected = false, any_epsilon = false;
+  for (const auto& st : sets) {
+    any_corrected = any_corrected || st.corrected;
+    any_epsilon = any_epsilon || st.epsilon > 0;
+  }
   w.read2.resize(p.n_all);
+  w.read2r.resize(p.n_all);
   w.low2.resize(p.n_all);
   std::fill(w.low2.begin(), w.low2.end(), LowerSums2{});
   // `width` records at a time: four fields of every record per 4 x 4 transpose.
   std::size_t i0 = 0;
   for (; i0 + width <= p.n_all; i0 += width) {
-    double* q[width];
-    for (int l = 0; l < width; ++l) q[l] = w.read2[i0 + static_cast<std::size_t>(l)].a;
-    auto put = [&](int offset, const vdouble& a, const vdouble& b, const vdouble& c,
-                   const vdouble& d) {
+    double *q[width], *qr[width];
+    for (int l = 0; l < width; ++l) {
+      q[l] = w.read2[i0 + static_cast<std::size_t>(l)].a;
+      qr[l] = w.read2r[i0 + static_cast<std::size_t>(l)].a;
+    }
+    auto put_in = [&](double* const* base, int offset, const vdouble& a, const vdouble& b,
+                      const vdouble& c, const vdouble& d) {
       double* qo[width];
-      for (int l = 0; l < width; ++l) qo[l] = q[l] + offset;
+      for (int l = 0; l < width; ++l) qo[l] = base[l] + offset;
       simd::scatter4(qo, {a, b, c, d});
     };
+    auto put = [&](int offset, const vdouble& a, const vdouble& b, const vdouble& c,
+                   const vdouble& d) { put_in(q, offset, a, b, c, d); };
+    auto put_r = [&](int offset, const vdouble& a, const vdouble& b, const vdouble& c,
+                     const vdouble& d) { put_in(qr, offset, a, b, c, d); };
     auto ld = [&](const double* a) { return simd::load(a + i0); };
     auto per_set = [&](auto field) {
       return vdouble([&](auto l) { return field(sets[static_cast<std::size_t>(p.set[i0 + l])]); });
@@ -836,22 +858,27 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
     const vdouble rho = ld(p.rho);
     vdouble R[6];
     for (int c = 0; c < 6; ++c) R[c] = ld(p.R[c]);
-    const auto any =
-        R[0] != 0.0 || R[1] != 0.0 || R[2] != 0.0 || R[3] != 0.0 || R[4] != 0.0 || R[5] != 0.0;
-    vdouble has_r = 0.0;
-    stdx::where(any, has_r) = 1.0;
     put(R2::x, ld(p.x[0]), ld(p.x[1]), ld(p.x[2]), ld(p.h));
     put(R2::v, ld(p.v[0]), ld(p.v[1]), ld(p.v[2]), ld(p.wave_speed));
     put(R2::S, ld(p.S[0]), ld(p.S[1]), ld(p.S[2]), ld(p.S[3]));
     put(R2::S45, ld(p.S[4]), ld(p.S[5]), rho, ld(p.mass));
-    put(R2::S6, ld(p.S[6]), ld(p.S[7]), ld(p.S[8]), has_r);
-    put(R2::R, R[0], R[1], R[2], R[3]);
-    put(R2::R45, R[4], R[5], per_set([](const SetParams& st) { return st.alpha; }),
-        per_set([](const SetParams& st) { return st.beta; }));
-    put(R2::inv_rho, 1 / rho, 0.0, 0.0, 0.0);
+    // The groups only a normalised gradient or an artificial stress reads (forces_pairs
+    // reads them under the same conditions): not written otherwise.
+    if (any_corrected || any_epsilon) {
+      const auto any =
+          R[0] != 0.0 || R[1] != 0.0 || R[2] != 0.0 || R[3] != 0.0 || R[4] != 0.0 || R[5] != 0.0;
+      vdouble has_r = 0.0;
+      stdx::where(any, has_r) = 1.0;
+      put_r(R2r::S6, ld(p.S[6]), ld(p.S[7]), ld(p.S[8]), has_r);
+      put_r(R2r::R, R[0], R[1], R[2], R[3]);
+    }
+    put_r(R2r::R45, R[4], R[5], per_set([](const SetParams& st) { return st.alpha; }),
+          per_set([](const SetParams& st) { return st.beta; }));
+    put_r(R2r::inv_rho, 1 / rho, 0.0, 0.0, 0.0);
   }
   for (std::size_t i = i0; i < p.n_all; ++i) {
     double* r = w.read2[i].a;
+    double* rr = w.read2r[i].a;
     const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
     for (int a = 0; a < 3; ++a) {
       r[R2::x + a] = p.x[a][i];
@@ -860,22 +887,20 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
     r[R2::h] = p.h[i];
     r[R2::c] = p.wave_speed[i];
     r[R2::rho] = p.rho[i];
-    r[R2::inv_rho] = 1 / p.rho[i];
+    rr[R2r::inv_rho] = 1 / p.rho[i];
     r[R2::mass] = p.mass[i];
     for (int c = 0; c < 6; ++c) r[R2::S + c] = p.S[c][i];
-    for (int c = 6; c < 9; ++c) r[R2::S6 + c - 6] = p.S[c][i];
+    for (int c = 6; c < 9; ++c) rr[R2r::S6 + c - 6] = p.S[c][i];
     int any = 0;
     for (int c = 0; c < 6; ++c) any |= p.R[c][i] != 0.0;
-    for (int c = 0; c < 4; ++c) r[R2::R + c] = p.R[c][i];
-    r[R2::R45] = p.R[4][i];
-    r[R2::R45 + 1] = p.R[5][i];
-    r[R2::has_r] = any ? 1.0 : 0.0;
-    r[R2::alpha] = si.alpha;
-    r[R2::beta] = si.beta;
-    r[R2::inv_rho + 1] = r[R2::inv_rho + 2] = r[R2::inv_rho + 3] = 0; // unused
+    for (int c = 0; c < 4; ++c) rr[R2r::R + c] = p.R[c][i];
+    rr[R2r::R45] = p.R[4][i];
+    rr[R2r::R45 + 1] = p.R[5][i];
+    rr[R2r::has_r] = any ? 1.0 : 0.0;
+    rr[R2r::alpha] = si.alpha;
+    rr[R2r::beta] = si.beta;
+    rr[R2r::inv_rho + 1] = rr[R2r::inv_rho + 2] = rr[R2r::inv_rho + 3] = 0; // unused
   }
-  bool any_corrected = false;
-  for (const auto& st : sets) any_corrected = any_corrected || st.corrected;
   const int dim = sets.empty() ? 3 : sets[0].dimensions;
   auto run = [&]<KernelType K, int D>() {
     if (any_corrected)
