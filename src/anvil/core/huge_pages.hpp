@@ -6,7 +6,6 @@
 #pragma once
 
 #include <cstddef>
-#include <cstdlib>
 #include <new>
 #include <vector>
 
@@ -27,9 +26,10 @@ struct HugePageAllocator {
   T* allocate(std::size_t n) {
     const std::size_t bytes = n * sizeof(T);
     if (bytes < huge) return static_cast<T*>(::operator new(bytes, align));
+    // Through the aligned operator new (not aligned_alloc directly), so that a replaced
+    // operator new sees it too (tests/mpi/allocation_counter.hpp).
     const std::size_t rounded = (bytes + huge - 1) / huge * huge;
-    void* p = std::aligned_alloc(huge, rounded);
-    if (!p) throw std::bad_alloc();
+    void* p = ::operator new (rounded, std::align_val_t{huge});
 #ifdef MADV_HUGEPAGE
     madvise(p, rounded, MADV_HUGEPAGE); // advice only: its failure changes nothing
 #endif
@@ -39,7 +39,7 @@ struct HugePageAllocator {
     if (n * sizeof(T) < huge)
       ::operator delete(p, align);
     else
-      std::free(p);
+      ::operator delete (p, std::align_val_t{huge});
   }
   template <class U>
   bool operator==(const HugePageAllocator<U>&) const noexcept {
