@@ -46,6 +46,7 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
     if (l >= 0) force_nodes_.push_back(l);
   }
   std::sort(force_nodes_.begin(), force_nodes_.end());
+  history_set_.reserve(my_nodes_.size()); // a node is the slave of one pair at most
   // Faces of owned elements, with the penalty stiffness k = scale K A^2 / V and the
   // contact depth fraction V / A of their element, from the initial geometry.
   const auto offsets = mesh.block_offsets();
@@ -911,10 +912,14 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
     for (std::size_t j = 0; j < ni; ++j)
       item_order_[static_cast<std::size_t>(key_start_[static_cast<std::size_t>(item_key_[j])]++)] =
           static_cast<int>(j);
-    for (int l : my_nodes_) {
+    // The history of last cycle's pairs is cleared (of every owned node after a restore).
+    for (int l :
+         history_set_all_ ? std::span<const int>(my_nodes_) : std::span<const int>(history_set_)) {
       last_face_[static_cast<std::size_t>(l)] = -1;
       allowance_[static_cast<std::size_t>(l)] = 0;
     }
+    history_set_all_ = false;
+    history_set_.clear();
     extra_force_.assign(extra_.size(), {0.0, 0.0, 0.0});
     extra_face_.assign(extra_.size(), -1);
     // After the placement key_start_[k] is the end of group k, the start of group k + 1.
@@ -939,6 +944,7 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
         if (it.target == it.slave) {
           last_face_[k] = it.face;
           allowance_[k] = it.allowance;
+          history_set_.push_back(static_cast<int>(k));
         }
       }
       j0 = j1;

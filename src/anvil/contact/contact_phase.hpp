@@ -100,6 +100,7 @@ public:
   const std::vector<std::int64_t>& last_face() const { return last_face_; }
   const std::vector<double>& allowance() const { return allowance_; }
   void set_history(std::size_t local_node, std::int64_t face, double allowance) {
+    history_set_all_ = true; // the next forces() clears every owned node's history
     last_face_[local_node] = face;
     allowance_[local_node] = allowance;
   }
@@ -132,6 +133,8 @@ private:
   std::vector<int> force_nodes_;        // every local contact node, owned or not, ascending
   std::vector<std::int64_t> last_face_; // per local node: face contacted last cycle
   std::vector<double> allowance_;       // per local node: penetration allowed without force
+  std::vector<int> history_set_;        // local nodes whose history forces() set last cycle
+  bool history_set_all_ = false;        // set_history() may have set any
   std::vector<double> gathered_;        // forces(): four values per rank, all-gathered
   std::vector<std::int64_t> my_face_gid_;
   std::vector<std::array<int, 4>> my_face_nodes_;    // local node indices
