@@ -1,8 +1,6 @@
 #include "anvil/contact/search.hpp"
 
 #include <algorithm>
-#include <array>
-#include <bit>
 #include <cmath>
 
 #include "anvil/contact/geometry.hpp"
@@ -57,21 +55,6 @@ FacePlane set_capture(ContactFaceItem& f) {
 }
 
 namespace {
-
-// For each mask of four lanes, the byte shuffle that moves the 32-bit lanes set in it to
-// the front, in order (filter_entries()).
-constexpr std::array<std::array<char, 16>, 16> pack_table() {
-  std::array<std::array<char, 16>, 16> t{};
-  for (unsigned m = 0; m < 16; ++m) {
-    int k = 0;
-    for (int l = 0; l < 4; ++l)
-      if (m & (1u << l))
-        for (int byte = 0; byte < 4; ++byte, ++k) t[m][k] = static_cast<char>(4 * l + byte);
-    for (; k < 16; ++k) t[m][k] = static_cast<char>(0x80); // zero
-  }
-  return t;
-}
-constexpr std::array<std::array<char, 16>, 16> kPack = pack_table();
 
 // True when the candidate lists of the last build still hold every face whose capture box
 // holds each node: the same nodes and faces, none moved more than half the skin. (A node
@@ -237,13 +220,11 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
   for (std::size_t f = 0; f < nf; ++f)
     if (w.mark[f]) w.needed.push_back(static_cast<int>(f));
   // The longest range of candidates or own faces (filter_entries() writes at most that
-  // many, and a vector more).
+  // many).
   w.longest = 0;
   for (std::size_t k = 0; k < w.active.size(); ++k)
     w.longest = std::max(
         {w.longest, w.own_start[k] - w.list_start[k], w.list_start[k + 1] - w.own_start[k]});
-  // Padding: filter_entries() reads whole vectors of entries past a node's range.
-  w.list.insert(w.list.end(), simd::width - 1, 0);
   // Room for a cycle's detailed checks: at most one per candidate entry.
   w.query_start.reserve(w.active.capacity() + 1);
   w.query_face.reserve(w.list.capacity()); // capacities: they grow only where the lists did
@@ -257,75 +238,35 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
 // face's capture box holds p (each side compared as p < lo, p > hi: a box with a NaN side
 // holds) and, with Side, p lies behind the face's mean plane no deeper than a tracked pair
 // may go (see find_pairs). Writes the faces that pass to out, in their order, and returns
-// their number. list must be readable, and out writable, a whole vector past e - b
-// entries (build_lists pads the list, find_pairs sizes out).
+// their number. Without branches on the outcomes (about two entries in three pass the box
+// test, in no pattern a predictor could learn): every entry is written, and the count
+// advances by the test's result.
 template <bool Side>
 int filter_entries(const int* list, int b, int e, const FaceBoxes& boxes,
                    const ContactFaceItem* faces, const Vec3& p, int* out) {
+  const double *l0 = boxes.lo[0].data(), *l1 = boxes.lo[1].data(), *l2 = boxes.lo[2].data();
+  const double *h0 = boxes.hi[0].data(), *h1 = boxes.hi[1].data(), *h2 = boxes.hi[2].data();
+  using u = unsigned;
   int n = 0;
-#if defined(__AVX2__)
-  if constexpr (simd::width == 4) {
-    // Four entries at a time, their values by hardware gathers (six box sides from the
-    // boxes' arrays; the plane from the face items), the passing entries packed by a
-    // byte shuffle from a table of the 16 lane masks.
-    static_assert(sizeof(ContactFaceItem) % sizeof(double) == 0);
-    constexpr int stride = sizeof(ContactFaceItem) / sizeof(double);
-    const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
-    auto gather = [&](const double* base, __m128i idx) {
-      return _mm256_mask_i32gather_pd(_mm256_setzero_pd(), base, idx, all, 8);
-    };
-    const __m256d px = _mm256_set1_pd(p.x), py = _mm256_set1_pd(p.y), pz = _mm256_set1_pd(p.z);
-    const __m256d sign = _mm256_set1_pd(-0.0);
-    const double *l0 = boxes.lo[0].data(), *l1 = boxes.lo[1].data(), *l2 = boxes.lo[2].data();
-    const double *h0 = boxes.hi[0].data(), *h1 = boxes.hi[1].data(), *h2 = boxes.hi[2].data();
-    for (int j = b; j < e; j += 4) {
-      const __m128i idx = _mm_loadu_si128(reinterpret_cast<const __m128i*>(list + j));
-      __m256d reject =
-          _mm256_or_pd(_mm256_or_pd(_mm256_cmp_pd(px, gather(l0, idx), _CMP_LT_OQ),
-                                    _mm256_cmp_pd(px, gather(h0, idx), _CMP_GT_OQ)),
-                       _mm256_or_pd(_mm256_or_pd(_mm256_cmp_pd(py, gather(l1, idx), _CMP_LT_OQ),
-                                                 _mm256_cmp_pd(py, gather(h1, idx), _CMP_GT_OQ)),
-                                    _mm256_or_pd(_mm256_cmp_pd(pz, gather(l2, idx), _CMP_LT_OQ),
-                                                 _mm256_cmp_pd(pz, gather(h2, idx), _CMP_GT_OQ))));
-      if constexpr (Side) {
-        // side = dot(p, normal) - offset, rejected when side > warp or
-        // side < -(2 depth + warp): the scalar operations in the scalar order.
-        const __m128i item = _mm_mullo_epi32(idx, _mm_set1_epi32(stride));
-        const __m256d nx = gather(&faces->normal[0], item), ny = gather(&faces->normal[1], item);
-        const __m256d nz = gather(&faces->normal[2], item);
-        const __m256d side =
-            _mm256_sub_pd(_mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(px, nx), _mm256_mul_pd(py, ny)),
-                                        _mm256_mul_pd(pz, nz)),
-                          gather(&faces->offset, item));
-        const __m256d warp = gather(&faces->warp, item);
-        const __m256d deep = _mm256_xor_pd(
-            _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(2.0), gather(&faces->depth, item)), warp),
-            sign);
-        reject = _mm256_or_pd(reject, _mm256_or_pd(_mm256_cmp_pd(side, warp, _CMP_GT_OQ),
-                                                   _mm256_cmp_pd(side, deep, _CMP_LT_OQ)));
-      }
-      unsigned in = ~static_cast<unsigned>(_mm256_movemask_pd(reject)) & 0xFu;
-      if (e - j < 4) in &= (1u << (e - j)) - 1;
-      const __m128i packed = _mm_shuffle_epi8(
-          idx, _mm_loadu_si128(reinterpret_cast<const __m128i*>(kPack[in].data())));
-      _mm_storeu_si128(reinterpret_cast<__m128i*>(out + n), packed);
-      n += std::popcount(in);
-    }
-    return n;
-  }
-#endif
   for (int j = b; j < e; ++j) {
-    const auto k = static_cast<std::size_t>(list[j]);
-    using u = unsigned; // the six tests combined without branches
-    if ((u(p.x < boxes.lo[0][k]) | u(p.x > boxes.hi[0][k]) | u(p.y < boxes.lo[1][k]) |
-         u(p.y > boxes.hi[1][k]) | u(p.z < boxes.lo[2][k]) | u(p.z > boxes.hi[2][k])) != 0)
-      continue;
-    if constexpr (Side) {
-      const auto& fc = faces[k];
+    const int f = list[j];
+    const auto k = static_cast<std::size_t>(f);
+    out[n] = f;
+    n += static_cast<int>((u(p.x < l0[k]) | u(p.x > h0[k]) | u(p.y < l1[k]) | u(p.y > h1[k]) |
+                           u(p.z < l2[k]) | u(p.z > h2[k])) ^
+                          1u);
+  }
+  if constexpr (Side) {
+    // Of those, in place: side = dot(p, normal) - offset within [-(2 depth + warp), warp].
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+      const int f = out[i];
+      const auto& fc = faces[static_cast<std::size_t>(f)];
       const double side = dot(p, Vec3{fc.normal[0], fc.normal[1], fc.normal[2]}) - fc.offset;
-      if (side > fc.warp || side < -(2 * fc.depth + fc.warp)) continue;
+      out[m] = f;
+      m += static_cast<int>((u(side > fc.warp) | u(side < -(2 * fc.depth + fc.warp))) ^ 1u);
     }
-    out[n++] = list[j];
+    n = m;
   }
   return n;
 }
@@ -371,8 +312,8 @@ void find_pairs(const std::vector<ContactNodeItem>& nodes,
   if (nodes.empty() || faces.empty()) return;
 
   const double tol = 1 + opt.parametric_tolerance;
-  // Room for the filtered entries of the longest range, and a vector more.
-  const std::size_t room = static_cast<std::size_t>(w.longest) + simd::width;
+  // Room for the filtered entries of the longest range.
+  const auto room = static_cast<std::size_t>(w.longest);
   if (w.cand.size() < room) w.cand.resize(room);
   if (w.own.size() < room) w.own.resize(room);
   int* const cand = w.cand.data();

@@ -130,7 +130,7 @@ struct SearchWorkspace {
   std::vector<int> active;            // nodes with candidates, ascending
   std::vector<int> list_start;        // per active node: its first candidate (+ end)
   std::vector<int> own_start;         // per active node: its first own face
-  std::vector<int> list;              // face indices (and a vector's padding)
+  std::vector<int> list;              // face indices
   int longest = 0;                    // the longest range of candidates or own faces
   std::vector<int> needed;            // the faces in some list, ascending (each once)
   std::vector<char> mark;             // per face: in some list (scratch of the build)
