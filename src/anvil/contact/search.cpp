@@ -238,9 +238,9 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
 // face's capture box holds p (each side compared as p < lo, p > hi: a box with a NaN side
 // holds) and, with Side, p lies behind the face's mean plane no deeper than a tracked pair
 // may go (see find_pairs). Writes the faces that pass to out, in their order, and returns
-// their number. Without branches on the outcomes (about two entries in three pass the box
-// test, in no pattern a predictor could learn): every entry is written, and the count
-// advances by the test's result.
+// their number. Without branches on the outcomes (late in the can crush a little over
+// half the candidates pass the box test, in no pattern a predictor could learn): every
+// entry is written, and the count advances by the test's result.
 template <bool Side>
 int filter_entries(const int* list, int b, int e, const FaceBoxes& boxes,
                    const ContactFaceItem* faces, const Vec3& p, int* out) {
