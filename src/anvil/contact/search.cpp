@@ -219,6 +219,12 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
   w.needed.clear();
   for (std::size_t f = 0; f < nf; ++f)
     if (w.mark[f]) w.needed.push_back(static_cast<int>(f));
+  // The longest range of candidates or own faces (filter_entries() writes at most that
+  // many).
+  w.longest = 0;
+  for (std::size_t k = 0; k < w.active.size(); ++k)
+    w.longest = std::max(
+        {w.longest, w.own_start[k] - w.list_start[k], w.list_start[k + 1] - w.own_start[k]});
   // Room for a cycle's detailed checks: at most one per candidate entry.
   w.query_start.reserve(w.active.capacity() + 1);
   w.query_face.reserve(w.list.capacity()); // capacities: they grow only where the lists did
@@ -226,6 +232,43 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
   w.feet.reserve(w.list.capacity());
   w.built = true;
   ++w.builds;
+}
+
+// The detailed check's cheap filters, for the entries list[b..e) of a node at p: the
+// face's capture box holds p (each side compared as p < lo, p > hi: a box with a NaN side
+// holds) and, with Side, p lies behind the face's mean plane no deeper than a tracked pair
+// may go (see find_pairs). Writes the faces that pass to out, in their order, and returns
+// their number. Without branches on the outcomes (late in the can crush a little over
+// half the candidates pass the box test, in no pattern a predictor could learn): every
+// entry is written, and the count advances by the test's result.
+template <bool Side>
+int filter_entries(const int* list, int b, int e, const FaceBoxes& boxes,
+                   const ContactFaceItem* faces, const Vec3& p, int* out) {
+  const double *l0 = boxes.lo[0].data(), *l1 = boxes.lo[1].data(), *l2 = boxes.lo[2].data();
+  const double *h0 = boxes.hi[0].data(), *h1 = boxes.hi[1].data(), *h2 = boxes.hi[2].data();
+  using u = unsigned;
+  int n = 0;
+  for (int j = b; j < e; ++j) {
+    const int f = list[j];
+    const auto k = static_cast<std::size_t>(f);
+    out[n] = f;
+    n += static_cast<int>((u(p.x < l0[k]) | u(p.x > h0[k]) | u(p.y < l1[k]) | u(p.y > h1[k]) |
+                           u(p.z < l2[k]) | u(p.z > h2[k])) ^
+                          1u);
+  }
+  if constexpr (Side) {
+    // Of those, in place: side = dot(p, normal) - offset within [-(2 depth + warp), warp].
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+      const int f = out[i];
+      const auto& fc = faces[static_cast<std::size_t>(f)];
+      const double side = dot(p, Vec3{fc.normal[0], fc.normal[1], fc.normal[2]}) - fc.offset;
+      out[m] = f;
+      m += static_cast<int>((u(side > fc.warp) | u(side < -(2 * fc.depth + fc.warp))) ^ 1u);
+    }
+    n = m;
+  }
+  return n;
 }
 
 } // namespace
@@ -269,35 +312,30 @@ void find_pairs(const std::vector<ContactNodeItem>& nodes,
   if (nodes.empty() || faces.empty()) return;
 
   const double tol = 1 + opt.parametric_tolerance;
-  std::vector<int>& own = w.own;
-  std::vector<int>& cand = w.cand;
-  auto by_gid = [&](int a, int b) {
-    return faces[static_cast<std::size_t>(a)].gid < faces[static_cast<std::size_t>(b)].gid;
-  };
-  auto same_gid = [&](int a, int b) {
-    return faces[static_cast<std::size_t>(a)].gid == faces[static_cast<std::size_t>(b)].gid;
-  };
+  // Room for the filtered entries of the longest range.
+  const auto room = static_cast<std::size_t>(w.longest);
+  if (w.cand.size() < room) w.cand.resize(room);
+  if (w.own.size() < room) w.own.resize(room);
+  int* const cand = w.cand.data();
+  int* const own = w.own.data();
   // The surfaces face each other when at least one of the node's own faces opposes the
   // candidate (normals at more than about 107 degrees). At a convex edge a node just
   // outside is "behind" the side face, but none of its faces opposes that face; in a
   // closing fold the node at the crease has one face on each side, and one opposes.
-  auto faces_oppose = [&](const std::vector<int>& mine, const Vec3& fn) {
-    if (mine.empty()) return true;
-    for (int g : mine) {
-      const double* q = faces[static_cast<std::size_t>(g)].normal;
+  // (Neither the order of the node's faces nor a repeated one changes the answer.)
+  auto faces_oppose = [&](int nown, const Vec3& fn) {
+    if (nown == 0) return true;
+    for (int i = 0; i < nown; ++i) {
+      const double* q = faces[static_cast<std::size_t>(own[i])].normal;
       if (q[0] * fn.x + q[1] * fn.y + q[2] * fn.z < -0.3) return true;
     }
     return false;
   };
-  auto holds = [&](int f, const Vec3& p) {
-    const auto k = static_cast<std::size_t>(f);
-    using u = unsigned; // the six tests combined without branches
-    return (u(p.x < boxes.lo[0][k]) | u(p.x > boxes.hi[0][k]) | u(p.y < boxes.lo[1][k]) |
-            u(p.y > boxes.hi[1][k]) | u(p.z < boxes.lo[2][k]) | u(p.z > boxes.hi[2][k])) == 0;
-  };
-  // Pass 1, node by node: the candidates whose capture box holds the node, then, if there
-  // are any, the node's own faces whose box holds it; of the candidates, those that face
-  // the node's surface and hold it within their depth are queued for the detailed check.
+  // Pass 1, node by node: the candidates whose capture box holds the node and behind
+  // whose mean plane it lies, not deeper than a tracked pair may go; then, if there are
+  // any, the node's own faces whose box holds it; of the candidates, those that face the
+  // node's surface are queued for the detailed check. (A node just outside a convex edge
+  // can be "behind" the side face there while it is in front of the top face.)
   w.query_start.assign(w.active.size() + 1, 0);
   w.query_face.clear();
   w.queries.clear();
@@ -306,29 +344,15 @@ void find_pairs(const std::vector<ContactNodeItem>& nodes,
     const auto n = static_cast<std::size_t>(w.active[k]);
     const auto& nd = nodes[n];
     const Vec3 p{nd.x[0], nd.x[1], nd.x[2]};
-    cand.clear();
-    for (int j = w.list_start[k]; j < w.own_start[k]; ++j)
-      if (holds(w.list[static_cast<std::size_t>(j)], p))
-        cand.push_back(w.list[static_cast<std::size_t>(j)]);
-    if (cand.empty()) continue;
-    own.clear();
-    for (int j = w.own_start[k]; j < w.list_start[k + 1]; ++j)
-      if (holds(w.list[static_cast<std::size_t>(j)], p))
-        own.push_back(w.list[static_cast<std::size_t>(j)]);
-    // The node's own faces (all of them are here: their capture boxes hold the node),
-    // deduplicated (a face can sit in several cells? no: one cell per node, but ghosts of
-    // the same face never coexist on a rank; kept for safety).
-    std::sort(own.begin(), own.end(), by_gid);
-    own.erase(std::unique(own.begin(), own.end(), same_gid), own.end());
-    for (int f : cand) {
+    const int ncand = filter_entries<true>(w.list.data(), w.list_start[k], w.own_start[k], boxes,
+                                           faces.data(), p, cand);
+    if (ncand == 0) continue;
+    const int nown = filter_entries<false>(w.list.data(), w.own_start[k], w.list_start[k + 1],
+                                           boxes, faces.data(), p, own);
+    for (int i = 0; i < ncand; ++i) {
+      const int f = cand[i];
       const auto& fc = faces[static_cast<std::size_t>(f)];
-      // The surfaces must face each other (a node just outside a convex edge can be
-      // "behind" the side face there while it is in front of the top face), and the node
-      // must be behind the face's mean plane, not deeper than a tracked pair may go.
-      const Vec3 fn{fc.normal[0], fc.normal[1], fc.normal[2]};
-      if (!faces_oppose(own, fn)) continue;
-      const double side = dot(p, fn) - fc.offset;
-      if (side > fc.warp || side < -(2 * fc.depth + fc.warp)) continue;
+      if (!faces_oppose(nown, Vec3{fc.normal[0], fc.normal[1], fc.normal[2]})) continue;
       w.queries.push_back(
           {{Vec3{fc.x[0][0], fc.x[0][1], fc.x[0][2]}, Vec3{fc.x[1][0], fc.x[1][1], fc.x[1][2]},
             Vec3{fc.x[2][0], fc.x[2][1], fc.x[2][2]}, Vec3{fc.x[3][0], fc.x[3][1], fc.x[3][2]}},

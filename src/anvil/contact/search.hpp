@@ -109,7 +109,7 @@ struct SearchWorkspace {
   std::vector<int> cell_start, cursor; // per cell: first entry; fill cursors
   std::vector<CellEntry> entries;      // faces binned by cell
   std::vector<double> extent;          // largest side of each capture box
-  std::vector<int> own, cand;          // a node's own faces and its candidates
+  std::vector<int> own, cand;          // a node's own faces and its candidates (scratch)
   // The detailed checks of a cycle, projected together (project_on_quads): per active
   // node its range of queries (+ end), each query's face and the feet found.
   std::vector<int> query_start, query_face;
@@ -131,6 +131,7 @@ struct SearchWorkspace {
   std::vector<int> list_start;        // per active node: its first candidate (+ end)
   std::vector<int> own_start;         // per active node: its first own face
   std::vector<int> list;              // face indices
+  int longest = 0;                    // the longest range of candidates or own faces
   std::vector<int> needed;            // the faces in some list, ascending (each once)
   std::vector<char> mark;             // per face: in some list (scratch of the build)
   std::vector<double> box[6];         // find_contacts(): the items' boxes as FaceBoxes
