@@ -385,7 +385,10 @@ void Simulation::predict() {
   const std::uint8_t* owned = fe_.node_owned.data();
   const std::uint8_t* fixed = constrained_.data();
   // simd::width nodes at a time (the vector body), then one at a time (the rest): the
-  // same operations, so the same bits. The kinetic energy is summed node after node.
+  // same operations, so the same bits. The kinetic energy is summed node after node, in a
+  // local whose address is not taken (ke's is: a store to v could alias it, and the sum
+  // went through memory at every node).
+  double ke_nodes = 0;
   constexpr auto W = static_cast<std::size_t>(simd::width);
   std::size_t n = 0;
   for (; n + W <= nn; n += W) {
@@ -406,7 +409,7 @@ void Simulation::predict() {
       simd::store(nv[i], v[i] + n);
     }
     for (std::size_t l = 0; l < W; ++l)
-      if (owned[n + l]) ke += e[static_cast<int>(l)];
+      if (owned[n + l]) ke_nodes += e[static_cast<int>(l)];
   }
   for (; n < nn; ++n) {
     double old[3], force[3], bc[3], nv[3];
@@ -422,8 +425,9 @@ void Simulation::predict() {
       v_prev[i][n] = old[i];
       v[i][n] = nv[i];
     }
-    if (owned[n]) ke += e;
+    if (owned[n]) ke_nodes += e;
   }
+  ke = ke_nodes; // (ke is 0 before the nodes: the same sum)
   if (sph_) predict_particles(dt_avg, ke, work);
   external_work_ += work;
   // Probe velocity at t(n): mean of the two half-step velocities.
