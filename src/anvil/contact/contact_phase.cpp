@@ -460,7 +460,7 @@ bool ContactPhase::shared_bound_holds() {
     for (int a = 0; a < 4; ++a) {
       simd::vdouble s = 0.0;
       for (int i = 0; i < 3; ++i) {
-        const simd::vdouble d = simd::gather_i32(x[i], c[a] + f) - simd::load(r[3 * a + i] + f);
+        const simd::vdouble d = simd::gather(x[i], c[a] + f) - simd::load(r[3 * a + i] + f);
         s += d * d;
       }
       where(d2 < s, d2) = s;
@@ -569,7 +569,7 @@ bool ContactPhase::lazy_bound_holds() {
   for (; f + W <= nf; f += W) {
     simd::vdouble d = 0.0;
     for (int a = 0; a < 4; ++a) {
-      const simd::vdouble p = simd::gather_i32(move, corner_[a].data() + f);
+      const simd::vdouble p = simd::gather(move, corner_[a].data() + f);
       where(d < p, d) = p;
     }
     const simd::vdouble m =

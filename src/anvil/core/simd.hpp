@@ -24,22 +24,11 @@ using vdouble = stdx::native_simd<double>;
 using vmask = stdx::native_simd_mask<double>;
 inline constexpr int width = static_cast<int>(vdouble::size());
 
-// Loads lane l from p[idx[l]].
+// Loads lane l from p[idx[l]] (scalar loads and inserts: on this machine AVX2's hardware
+// gather measured slower, docs/performance_contact.md).
 template <class Index>
 inline vdouble gather(const double* p, const Index* idx) {
   return vdouble([&](auto l) { return p[idx[l]]; });
-}
-
-// The same as gather() with 32-bit indices, as one hardware gather where AVX2 has one
-// (fewer instructions where a loop does little else than gather scattered values).
-inline vdouble gather_i32(const double* p, const int* idx) {
-#if defined(__AVX2__)
-  if constexpr (width == 4)
-    return vdouble(_mm256_mask_i32gather_pd(_mm256_setzero_pd(), p,
-                                            _mm_loadu_si128(reinterpret_cast<const __m128i*>(idx)),
-                                            _mm256_castsi256_pd(_mm256_set1_epi64x(-1)), 8));
-#endif
-  return gather(p, idx);
 }
 
 // Loads two values per lane from consecutive addresses: first[l] = p[off[l]],
