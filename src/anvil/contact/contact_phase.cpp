@@ -404,6 +404,7 @@ void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live
   for (auto& v : sf_box_) v.resize(nf);
   sf_a_.assign(nfp, 0.0);
   sf_b_.assign(nfp, 0.0);
+  sf_due_.resize(nfp);
   sf_near_.assign(nf, 0);
   near_.clear();
   for (std::size_t f = 0; f < nfp; ++f) set_face_reference(f);
@@ -423,6 +424,7 @@ void ContactPhase::set_face_reference(std::size_t f) {
   }
   sf_a_[f] = bound_a(my_face_depth_[f], cap_.len[f]);
   sf_b_[f] = 2 * cap_.diag[f];
+  sf_due_[f] = drift_ + 0.999999 * largest_delta(f); // delta is 0 at the reference
   if (!alive(f)) return;
   // The centre moves no more than the corners, at most 0.45 g while the bound holds: only
   // a face whose centre is nearer its rank's box side can change rank.
@@ -438,8 +440,32 @@ void ContactPhase::set_face_reference(std::size_t f) {
   }
 }
 
-// The face bound of lazy_bound_holds(), per face from its own reference, vectorised
-// across faces: delta is the largest distance of a corner from where it was then.
+// Face f's delta: the largest distance of a corner from where it was at its reference.
+double ContactPhase::corner_delta(std::size_t f) const {
+  double d2 = 0;
+  for (int a = 0; a < 4; ++a) {
+    const auto p = static_cast<std::size_t>(corner_[a][f]);
+    double s = 0;
+    for (int i = 0; i < 3; ++i) {
+      const double d = xs_[i][p] - sf_x_[3 * a + i][f];
+      s += d * d;
+    }
+    if (d2 < s || s != s) d2 = s;
+  }
+  return std::sqrt(d2);
+}
+
+// The largest delta for which face f's bound holds: the root of
+// 1.001 delta (1 + A (B + 4 delta)) = budget (infinite for an infinite budget).
+double ContactPhase::largest_delta(std::size_t f) const {
+  const double a = sf_a_[f], b = sf_b_[f], beta = sf_budget_[f] / 1.001;
+  if (!(beta < std::numeric_limits<double>::infinity())) return beta;
+  const double p = 1 + a * b;
+  return 2 * beta / (p + std::sqrt(p * p + 16 * a * beta));
+}
+
+// The face bound of lazy_bound_holds(), per face from its own reference: delta is the
+// largest distance of a corner from where it was then.
 bool ContactPhase::shared_bound_holds() {
   unsigned bad = 0; // also when anything is not a number
   for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
@@ -449,28 +475,22 @@ bool ContactPhase::shared_bound_holds() {
     bad |= static_cast<unsigned>(!(e <= sn_budget_[k]));
   }
   fail_.clear();
+  // A face whose corners have moved delta from its reference at some cycle can have moved
+  // at most delta + (drift_ now - drift_ then) since: it is looked at again only when that
+  // could exceed the largest delta its budget allows (sf_due_), and the others pass.
   const std::size_t nfp = sf_budget_.size();
-  const double* x[3] = {xs_[0].data(), xs_[1].data(), xs_[2].data()};
-  const int* c[4] = {corner_[0].data(), corner_[1].data(), corner_[2].data(), corner_[3].data()};
-  const double* r[12];
-  for (int k = 0; k < 12; ++k) r[k] = sf_x_[k].data();
   const double *A = sf_a_.data(), *B = sf_b_.data(), *budget = sf_budget_.data();
   for (std::size_t f = 0; f < nfp; f += simd::width) {
-    simd::vdouble d2 = 0.0;
-    for (int a = 0; a < 4; ++a) {
-      simd::vdouble s = 0.0;
-      for (int i = 0; i < 3; ++i) {
-        const simd::vdouble d = simd::gather(x[i], c[a] + f) - simd::load(r[3 * a + i] + f);
-        s += d * d;
-      }
-      where(d2 < s, d2) = s;
+    if (all_of(simd::load(sf_due_.data() + f) >= drift_)) continue; // (a NaN is looked at)
+    for (int l = 0; l < simd::width; ++l) {
+      const std::size_t g = f + static_cast<std::size_t>(l);
+      if (sf_due_[g] >= drift_) continue;
+      const double delta = corner_delta(g);
+      if (!(1.001 * side_move(delta, A[g], B[g]) <= budget[g]))
+        fail_.push_back(static_cast<int>(g));
+      else
+        sf_due_[g] = drift_ + 0.999999 * (largest_delta(g) - delta);
     }
-    const simd::vdouble delta = sqrt(d2);
-    const simd::vdouble m = side_move(delta, simd::load(A + f), simd::load(B + f));
-    const simd::vmask ok = 1.001 * m <= simd::load(budget + f);
-    if (all_of(ok)) continue;
-    for (int l = 0; l < simd::width; ++l)
-      if (!ok[l]) fail_.push_back(static_cast<int>(f) + l);
   }
   return bad == 0;
 }
@@ -601,18 +621,52 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
   {
     ScopedPhase t(timers, Phase::transfer);
     const std::size_t np = surf_local_.size();
-    if (np == fe_.node_gid.size()) { // every local node is a surface point (point k is node k)
-      for (int i = 0; i < 3; ++i) {
-        const double *x = nd.x[i], *v = nd.v[i];
-        double* out = xs_[i].data();
+    if (alone) {
+      if (np == fe_.node_gid.size()) { // every local node is a surface point (point k: node k)
+        for (int i = 0; i < 3; ++i) {
+          const double *x = nd.x[i], *v = nd.v[i];
+          double* out = xs_[i].data();
 #pragma omp simd
-        for (std::size_t k = 0; k < np; ++k) out[k] = x[k] + dt * v[k];
+          for (std::size_t k = 0; k < np; ++k) out[k] = x[k] + dt * v[k];
+        }
+      } else {
+        for (std::size_t k = 0; k < np; ++k) {
+          const auto l = static_cast<std::size_t>(surf_local_[k]);
+          for (int i = 0; i < 3; ++i) xs_[i][k] = nd.x[i][l] + dt * nd.v[i][l];
+        }
       }
     } else {
-      for (std::size_t k = 0; k < np; ++k) {
-        const auto l = static_cast<std::size_t>(surf_local_[k]);
-        for (int i = 0; i < 3; ++i) xs_[i][k] = nd.x[i][l] + dt * nd.v[i][l];
+      // Several ranks: also the largest move of a point since last cycle, summed into
+      // drift_ (shared_bound_holds()).
+      // (A NaN is not carried: the element phase stops the run on non-finite values.)
+      double step2 = 0;
+      if (np == fe_.node_gid.size()) {
+        const double *x0 = nd.x[0], *x1 = nd.x[1], *x2 = nd.x[2];
+        const double *v0 = nd.v[0], *v1 = nd.v[1], *v2 = nd.v[2];
+        double *y0 = xs_[0].data(), *y1 = xs_[1].data(), *y2 = xs_[2].data();
+#pragma omp simd reduction(max : step2)
+        for (std::size_t k = 0; k < np; ++k) {
+          const double a0 = x0[k] + dt * v0[k], a1 = x1[k] + dt * v1[k], a2 = x2[k] + dt * v2[k];
+          const double d0 = a0 - y0[k], d1 = a1 - y1[k], d2 = a2 - y2[k];
+          step2 = std::max(step2, d0 * d0 + d1 * d1 + d2 * d2);
+          y0[k] = a0;
+          y1[k] = a1;
+          y2[k] = a2;
+        }
+      } else {
+        for (std::size_t k = 0; k < np; ++k) {
+          const auto l = static_cast<std::size_t>(surf_local_[k]);
+          double d2 = 0;
+          for (int i = 0; i < 3; ++i) {
+            const double y = nd.x[i][l] + dt * nd.v[i][l];
+            const double d = y - xs_[i][k];
+            d2 += d * d;
+            xs_[i][k] = y;
+          }
+          step2 = std::max(step2, d2);
+        }
       }
+      drift_ += std::sqrt(step2);
     }
     // The faces alive: counted again only when some element has eroded since.
     std::int64_t eroded = 0;

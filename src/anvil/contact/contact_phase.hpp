@@ -186,6 +186,11 @@ private:
                                              // its reference ([3 a + i])
   std::vector<double> sf_box_[6];            // per face: capture box then (lo, then hi)
   std::vector<double> sf_a_, sf_b_;          // per face (padded): the bound's coefficients
+  // drift_: the sum over cycles of the largest move of any point's x* since the previous
+  // cycle, m. sf_due_: per face (padded), the drift_ at which its corners may first have
+  // moved too far for its budget (shared_bound_holds() looks at it again then).
+  double drift_ = 0;
+  std::vector<double> sf_due_;
   std::vector<double> sf_budget_, sf_ghost_; // per face (padded): how far its box sides may
                                              // move from there, and for the ghosting, m
   std::vector<char> sf_near_;                // per face: listed in near_
@@ -258,6 +263,8 @@ private:
   // Several ranks: true when every node is within its budget; fail_ gets the faces whose
   // bound fails.
   bool shared_bound_holds();
+  double corner_delta(std::size_t f) const;  // largest move of f's corners since its reference
+  double largest_delta(std::size_t f) const; // the largest that f's budget allows
   // The faces of fail_ checked exactly: true when each is within its budget; each then
   // gets this cycle as its reference, its budgets less what it used.
   bool rebase_faces();
