@@ -620,54 +620,38 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
   bool bound_ok = false;   // several ranks: this rank's items are within their budgets
   {
     ScopedPhase t(timers, Phase::transfer);
+    // The points' predicted positions, and the largest move of a point since last cycle,
+    // summed into drift_ (several ranks: shared_bound_holds()). (A NaN is not carried: the
+    // element phase stops the run on non-finite values.)
     const std::size_t np = surf_local_.size();
-    if (alone) {
-      if (np == fe_.node_gid.size()) { // every local node is a surface point (point k: node k)
-        for (int i = 0; i < 3; ++i) {
-          const double *x = nd.x[i], *v = nd.v[i];
-          double* out = xs_[i].data();
-#pragma omp simd
-          for (std::size_t k = 0; k < np; ++k) out[k] = x[k] + dt * v[k];
-        }
-      } else {
-        for (std::size_t k = 0; k < np; ++k) {
-          const auto l = static_cast<std::size_t>(surf_local_[k]);
-          for (int i = 0; i < 3; ++i) xs_[i][k] = nd.x[i][l] + dt * nd.v[i][l];
-        }
+    double step2 = 0;
+    if (np == fe_.node_gid.size()) { // every local node is a surface point (point k: node k)
+      const double *x0 = nd.x[0], *x1 = nd.x[1], *x2 = nd.x[2];
+      const double *v0 = nd.v[0], *v1 = nd.v[1], *v2 = nd.v[2];
+      double *y0 = xs_[0].data(), *y1 = xs_[1].data(), *y2 = xs_[2].data();
+#pragma omp simd reduction(max : step2)
+      for (std::size_t k = 0; k < np; ++k) {
+        const double a0 = x0[k] + dt * v0[k], a1 = x1[k] + dt * v1[k], a2 = x2[k] + dt * v2[k];
+        const double d0 = a0 - y0[k], d1 = a1 - y1[k], d2 = a2 - y2[k];
+        step2 = std::max(step2, d0 * d0 + d1 * d1 + d2 * d2);
+        y0[k] = a0;
+        y1[k] = a1;
+        y2[k] = a2;
       }
     } else {
-      // Several ranks: also the largest move of a point since last cycle, summed into
-      // drift_ (shared_bound_holds()).
-      // (A NaN is not carried: the element phase stops the run on non-finite values.)
-      double step2 = 0;
-      if (np == fe_.node_gid.size()) {
-        const double *x0 = nd.x[0], *x1 = nd.x[1], *x2 = nd.x[2];
-        const double *v0 = nd.v[0], *v1 = nd.v[1], *v2 = nd.v[2];
-        double *y0 = xs_[0].data(), *y1 = xs_[1].data(), *y2 = xs_[2].data();
-#pragma omp simd reduction(max : step2)
-        for (std::size_t k = 0; k < np; ++k) {
-          const double a0 = x0[k] + dt * v0[k], a1 = x1[k] + dt * v1[k], a2 = x2[k] + dt * v2[k];
-          const double d0 = a0 - y0[k], d1 = a1 - y1[k], d2 = a2 - y2[k];
-          step2 = std::max(step2, d0 * d0 + d1 * d1 + d2 * d2);
-          y0[k] = a0;
-          y1[k] = a1;
-          y2[k] = a2;
+      for (std::size_t k = 0; k < np; ++k) {
+        const auto l = static_cast<std::size_t>(surf_local_[k]);
+        double d2 = 0;
+        for (int i = 0; i < 3; ++i) {
+          const double y = nd.x[i][l] + dt * nd.v[i][l];
+          const double d = y - xs_[i][k];
+          d2 += d * d;
+          xs_[i][k] = y;
         }
-      } else {
-        for (std::size_t k = 0; k < np; ++k) {
-          const auto l = static_cast<std::size_t>(surf_local_[k]);
-          double d2 = 0;
-          for (int i = 0; i < 3; ++i) {
-            const double y = nd.x[i][l] + dt * nd.v[i][l];
-            const double d = y - xs_[i][k];
-            d2 += d * d;
-            xs_[i][k] = y;
-          }
-          step2 = std::max(step2, d2);
-        }
+        step2 = std::max(step2, d2);
       }
-      drift_ += std::sqrt(step2);
     }
+    drift_ += std::sqrt(step2);
     // The faces alive: counted again only when some element has eroded since.
     std::int64_t eroded = 0;
     for (const auto& b : blocks_) eroded += b.eroded;
