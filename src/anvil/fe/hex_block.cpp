@@ -603,7 +603,9 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       // lane, so that every node receives its corners in ascending (element, corner).
       auto assemble = [&] {
         if (!sums) return;
-        if (stream && slots) simd::stream_fence(); // the rows are read back at once
+        // (Never taken since rows are not streamed with sums; kept: removing it changes
+        // GCC's FMA contraction of the corner forces, and so the last bits.)
+        if (stream && slots) simd::stream_fence();
         for (int k = 0; k < lanes; ++k) {
           const double* f[3] = {rows_of[0] + 8 * k, rows_of[1] + 8 * k, rows_of[2] + 8 * k};
           _Pragma("GCC unroll 2") for (int h = 0; h < 8; h += 4) {
