@@ -17,8 +17,8 @@ namespace {
 using namespace anvil;
 
 // An impact with plasticity, the three hourglass forms (a clamped sheet one element thick
-// flaps with the assumed-strain form), a prescribed velocity, a rotation and non-trivial
-// partitions: every code path of the FE cycle.
+// flaps with the assumed-strain form, another as a thick shell), a prescribed velocity, a rotation
+// and non-trivial partitions: every code path of the FE cycle.
 const char* deck_text = R"(
 termination: {cycles: 150}
 materials:
@@ -40,11 +40,17 @@ parts:
     mesh: {generate: box, min: [0.02, -0.01, 0], max: [0.04, 0.01, 0.001], divisions: [8, 8, 1]}
     material: steel
     hourglass: {model: assumed_strain}
+  shell:
+    mesh: {generate: box, min: [0.05, -0.01, 0], max: [0.07, 0.01, 0.001], divisions: [8, 8, 1]}
+    material: steel
+    thick_shell: {points: 3}
 initial_conditions:
   - {part: bar, velocity: [0, 0, -400.0], angular_velocity: [0, 0, 2000.0], center: [0, 0, 0]}
   - {part: sheet, velocity: [0, 0, 60.0], angular_velocity: [3000.0, 0, 0], center: [0.03, 0, 0]}
+  - {part: shell, velocity: [0, 0, 80.0], angular_velocity: [3000.0, 0, 0], center: [0.06, 0, 0]}
 boundary_conditions:
   - {set: sheet.xmin, fix: all}
+  - {set: shell.xmin, fix: all}
   - {set: bar.bottom, fix: [z]}
   - {set: plate.zmin, velocity: [0, 0, 30.0]}
 )";

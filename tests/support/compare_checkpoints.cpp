@@ -1,7 +1,7 @@
 // compare_checkpoints A B: exit 0 when two checkpoints hold the same state bit for bit
 // (time, cycle, every node's position, velocity and contact history, every element's
-// state, every particle's state and contact history); diagnostics that are sums over
-// ranks may differ in the last bits and are not compared. Otherwise prints the first
+// state and its thick-shell points', every particle's state and contact history); diagnostics that
+// are sums over ranks may differ in the last bits and are not compared. Otherwise prints the first
 // difference of each section that differs (exit 1).
 #include <cstdio>
 #include <cstring>
@@ -49,6 +49,9 @@ int main(int argc, char** argv) {
     ok &= same("particle ids", a.particle_gid, b.particle_gid, 1);
     ok &= same("particles", a.particle_data, b.particle_data, Checkpoint::particle_values);
     ok &= same("particle contact faces", a.particle_face, b.particle_face, 1);
+    ok &= same("thick-shell element ids", a.point_gid, b.point_gid, 1);
+    ok &= same("thick-shell points", a.point_data, b.point_data, Checkpoint::point_values);
+    ok &= same("thick-shell point counts", a.point_count, b.point_count, 1);
     std::printf(
         "%s: cycle %lld vs %lld, t %.17g vs %.17g, %zu nodes, %zu elements, %zu particles\n",
         ok ? "identical" : "DIFFERENT", static_cast<long long>(a.cycle),

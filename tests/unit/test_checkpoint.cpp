@@ -1,5 +1,6 @@
-// The checkpoint file format (io/checkpoint.hpp): a version 3 file keeps every section
-// bit for bit, particles, eroded elements and both .pvd lists included; a version 1 file
+// The checkpoint file format (io/checkpoint.hpp): a version 4 file keeps every section
+// bit for bit, particles, eroded elements, thick-shell points and both .pvd lists
+// included; a version 1 file
 // (written before particles and erosion were checkpointed) still reads, as a model without
 // particles whose elements are all alive; a file whose
 // sections disagree is an InputError naming it. The restart itself is tested end to end
@@ -56,6 +57,9 @@ Checkpoint sample() {
   for (int k = 0; k < 3 * Checkpoint::particle_values; ++k)
     c.particle_data.push_back(k / 11.0 - 1.0);
   c.particle_face = {-1, 5, -1};
+  c.point_gid = {0};
+  for (int k = 0; k < Checkpoint::point_values; ++k) c.point_data.push_back(k / 13.0 + 0.5);
+  c.point_count = {3};
   return c;
 }
 
@@ -109,6 +113,9 @@ TEST(Checkpoint, RoundTripKeepsParticlesAndBothSeries) {
   EXPECT_TRUE(same_bits(r.particle_gid, c.particle_gid));
   EXPECT_TRUE(same_bits(r.particle_data, c.particle_data));
   EXPECT_TRUE(same_bits(r.particle_face, c.particle_face));
+  EXPECT_TRUE(same_bits(r.point_gid, c.point_gid));
+  EXPECT_TRUE(same_bits(r.point_data, c.point_data));
+  EXPECT_EQ(r.point_count, c.point_count);
   EXPECT_EQ(r.outputs.pvd, c.outputs.pvd);
   EXPECT_EQ(r.outputs.particle_pvd, c.outputs.particle_pvd);
 }
@@ -127,6 +134,7 @@ TEST(Checkpoint, VersionOneReadsWithoutParticles) {
   EXPECT_EQ(r.model_particles, 0);
   EXPECT_TRUE(r.particle_gid.empty());
   EXPECT_TRUE(r.outputs.particle_pvd.empty());
+  EXPECT_TRUE(r.point_gid.empty());
 }
 
 TEST(Checkpoint, InconsistentParticleCountNamesTheFile) {

@@ -114,6 +114,35 @@ TEST(Deck, BrokenReferences) {
                {"deck.yaml:5", "j3_plasticity", "johnson_cook"});
 }
 
+// thick_shell: {points: n}: 2 to 5 Gauss points through the thickness, with the
+// assumed-strain hourglass form for the other modes (implied, or given; any other form is
+// an error naming file, line and key).
+TEST(Deck, ThickShell) {
+  const std::string from = "hourglass: {model: viscous, coefficient: 0.05}";
+  std::string text = good;
+  text.replace(text.find(from), from.size(), "thick_shell: {points: 3}");
+  Config c = test::deck(text);
+  EXPECT_EQ(c.parts[0].thick_shell.points, 3);
+  EXPECT_EQ(c.parts[0].hourglass.model, HourglassControl::Model::assumed_strain);
+  EXPECT_DOUBLE_EQ(c.parts[0].hourglass.coefficient, 1.0);
+  text = good;
+  text.replace(
+      text.find(from), from.size(),
+      "thick_shell: {points: 2}\n    hourglass: {model: assumed_strain, coefficient: 0.5}");
+  c = test::deck(text);
+  EXPECT_EQ(c.parts[0].thick_shell.points, 2);
+  EXPECT_DOUBLE_EQ(c.parts[0].hourglass.coefficient, 0.5);
+  expect_error(from, "thick_shell: {points: 6}",
+               {"deck.yaml:11", "parts.bar.thick_shell.points", "between 2 and 5"});
+  expect_error(from, "thick_shell: {points: 1}",
+               {"deck.yaml:11", "parts.bar.thick_shell.points", "between 2 and 5"});
+  expect_error(from, "thick_shell: {points: two}", {"deck.yaml:11", "thick_shell.points"});
+  expect_error(from, "thick_shell: {}", {"thick_shell.points", "missing"});
+  expect_error(from, "thick_shell: {points: 3, layers: 2}", {"deck.yaml:11", "layers"});
+  expect_error(from, from + "\n    thick_shell: {points: 3}",
+               {"deck.yaml:11", "parts.bar.hourglass", "assumed_strain"});
+}
+
 // hourglass: {model: assumed_strain, coefficient: c}: c a scale on the physical stiffness,
 // 1 by default; bad values name file, line and key.
 TEST(Deck, AssumedStrainHourglass) {

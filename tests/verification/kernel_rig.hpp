@@ -23,7 +23,7 @@ struct KernelRig {
   HexResult result;
 
   KernelRig(Mesh m, const std::string& model, const ParamValues& params,
-            HourglassControl hourglass = {}, BulkViscosity bulk = {})
+            HourglassControl hourglass = {}, BulkViscosity bulk = {}, ThickShell shell = {})
       : mesh(std::move(m)) {
     fe = decompose_fe(mesh, std::vector<int>(static_cast<std::size_t>(mesh.num_elements()), 0), 0,
                       1);
@@ -31,6 +31,7 @@ struct KernelRig {
     block.material = material.get();
     block.hourglass = hourglass;
     block.bulk_viscosity = bulk;
+    block.thick_shell = shell;
     const std::size_t nn = fe.node_gid.size();
     for (int i = 0; i < 3; ++i) {
       x[i].resize(nn);

@@ -59,11 +59,22 @@ void midstep_gradient(double dt, double (&out)[3][3]) {
       out[i][j] = L[i][0] * inv[0][j] + L[i][1] * inv[1][j] + L[i][2] * inv[2][j];
 }
 
-class Patch : public ::testing::TestWithParam<HourglassControl::Model> {};
+// The element forms: the three hourglass controls, and the thick shell (three points
+// through the thickness, the assumed-strain form for its other modes).
+struct Form {
+  HourglassControl::Model hourglass;
+  int thick_shell_points = 0;
+};
+
+class Patch : public ::testing::TestWithParam<Form> {};
+
+test::KernelRig rig_for(unsigned seed, const Form& f) {
+  return test::KernelRig(distorted_box(seed), "elastic", test::elastic_steel(), {f.hourglass, 0.1},
+                         no_bulk_viscosity, ThickShell{f.thick_shell_points});
+}
 
 TEST_P(Patch, LinearVelocityGivesUniformStressAndBalancedInteriorNodes) {
-  test::KernelRig rig(distorted_box(3), "elastic", test::elastic_steel(), {GetParam(), 0.1},
-                      no_bulk_viscosity);
+  test::KernelRig rig = rig_for(3, GetParam());
   const std::size_t nn = rig.fe.node_gid.size();
   for (std::size_t k = 0; k < nn; ++k)
     for (int i = 0; i < 3; ++i)
@@ -110,8 +121,7 @@ TEST_P(Patch, LinearVelocityGivesUniformStressAndBalancedInteriorNodes) {
 // started on the same field, 200 cycles of central difference. The interior nodes must
 // stay on the homogeneous deformation x = (I + t L) X and the stress stay uniform.
 TEST_P(Patch, DrivenBoundaryCarriesInteriorAlongHomogeneousDeformation) {
-  test::KernelRig rig(distorted_box(5), "elastic", test::elastic_steel(), {GetParam(), 0.1},
-                      no_bulk_viscosity);
+  test::KernelRig rig = rig_for(5, GetParam());
   const std::size_t nn = rig.fe.node_gid.size();
   // Lumped nodal masses by the same exact gather the solver uses.
   std::vector<double> corner_mass(rig.fe.total_slots(), 0.0), mass(nn);
@@ -156,8 +166,9 @@ TEST_P(Patch, DrivenBoundaryCarriesInteriorAlongHomogeneousDeformation) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Hourglass, Patch,
-                         ::testing::Values(HourglassControl::Model::viscous,
-                                           HourglassControl::Model::stiffness,
-                                           HourglassControl::Model::assumed_strain));
+                         ::testing::Values(Form{HourglassControl::Model::viscous},
+                                           Form{HourglassControl::Model::stiffness},
+                                           Form{HourglassControl::Model::assumed_strain},
+                                           Form{HourglassControl::Model::assumed_strain, 3}));
 
 } // namespace

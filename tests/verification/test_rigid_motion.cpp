@@ -39,19 +39,23 @@ void rotation(const Vec3& a, double t, double (&R)[3][3]) {
 struct RigidRun {
   double max_abs_error = 0; // largest |sigma - R sigma0 R^T| over elements and components
   double scale = 0;
-  double max_hourglass = 0; // largest |Q_i,alpha| (stiffness forms), N
+  double max_hourglass = 0;   // largest |Q_i,alpha| (stiffness forms), N
+  double max_point_error = 0; // as max_abs_error, at a thick shell's points
 };
 
-RigidRun spin(const double (&sigma0)[6], HourglassControl::Model hg) {
+RigidRun spin(const double (&sigma0)[6], HourglassControl::Model hg, int thick_shell_points = 0) {
   test::KernelRig rig(distorted_block(), "j2_plasticity",
                       {{"density", 7850},
                        {"youngs_modulus", 200e9},
                        {"poissons_ratio", 0.3},
                        {"yield_stress", 250e6},
                        {"hardening_modulus", 1e9}},
-                      {hg, 0.1});
+                      {hg, 0.1}, BulkViscosity{}, ThickShell{thick_shell_points});
   for (int e = 0; e < rig.block.size(); ++e)
     for (int k = 0; k < 6; ++k) rig.block.stress[k][e] = sigma0[k];
+  for (auto& ps : rig.block.point_stress) // a thick shell's points: the same stress
+    for (int e = 0; e < rig.block.size(); ++e)
+      for (int k = 0; k < 6; ++k) ps[k][e] = sigma0[k];
   const std::size_t nn = rig.fe.node_gid.size();
   const Vec3 axis = Vec3{1, 2, 3} * (1 / std::sqrt(14.0)), center{0.005, -0.003, 0.01},
              drift{3.0, -1.0, 2.0};
@@ -102,6 +106,10 @@ RigidRun spin(const double (&sigma0)[6], HourglassControl::Model hg) {
   for (const auto& q : rig.block.hourglass_force) // empty for the viscous form
     for (std::size_t e = 0; e < q.size(); ++e)
       out.max_hourglass = std::max(out.max_hourglass, std::abs(q[e]));
+  for (const auto& ps : rig.block.point_stress)
+    for (int e = 0; e < rig.block.size(); ++e)
+      for (int k = 0; k < 6; ++k)
+        out.max_point_error = std::max(out.max_point_error, std::abs(ps[k][e] - expected[k]));
   return out;
 }
 
@@ -117,12 +125,24 @@ TEST(RigidMotion, ZeroStressStaysZeroThrough120Degrees) {
         "rigid motion, hourglass model %d: largest stress %.2e Pa, hourglass force %.2e N\n",
         static_cast<int>(hg), r.max_abs_error, r.max_hourglass);
   }
+  // The thick shell: its points' stresses (whose average is the element's) stay zero too.
+  const RigidRun r = spin(zero, HourglassControl::Model::assumed_strain, 3);
+  EXPECT_LT(r.max_abs_error, 1.0) << "Pa";
+  EXPECT_LT(r.max_point_error, 1.0) << "Pa";
+  EXPECT_LT(r.max_hourglass, 2.5e-5) << "N";
+  std::printf("rigid motion, thick shell (3 points): largest stress %.2e Pa (points %.2e Pa), "
+              "hourglass force %.2e N\n",
+              r.max_abs_error, r.max_point_error, r.max_hourglass);
 }
 
 TEST(RigidMotion, InitialStressRotatesWithTheBody) {
   const double s0[6] = {100e6, -20e6, 40e6, 30e6, -10e6, 15e6}; // below yield (von Mises ~ 140 MPa)
   const auto r = spin(s0, HourglassControl::Model::viscous);
   EXPECT_LT(r.max_abs_error, 1e-9 * r.scale);
+  // A thick shell's points rotate theirs alike.
+  const auto rs = spin(s0, HourglassControl::Model::assumed_strain, 3);
+  EXPECT_LT(rs.max_abs_error, 1e-9 * rs.scale);
+  EXPECT_LT(rs.max_point_error, 1e-9 * rs.scale);
 }
 
 // A free body in uniform translation through the whole solver stays stress-free and

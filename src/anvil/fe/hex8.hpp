@@ -279,6 +279,79 @@ ANVIL_HEX8_INLINE void assumed_strain_limit(const V& sy, const V (&len)[3], V (&
   }
 }
 
+// Gauss points and weights on [-1, 1] through the thickness of a thick-shell element
+// (docs/element.md, "Thick shell"): row n - 2 holds the n-point rule, n = 2..5.
+inline constexpr int thick_shell_max_points = 5;
+inline constexpr double thick_shell_point[4][5] = {
+    {-0.5773502691896257, 0.5773502691896257},
+    {-0.7745966692414834, 0.0, 0.7745966692414834},
+    {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526},
+    {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640}};
+inline constexpr double thick_shell_weight[4][5] = {
+    {1.0, 1.0},
+    {0.5555555555555556, 0.8888888888888888, 0.5555555555555556},
+    {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538},
+    {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
+     0.2369268850561891}};
+
+// The thick shell's stiffness rate for the hourglass modes its points do not integrate:
+// assumed_strain_rate without the zeta group (the normal modes (0, 1) and (1, 0), and the
+// twist modes' g_xy part), whose stresses vary through the thickness (zeta) and live at
+// the integration points. r[0][1] = r[1][0] = 0.
+template <class V>
+ANVIL_HEX8_INLINE void thick_shell_rate(double E, double mu, const V (&len)[3], const V (&q)[3][4],
+                                        V (&r)[3][4]) {
+  const V i01 = 1.0 / (len[0] * len[1]);
+  const V il[3] = {len[1] * i01, len[0] * i01, 1.0 / len[2]};
+  const V w = (1.0 / 192.0) * len[0] * len[1] * len[2];
+  _Pragma("GCC unroll 3") for (int d = 0; d < 3; ++d) {
+    const V k = (E * w) * (il[d] * il[d]);
+    _Pragma("GCC unroll 3") for (int al = 0; al < 3; ++al) if (al != d) r[d][al] = k * q[d][al];
+    r[d][3] = (1.0 / 3.0) * k * q[d][3];
+  }
+  r[0][1] = 0.0;
+  r[1][0] = 0.0;
+  const V gyz = q[1][1] * il[2] + q[2][2] * il[1];
+  const V gzx = q[2][2] * il[0] + q[0][0] * il[2];
+  const V mw = mu * w;
+  r[0][0] = mw * (gzx * il[2]);
+  r[1][1] = mw * (gyz * il[2]);
+  r[2][2] = mw * (gyz * il[1] + gzx * il[0]);
+}
+
+// The plastic limit of thick_shell_rate's forces: assumed_strain_limit's eta and xi groups
+// and xi eta zeta clips (the zeta group yields at the integration points). With no
+// zeta-group force, the twist forces give the shear moments directly: T_zx = Q_x len2,
+// T_yz = Q_y len2 (and Q_z = T_yz il1 + T_zx il0).
+template <class V>
+ANVIL_HEX8_INLINE void thick_shell_limit(const V& sy, const V (&len)[3], V (&Q)[3][4]) {
+  using std::sqrt;
+  const V iv = 128.0 / (len[0] * len[1] * len[2]); // 2 / V
+  const V tyz = Q[1][1] * len[2], tzx = Q[0][0] * len[2];
+  const V ks = 1.7320508075688772 * iv;
+  const V sy2 = sy * sy;
+  auto group = [&](int d, int al, int e, int be, const V& t) {
+    const V sa = Q[d][al] * len[d] * iv, sb = Q[e][be] * len[e] * iv, ss = t * ks;
+    const V phi = sa * sa - sa * sb + sb * sb + ss * ss;
+    const V k = simd::select(phi > sy2, sy / sqrt(phi), V(1.0));
+    Q[d][al] *= k;
+    Q[e][be] *= k;
+    return k;
+  };
+  const V ky = group(0, 2, 2, 0, tzx);
+  const V kx = group(1, 2, 2, 1, tyz);
+  const V syz = tyz * kx, szx = tzx * ky;
+  const V il0 = 1.0 / len[0], il1 = 1.0 / len[1], il2 = 1.0 / len[2];
+  const auto scaled = (ky < 1.0) || (kx < 1.0);
+  Q[0][0] = simd::select(scaled, szx * il2, Q[0][0]);
+  Q[1][1] = simd::select(scaled, syz * il2, Q[1][1]);
+  Q[2][2] = simd::select(scaled, syz * il1 + szx * il0, Q[2][2]);
+  _Pragma("GCC unroll 3") for (int d = 0; d < 3; ++d) {
+    const V cap = (sy * (1.0 / 256.0)) * (len[(d + 1) % 3] * len[(d + 2) % 3]); // |s| <= sy
+    Q[d][3] = simd::select(Q[d][3] > cap, cap, simd::select(Q[d][3] < -cap, -cap, Q[d][3]));
+  }
+}
+
 // Hourglass shape vectors gamma_alpha = Gamma_alpha - (1/V)(Gamma_alpha . x_i) B_i, which
 // are orthogonal to every linear velocity field on any shape (the property that lets the
 // element pass the patch test with hourglass control on).

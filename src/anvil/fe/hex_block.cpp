@@ -9,6 +9,8 @@
 
 namespace anvil {
 
+static_assert(ThickShell::max_points == hex8::thick_shell_max_points);
+
 using simd::vdouble;
 using simd::width;
 namespace stdx = simd::stdx;
@@ -39,9 +41,10 @@ enum Slot : int {
   s_q6,
   s_q7,
   s_q8,
-  s_x0,             // 24 gathered positions (3 a + i)
-  s_v0 = s_x0 + 24, // 24 gathered velocities
-  s_count = s_v0 + 24
+  s_x0,              // 24 gathered positions (3 a + i)
+  s_v0 = s_x0 + 24,  // 24 gathered velocities
+  s_pd0 = s_v0 + 24, // thick shell: the rate of deformation at each point (6 p + k)
+  s_count = s_pd0 + 6 * hex8::thick_shell_max_points
 };
 
 // Stage scratch of one vector of elements, after the chunk scratch: `width` values per
@@ -64,9 +67,9 @@ constexpr int prefetch_ahead = 32; // elements
 constexpr int node_stride = 8;
 
 // Packs nodes [lo, hi) of the nodal arrays into p (node k at p + node_stride k).
-// A template only so that each of detail::block_forces' two instantiations has its own
+// A template only so that each of detail::block_forces' instantiations has its own
 // copy, called once and inlined as when hex_forces was the only caller (as gather below).
-template <bool Asq>
+template <int Form>
 void pack_nodes(const NodalView& n, int lo, int hi, double* __restrict p) {
   const double* __restrict x0 = n.x[0];
   const double* __restrict x1 = n.x[1];
@@ -109,7 +112,7 @@ void pack_nodes(const NodalView& n, int lo, int hi, double* __restrict p) {
 // C, and writes the edge sums of the mid-step positions x - h v (and their x
 // coordinates) to the stage scratch t. conn: the block's eight corner index arrays;
 // ahead: the element to prefetch for.
-template <bool Asq>
+template <int Form>
 void gather(const int* const (&conn)[8], const double* packed, int e, int ahead, double h,
             double* __restrict xs, double* __restrict vs, double* __restrict t) {
   constexpr int C = HexWorkspace::chunk;
@@ -171,6 +174,132 @@ template <class Use>
   }
 }
 
+// Thick shell, stage A: the points' rates of deformation D_p = D + zeta_p A - c_p e_z e_z
+// for elements e..e+width-1 (chunk lane l), written to pd (6 p + k chunk arrays), their
+// old stresses rotated by Q, and their stress power sum_p w_p / 2 sigma_p : D_p returned.
+// A is the bending rate per unit zeta at the mid-step, from the zeta group's hourglass
+// velocities in the co-rotational frame (curvature rates k_xx = q_x,xi zeta / len0,
+// k_yy = q_y,eta zeta / len1, twist k_xy = q_x,eta zeta / len1 + q_y,xi zeta / len0)
+// with the plane-stress thickness rate -nu_ps (k_xx + k_yy); c_p drives each point's
+// thickness stress towards the element's average (docs/element.md, "Thick shell").
+// L is the mid-step velocity gradient, d its symmetric part.
+[[gnu::always_inline]] inline vdouble
+shell_point_rates(HexBlock& b, int e, int l, double dt, const vdouble (&L)[3][3],
+                  const vdouble (&d)[6], const vdouble (&Q)[3][3], int np, const double* zeta_p,
+                  const double* w_p, double nu_ps, double M, const double* xs, const double* vs,
+                  double* pd) {
+  constexpr int C = HexWorkspace::chunk;
+  vdouble J[3][3], gx[3][4], qz[3][2];
+  _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) {
+    vdouble col[8], gv[4];
+    _Pragma("GCC unroll 8") for (int a = 0; a < 8; ++a) col[a] =
+        simd::load(xs + (3 * a + i) * C + l) - (0.5 * dt) * simd::load(vs + (3 * a + i) * C + l);
+    hex8::gamma_sums(col, gx[i]);
+    hex8::natural_sums(col, J[i]);
+    _Pragma("GCC unroll 8") for (int a = 0; a < 8; ++a) col[a] =
+        simd::load(vs + (3 * a + i) * C + l);
+    hex8::gamma_sums(col, gv);
+    qz[i][0] = gv[0];
+    qz[i][1] = gv[1];
+  }
+  _Pragma("GCC unroll 2") for (int al = 0; al < 2; ++al)
+      _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) qz[i][al] -=
+      L[i][0] * gx[0][al] + L[i][1] * gx[1][al] + L[i][2] * gx[2][al];
+  vdouble ax[3][3], ext[3];
+  hex8::corotational_frame(J, ax, ext);
+  auto local = [&](int dd, int al) {
+    return ax[dd][0] * qz[0][al] + ax[dd][1] * qz[1][al] + ax[dd][2] * qz[2][al];
+  };
+  const vdouble il0 = 1.0 / ext[0], il1 = 1.0 / ext[1];
+  const vdouble kxx = local(0, 1) * il0, kyy = local(1, 0) * il1;
+  const vdouble kxy = local(0, 0) * il1 + local(1, 1) * il0;
+  const vdouble kzz = -nu_ps * (kxx + kyy);
+  const int ij[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}};
+  vdouble A[6], Z[6];
+  _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) {
+    const int i = ij[k][0], j = ij[k][1];
+    Z[k] = ax[2][i] * ax[2][j];
+    A[k] = ax[0][i] * ax[0][j] * kxx + ax[1][i] * ax[1][j] * kyy +
+           (0.5 * kxy) * (ax[0][i] * ax[1][j] + ax[1][i] * ax[0][j]) + Z[k] * kzz;
+  }
+  // The points' old stresses into the new frame, and their thickness stresses.
+  vdouble szz[hex8::thick_shell_max_points], mean = 0.0;
+  for (int p = 0; p < np; ++p) {
+    vdouble sp[6];
+    _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) sp[k] =
+        simd::load(&b.point_stress[p][k][e]);
+    hex8::rotate_symmetric(Q, sp);
+    _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k)
+        simd::store(sp[k], &b.point_stress[p][k][e]);
+    szz[p] = Z[0] * sp[0] + Z[1] * sp[1] + Z[2] * sp[2] +
+             2.0 * (Z[3] * sp[3] + Z[4] * sp[4] + Z[5] * sp[5]);
+    mean += (0.5 * w_p[p]) * szz[p];
+  }
+  const double icorr = dt > 0 ? 1.0 / (M * dt) : 0.0;
+  vdouble power = 0.0;
+  for (int p = 0; p < np; ++p) {
+    const vdouble c = (szz[p] - mean) * icorr;
+    vdouble dp[6], sp[6];
+    _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) {
+      dp[k] = d[k] + zeta_p[p] * A[k] - c * Z[k];
+      simd::store(dp[k], pd + (6 * p + k) * C + l);
+      sp[k] = simd::load(&b.point_stress[p][k][e]);
+    }
+    power += (0.5 * w_p[p]) * (sp[0] * dp[0] + sp[1] * dp[1] + sp[2] * dp[2] +
+                               2.0 * (sp[3] * dp[3] + sp[4] * dp[4] + sp[5] * dp[5]));
+  }
+  return power;
+}
+
+// Thick shell, stage C: the points' new stress power, sum_p w_p / 2 sigma_p : D_p.
+[[gnu::always_inline]] inline vdouble shell_power(const HexBlock& b, int e, int l, int np,
+                                                  const double* w_p, const double* pd) {
+  constexpr int C = HexWorkspace::chunk;
+  vdouble power = 0.0;
+  for (int p = 0; p < np; ++p) {
+    vdouble sp[6], dp[6];
+    _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) {
+      sp[k] = simd::load(&b.point_stress[p][k][e]);
+      dp[k] = simd::load(pd + (6 * p + k) * C + l);
+    }
+    power += (0.5 * w_p[p]) * (sp[0] * dp[0] + sp[1] * dp[1] + sp[2] * dp[2] +
+                               2.0 * (sp[3] * dp[3] + sp[4] * dp[4] + sp[5] * dp[5]));
+  }
+  return power;
+}
+
+// Thick shell, stage C: adds to the generalized hourglass forces r (co-rotational frame)
+// those of the points' stresses, whose power is the bending part of their stress power:
+// the first moments M = int sigma zeta dV = V / 2 sum_p w_p zeta_p sigma_p in the frame give
+// r[0][1] += (M_xx - nu_ps M_zz) / len0, r[1][0] += (M_yy - nu_ps M_zz) / len1 and the
+// twist r[0][0] += M_xy / len1, r[1][1] += M_xy / len0.
+[[gnu::always_inline]] inline void
+shell_bending_forces(const HexBlock& b, int e, const vdouble& vol, const vdouble (&ax)[3][3],
+                     const vdouble (&len)[3], int np, const double* zeta_p, const double* w_p,
+                     double nu_ps, vdouble (&r)[3][4]) {
+  vdouble m[6];
+  _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) {
+    m[k] = (w_p[0] * zeta_p[0]) * simd::load(&b.point_stress[0][k][e]);
+    for (int p = 1; p < np; ++p)
+      m[k] += (w_p[p] * zeta_p[p]) * simd::load(&b.point_stress[p][k][e]);
+  }
+  const vdouble S[3][3] = {{m[0], m[3], m[5]}, {m[3], m[1], m[4]}, {m[5], m[4], m[2]}};
+  auto frame = [&](int dd, int ee) {
+    vdouble sum = 0.0;
+    _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) sum +=
+        ax[dd][i] * (S[i][0] * ax[ee][0] + S[i][1] * ax[ee][1] + S[i][2] * ax[ee][2]);
+    return sum;
+  };
+  const vdouble half = 0.5 * vol;
+  const vdouble mxx = half * frame(0, 0), myy = half * frame(1, 1), mxy = half * frame(0, 1),
+                mzz = half * frame(2, 2);
+  const vdouble il0 = 1.0 / len[0], il1 = 1.0 / len[1];
+  r[0][1] += (mxx - nu_ps * mzz) * il0;
+  r[1][0] += (myy - nu_ps * mzz) * il1;
+  r[0][0] += mxy * il1;
+  r[1][1] += mxy * il0;
+}
+
 } // namespace
 
 int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array<int, 8>> corners,
@@ -213,6 +342,13 @@ int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array
   for (auto& h : hourglass_force) h.clear();
   if (hourglass.model != HourglassControl::Model::viscous)
     for (auto& h : hourglass_force) h.assign(p, 0.0);
+  const auto np = static_cast<std::size_t>(thick_shell.points);
+  point_stress.assign(np, {});
+  for (auto& ps : point_stress)
+    for (auto& s : ps) s.assign(p, 0.0);
+  point_plastic_strain.assign(material->has_plastic_strain() ? np : 0, std::vector<double>(p, 0.0));
+  point_temperature.assign(material->has_temperature() ? np : 0,
+                           std::vector<double>(p, material->initial_temperature()));
   internal_energy.assign(p, 0.0);
   hourglass_energy.assign(p, 0.0);
   return bad;
@@ -258,12 +394,15 @@ void HexWorkspace::end_nodal_forces(double* const f[3]) {
 
 namespace detail {
 
-// hex_forces for one block, compiled twice: Asq for the assumed-strain hourglass form, and
-// without it for the viscous and stiffness forms, which then run the instructions they
-// ran before that form existed (it is not a branch in their code).
-template <bool Asq>
+// hex_forces for one block, compiled three times: Form 0 for the viscous and stiffness
+// hourglass forms, 1 for the assumed-strain form, 2 for the thick shell (assumed strain
+// with the bending integrated through the thickness), so that each form runs the
+// instructions it ran before the next existed (they are not branches in its code).
+template <int Form>
 void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corners,
                   HexWorkspace& work, HexResult& result) {
+  constexpr bool Asq = Form != 0;
+  constexpr bool Shell = Form == 2;
   const int n = b.size();
   constexpr int C = HexWorkspace::chunk;
   auto scratch = [&](int slot) { return work.buf_.data() + static_cast<std::size_t>(slot) * C; };
@@ -275,6 +414,14 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
   // Assumed strain with a material that yields: the plastic limit of the hourglass forces.
   [[maybe_unused]] const bool limit = Asq && b.material->has_plastic_strain();
   const double c1 = b.bulk_viscosity.linear, c2 = b.bulk_viscosity.quadratic;
+  // Thick shell: points, their places and weights, and the plane-stress ratio
+  // lambda / (lambda + 2 mu) that gives the bending its through-thickness strain.
+  [[maybe_unused]] const int np = b.thick_shell.points;
+  [[maybe_unused]] const double* zeta_p =
+      Shell ? hex8::thick_shell_point[np - 2] : hex8::thick_shell_point[0];
+  [[maybe_unused]] const double* w_p =
+      Shell ? hex8::thick_shell_weight[np - 2] : hex8::thick_shell_weight[0];
+  [[maybe_unused]] const double nu_ps = (M - 2.0 * b.material->elastic().shear) / M;
   const bool has_ep = !b.plastic_strain.empty(), has_T = !b.temperature.empty();
   const bool erode_ep = b.erosion.plastic_strain > 0 && has_ep;
   // Nodal assembly (HexWorkspace::begin_nodal_forces), or null.
@@ -290,7 +437,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
   // Positions and velocities of the block's nodes, packed per node.
   const std::size_t packed_size = node_stride * static_cast<std::size_t>(b.node_end);
   if (work.nodes_.size() < packed_size) work.nodes_.resize(packed_size); // first calls only
-  pack_nodes<Asq>(nodes, b.node_begin, b.node_end, work.nodes_.data());
+  pack_nodes<Form>(nodes, b.node_begin, b.node_end, work.nodes_.data());
   const double* packed = work.nodes_.data();
   const int* conn[8];
   for (int a = 0; a < 8; ++a) conn[a] = b.conn[a].data();
@@ -318,8 +465,8 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
     // rotate the old stress into the new frame.
     for (int l = 0; l < nc; l += width) {
       const int e = e0 + l;
-      gather<Asq>(conn, packed, e, std::min(e + prefetch_ahead, padded_size(n) - width), 0.5 * dt,
-                  scratch(s_x0) + l, scratch(s_v0) + l, t);
+      gather<Form>(conn, packed, e, std::min(e + prefetch_ahead, padded_size(n) - width), 0.5 * dt,
+                   scratch(s_x0) + l, scratch(s_v0) + l, t);
       simd::stage_barrier();
       // 12 B(x(n-1/2)) one direction at a time, consumed at once: 12 V and 12 V L^T.
       vdouble L[3][3], vol12;
@@ -340,8 +487,11 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       hex8::hughes_winget(w, dt, Q);
       _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) s[k] = simd::load(&b.stress[k][e]);
       hex8::rotate_symmetric(Q, s);
-      const vdouble power =
+      vdouble power =
           s[0] * d[0] + s[1] * d[1] + s[2] * d[2] + 2.0 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
+      if constexpr (Shell)
+        power = shell_point_rates(b, e, l, dt, L, d, Q, np, zeta_p, w_p, nu_ps, M, xs, vs,
+                                  scratch(s_pd0));
       _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) {
         simd::store(s[k], &b.stress[k][e]);
         simd::store(d[k], scratch(s_d0 + k) + l);
@@ -368,7 +518,39 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
     batch.plastic_strain = has_ep ? b.plastic_strain.data() + e0 : nullptr;
     batch.temperature = has_T ? b.temperature.data() + e0 : nullptr;
     batch.wave_speed = scratch(s_wave_speed);
-    b.material->update(batch);
+    if constexpr (Shell) {
+      // Each point through the thickness, then the element's averages (stress for the
+      // membrane forces and the outputs, the state for the flow stress and erosion).
+      for (int p = 0; p < np; ++p) {
+        MaterialBatch pb = batch;
+        _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) {
+          pb.d[k] = scratch(s_pd0 + 6 * p + k);
+          pb.stress[k] = b.point_stress[p][k].data() + e0;
+        }
+        pb.plastic_strain = has_ep ? b.point_plastic_strain[p].data() + e0 : nullptr;
+        pb.temperature = has_T ? b.point_temperature[p].data() + e0 : nullptr;
+        pb.wave_speed = p == 0 ? scratch(s_wave_speed) : scratch(s_q1);
+        b.material->update(pb);
+        if (p > 0)
+          for (int l = 0; l < nc; ++l)
+            scratch(s_wave_speed)[l] = std::max(scratch(s_wave_speed)[l], scratch(s_q1)[l]);
+      }
+      auto average = [&](auto&& point, double* out) {
+        for (int l = 0; l < nc; l += width) {
+          vdouble sum = (0.5 * w_p[0]) * simd::load(point(0) + e0 + l);
+          for (int p = 1; p < np; ++p) sum += (0.5 * w_p[p]) * simd::load(point(p) + e0 + l);
+          simd::store(sum, out + e0 + l);
+        }
+      };
+      for (int k = 0; k < 6; ++k)
+        average([&](int p) { return b.point_stress[p][k].data(); }, b.stress[k].data());
+      if (has_ep)
+        average([&](int p) { return b.point_plastic_strain[p].data(); }, b.plastic_strain.data());
+      if (has_T)
+        average([&](int p) { return b.point_temperature[p].data(); }, b.temperature.data());
+    } else {
+      b.material->update(batch);
+    }
     if (limit) b.material->flow_stress(batch, scratch(s_flow));
 
     // Stage C: forces at x(n): stress divergence, bulk viscosity, hourglass; energies and
@@ -470,18 +652,29 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         // With a flow stress, the forces are then limited to a fully plastic section's
         // (hex8::assumed_strain_limit); the work of the forces includes what that dissipates.
         vdouble r[3][4], old[3][4];
-        hex8::assumed_strain_rate(hg_E, hg_mu, extent, ql, r);
+        if constexpr (Shell)
+          hex8::thick_shell_rate(hg_E, hg_mu, extent, ql, r);
+        else
+          hex8::assumed_strain_rate(hg_E, hg_mu, extent, ql, r);
         _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
             _Pragma("GCC unroll 12") for (int d = 0; d < 3; ++d) {
           old[d][al] = simd::load(&b.hourglass_force[3 * al + d][e]);
           r[d][al] = old[d][al] + dt * r[d][al];
         }
-        if (limit) hex8::assumed_strain_limit(simd::load(scratch(s_flow) + l), extent, r);
+        if (limit) {
+          if constexpr (Shell)
+            hex8::thick_shell_limit(simd::load(scratch(s_flow) + l), extent, r);
+          else
+            hex8::assumed_strain_limit(simd::load(scratch(s_flow) + l), extent, r);
+        }
         _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
             _Pragma("GCC unroll 12") for (int d = 0; d < 3; ++d) {
           simd::store(r[d][al], &b.hourglass_force[3 * al + d][e]);
           hg_power += 0.5 * (old[d][al] + r[d][al]) * ql[d][al];
         }
+        // Thick shell: the bending forces of the points' stresses (their work is in the
+        // internal energy).
+        if constexpr (Shell) shell_bending_forces(b, e, vol, ax, extent, np, zeta_p, w_p, nu_ps, r);
         _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
             _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) Qh[i][al] =
                 ax[0][i] * r[0][al] + ax[1][i] * r[1][al] + ax[2][i] * r[2][al];
@@ -496,8 +689,9 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
               (-1.0 / 12.0);
 
       // Energies over the step just taken (dt = 0 on the first cycle).
-      const vdouble power_new =
+      vdouble power_new =
           s[0] * d[0] + s[1] * d[1] + s[2] * d[2] + 2.0 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
+      if constexpr (Shell) power_new = shell_power(b, e, l, np, w_p, scratch(s_pd0));
       const vdouble vmid = simd::load(scratch(s_volume_mid) + l);
       vdouble dE = dt * vmid * (0.5 * (simd::load(scratch(s_power_old) + l) + power_new) - q * trd);
       const auto dead = simd::load(&b.alive[e]) == 0.0; // eroded elements store no energy
@@ -555,6 +749,11 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
           vdouble sk = simd::load(&b.stress[k][e]);
           stdx::where(dead, sk) = 0.0;
           simd::store(sk, &b.stress[k][e]);
+          for (auto& ps : b.point_stress) {
+            vdouble pk = simd::load(&ps[k][e]);
+            stdx::where(dead, pk) = 0.0;
+            simd::store(pk, &ps[k][e]);
+          }
         }
       }
 
@@ -638,6 +837,8 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
           for (int a = 0; a < 8; ++a)
             for (double* r : rows_of) r[8 * k + a] = 0.0;
           for (auto& sk : b.stress) sk[e + k] = 0.0;
+          for (auto& ps : b.point_stress)
+            for (auto& sk : ps) sk[e + k] = 0.0;
           ++result.eroded;
           continue;
         }
@@ -660,10 +861,12 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
 
 void hex_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView corners,
                 HexWorkspace& work, HexResult& result) {
-  if (b.hourglass.model == HourglassControl::Model::assumed_strain)
-    detail::block_forces<true>(b, nodes, dt, corners, work, result);
+  if (b.thick_shell.enabled())
+    detail::block_forces<2>(b, nodes, dt, corners, work, result);
+  else if (b.hourglass.model == HourglassControl::Model::assumed_strain)
+    detail::block_forces<1>(b, nodes, dt, corners, work, result);
   else
-    detail::block_forces<false>(b, nodes, dt, corners, work, result);
+    detail::block_forces<0>(b, nodes, dt, corners, work, result);
 }
 
 void hex_volumes(const HexBlock& b, const double* const x[3], std::span<double> out) {

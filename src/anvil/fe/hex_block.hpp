@@ -45,6 +45,17 @@ struct Erosion {
   bool enabled() const { return plastic_strain > 0 || inverted; }
 };
 
+// Thick shell (optional, per part; docs/element.md, "Thick shell"): the element's
+// bending through its thinnest direction (made its zeta axis when the mesh is built,
+// orient_thick_shells) is integrated at `points` Gauss points through the thickness, each
+// with its own stress and material state, instead of carried by hourglass forces; the
+// other hourglass modes take the assumed-strain stiffness.
+struct ThickShell {
+  static constexpr int max_points = 5;
+  int points = 0; // 0: off; else 2..max_points
+  bool enabled() const { return points > 0; }
+};
+
 struct HexBlock {
   std::string name;                   // part name
   int part = 0;                       // part index in the deck
@@ -52,6 +63,7 @@ struct HexBlock {
   HourglassControl hourglass;
   BulkViscosity bulk_viscosity;
   Erosion erosion;
+  ThickShell thick_shell;
 
   std::vector<std::int64_t> gid;                       // global element ids, ascending
   std::array<std::vector<int>, 8> conn;                // local node index of each corner
@@ -66,15 +78,21 @@ struct HexBlock {
                                                        // forms only: global components for
                                                        // `stiffness`, co-rotational ones for
                                                        // `assumed_strain`
-  std::vector<double> internal_energy;                 // J, stress work plus bulk viscosity work
-  std::vector<double> hourglass_energy;                // J
-  std::size_t corner_base = 0;                         // corner (e, a) of this block lives at slot
-                                                       // corner_base + 8 e + a (element-major)
-  int node_begin = 0, node_end = 0;                    // the local nodes the corners refer to
-                                                       // lie in [node_begin, node_end)
-  std::vector<std::uint8_t> corner_rows;               // per vector of elements: 1 where the
-                                                       // kernel stores the corner slots (init:
-                                                       // all; see HexWorkspace::begin_nodal_forces)
+  // Thick shell: the state at each point through the thickness (point p at zeta =
+  // hex8::thick_shell_point); stress, plastic_strain and temperature above then hold
+  // their thickness averages (Gauss weights).
+  std::vector<std::array<std::vector<double>, 6>> point_stress;
+  std::vector<std::vector<double>> point_plastic_strain; // empty unless the material has it
+  std::vector<std::vector<double>> point_temperature;    // empty unless the material has it
+  std::vector<double> internal_energy;                   // J, stress work plus bulk viscosity work
+  std::vector<double> hourglass_energy;                  // J
+  std::size_t corner_base = 0;           // corner (e, a) of this block lives at slot
+                                         // corner_base + 8 e + a (element-major)
+  int node_begin = 0, node_end = 0;      // the local nodes the corners refer to
+                                         // lie in [node_begin, node_end)
+  std::vector<std::uint8_t> corner_rows; // per vector of elements: 1 where the
+                                         // kernel stores the corner slots (init:
+                                         // all; see HexWorkspace::begin_nodal_forces)
 
   int size() const { return static_cast<int>(gid.size()); }
 
@@ -125,7 +143,7 @@ struct HexResult {
 
 class HexWorkspace;
 namespace detail {
-template <bool Asq>
+template <int Form>
 void block_forces(HexBlock&, const NodalView&, double, CornerView, HexWorkspace&, HexResult&);
 }
 
@@ -152,7 +170,7 @@ public:
   void end_nodal_forces(double* const f[3]);
 
 private:
-  template <bool Asq>
+  template <int Form>
   friend void detail::block_forces(HexBlock&, const NodalView&, double, CornerView, HexWorkspace&,
                                    HexResult&);
   std::vector<double, CacheAligned<double>> buf_;   // chunk and stage scratch

@@ -19,9 +19,10 @@ namespace {
 // The format's version is the magic's last character. Version 2 added the particle
 // sections after the element sections and the header keys model_particles and
 // particle_pvd; version 3 the eroded flag of every element, after the particle sections
-// (erosion survives a restart). Files of versions 1 (no particles) and 2 still load, with
-// every element alive.
-constexpr char magic[8] = {'A', 'N', 'V', 'I', 'L', 'C', 'K', '3'};
+// (erosion survives a restart); version 4 the state at the points through the thickness
+// of thick-shell elements, last. Files of versions 1 (no particles), 2 and 3 still load,
+// with every element alive (1, 2) and no thick-shell state (1-3).
+constexpr char magic[8] = {'A', 'N', 'V', 'I', 'L', 'C', 'K', '4'};
 constexpr std::size_t magic_version = 7;
 
 // Sends this rank's records to rank 0, which keeps them in ascending global id.
@@ -136,6 +137,22 @@ Checkpoint capture(const Simulation& sim, const OutputState& outputs) {
     }
   gather_sorted<Checkpoint::element_values>(comm, gid, data, face, c.element_gid, c.element_data,
                                             c.element_eroded);
+  gid.clear();
+  data.clear();
+  face.clear();
+  for (const auto& b : sim.blocks())
+    for (int e = 0; b.thick_shell.enabled() && e < b.size(); ++e) {
+      gid.push_back(b.gid[e]);
+      for (int p = 0; p < 5; ++p) {
+        const bool in = p < b.thick_shell.points;
+        for (int k = 0; k < 6; ++k) data.push_back(in ? b.point_stress[p][k][e] : 0.0);
+        data.push_back(in && !b.point_plastic_strain.empty() ? b.point_plastic_strain[p][e] : 0.0);
+        data.push_back(in && !b.point_temperature.empty() ? b.point_temperature[p][e] : 0.0);
+      }
+      face.push_back(b.thick_shell.points);
+    }
+  gather_sorted<Checkpoint::point_values>(comm, gid, data, face, c.point_gid, c.point_data,
+                                          c.point_count);
   if (const sph::SphPhase* sph = sim.sph()) {
     c.model_particles = sph->global_count();
     gid.clear();
@@ -203,6 +220,9 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
   put(s, c.particle_data);
   put(s, c.particle_face);
   put(s, c.element_eroded);
+  put(s, c.point_gid);
+  put(s, c.point_data);
+  put(s, c.point_count);
   write_file_atomic(path, s);
 }
 
@@ -215,8 +235,8 @@ Checkpoint read_checkpoint(const std::string& path) {
   if (s.size() < sizeof magic || std::memcmp(s.data(), magic, magic_version) != 0)
     throw InputError("'" + path + "' is not an anvil checkpoint");
   const char version = s[magic_version];
-  if (version < '1' || version > '3')
-    throw InputError(fmt::format("checkpoint '{}' has format version {}; this anvil reads 1 to 3",
+  if (version < '1' || version > '4')
+    throw InputError(fmt::format("checkpoint '{}' has format version {}; this anvil reads 1 to 4",
                                  path, version));
   std::size_t pos = sizeof magic;
   Checkpoint c;
@@ -240,6 +260,11 @@ Checkpoint read_checkpoint(const std::string& path) {
     get(s, pos, c.element_eroded, path);
   else // earlier versions did not record erosion: every element alive
     c.element_eroded.assign(c.element_gid.size(), 0);
+  if (version >= '4') {
+    get(s, pos, c.point_gid, path);
+    get(s, pos, c.point_data, path);
+    get(s, pos, c.point_count, path);
+  }
   try {
     const auto h = nlohmann::json::parse(std::string(header.begin(), header.end()));
     c.deck = h.at("deck").get<std::string>();
@@ -263,6 +288,8 @@ Checkpoint read_checkpoint(const std::string& path) {
       c.element_eroded.size() != c.element_gid.size() ||
       c.particle_data.size() != c.particle_gid.size() * Checkpoint::particle_values ||
       c.particle_face.size() != c.particle_gid.size() ||
+      c.point_data.size() != c.point_gid.size() * Checkpoint::point_values ||
+      c.point_count.size() != c.point_gid.size() ||
       c.model_particles != static_cast<std::int64_t>(c.particle_gid.size()))
     throw InputError("checkpoint '" + path + "' is inconsistent");
   c.time = exact[0];

@@ -30,6 +30,9 @@ struct Checkpoint {
   // plastic strain, temperature, wave speed. What the deck fixes (set, mass, reference
   // position, constraints) is not stored: the restarted run rebuilds it from the deck.
   static constexpr int particle_values = 18;
+  // Per thick-shell element (version 4): stress (6), plastic strain and temperature at
+  // each of up to five points through the thickness (zero past the element's points).
+  static constexpr int point_values = 8 * 5;
   std::string deck; // the deck the run came from (for messages)
   std::string file; // the file it was read from (for messages; empty when captured)
   double time = 0, dt = 0, dt_prev = 0, dt_initial = 0;
@@ -45,6 +48,9 @@ struct Checkpoint {
   std::vector<std::int64_t> particle_gid;           // ascending (empty without particles)
   std::vector<double> particle_data;                // particle_values per particle
   std::vector<std::int64_t> particle_face;          // contact history: last face per particle
+  std::vector<std::int64_t> point_gid;              // thick-shell elements, ascending (version 4)
+  std::vector<double> point_data;                   // point_values per thick-shell element
+  std::vector<std::int64_t> point_count;            // points through each one's thickness
   std::int64_t model_nodes = 0, model_elements = 0; // sizes of the model, for validation
   std::int64_t model_particles = 0;
 };

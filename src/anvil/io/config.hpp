@@ -50,6 +50,7 @@ struct PartConfig {
   HourglassControl hourglass;
   BulkViscosity bulk_viscosity;
   Erosion erosion;
+  ThickShell thick_shell;
   SourceLocation where;
 };
 

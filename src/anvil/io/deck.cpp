@@ -361,7 +361,7 @@ PartConfig parse_part(const std::string& name, const Node& n, const std::string&
   PartConfig p;
   p.name = name;
   p.where = n.where();
-  n.check_keys({"mesh", "material", "hourglass", "bulk_viscosity", "erosion"});
+  n.check_keys({"mesh", "material", "hourglass", "bulk_viscosity", "erosion", "thick_shell"});
   p.mesh = parse_mesh(n.required("mesh"), base_dir);
   p.material = n.required("material").str();
   if (n.has("hourglass")) {
@@ -385,6 +385,21 @@ PartConfig parse_part(const std::string& name, const Node& n, const std::string&
       if (!(c >= 0 && c <= 1)) h.child("coefficient").fail("must be between 0 and 1");
       p.hourglass.coefficient = c;
     }
+  }
+  if (n.has("thick_shell")) {
+    const Node ts = n.child("thick_shell");
+    ts.check_keys({"points"});
+    const auto pts = ts.required("points").integer();
+    if (pts < 2 || pts > ThickShell::max_points)
+      ts.child("points").fail(fmt::format("must be between 2 and {}", ThickShell::max_points));
+    p.thick_shell.points = static_cast<int>(pts);
+    // The element's other hourglass modes take the assumed-strain stiffness.
+    if (!n.has("hourglass"))
+      p.hourglass = {HourglassControl::Model::assumed_strain, 1.0};
+    else if (p.hourglass.model != HourglassControl::Model::assumed_strain)
+      n.child("hourglass")
+          .fail("a thick_shell part needs hourglass model assumed_strain (its "
+                "other hourglass modes take that stiffness)");
   }
   if (n.has("erosion")) {
     const Node er = n.child("erosion");

@@ -94,4 +94,72 @@ std::vector<std::int64_t> block_nodes(const Mesh& mesh, std::size_t b) {
   return ids;
 }
 
+namespace {
+
+// Natural coordinates of the hexahedron's corners.
+constexpr int corner_xi[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+                                 {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
+
+// turn[t][k]: the old corner that becomes corner k when the old axis t (0 xi, 1 eta)
+// becomes zeta by a cyclic turn of the axes (t = 0: (xi, eta, zeta) -> (zeta, xi, eta)
+// as new (xi', eta', zeta') = (eta, zeta, xi); t = 1: new (xi', eta', zeta') =
+// (zeta, xi, eta)).
+std::array<std::array<int, 8>, 2> corner_turns() {
+  std::array<std::array<int, 8>, 2> turn{};
+  for (int t = 0; t < 2; ++t)
+    for (int k = 0; k < 8; ++k) {
+      const int* c = corner_xi[k];
+      const int old[3] = {t == 0 ? c[2] : c[1], t == 0 ? c[0] : c[2], t == 0 ? c[1] : c[0]};
+      for (int a = 0; a < 8; ++a)
+        if (corner_xi[a][0] == old[0] && corner_xi[a][1] == old[1] && corner_xi[a][2] == old[2])
+          turn[t][k] = a;
+    }
+  return turn;
+}
+
+} // namespace
+
+void orient_thickness_zeta(Mesh& mesh, std::size_t b) {
+  const auto turn = corner_turns();
+  // face_map[t][f]: the new number of old face f after turn t.
+  std::array<std::array<int, 6>, 2> face_map{};
+  for (int t = 0; t < 2; ++t)
+    for (int f = 0; f < 6; ++f)
+      for (int g = 0; g < 6; ++g) {
+        std::array<int, 4> old{};
+        for (int m = 0; m < 4; ++m) old[m] = turn[t][hex_faces[g][m]];
+        std::sort(old.begin(), old.end());
+        std::array<int, 4> mine = hex_faces[f];
+        std::sort(mine.begin(), mine.end());
+        if (old == mine) face_map[t][f] = g;
+      }
+  const std::int64_t first = mesh.block_offsets()[b];
+  std::vector<int> turned(mesh.blocks[b].elements.size(), -1);
+  for (std::size_t e = 0; e < turned.size(); ++e) {
+    Hex& h = mesh.blocks[b].elements[e];
+    double len2[3] = {0, 0, 0};
+    for (int d = 0; d < 3; ++d)
+      for (int i = 0; i < 3; ++i) {
+        double s = 0;
+        for (int a = 0; a < 8; ++a) s += corner_xi[a][d] * mesh.nodes[h[a]][i];
+        len2[d] += s * s;
+      }
+    int t = -1;
+    if (len2[0] < len2[2] && len2[0] <= len2[1])
+      t = 0;
+    else if (len2[1] < len2[2] && len2[1] < len2[0])
+      t = 1;
+    if (t < 0) continue;
+    const Hex old = h;
+    for (int k = 0; k < 8; ++k) h[k] = old[turn[t][k]];
+    turned[e] = t;
+  }
+  for (auto& [name, sides] : mesh.side_sets)
+    for (auto& s : sides) {
+      const std::int64_t e = s.element - first;
+      if (e >= 0 && e < static_cast<std::int64_t>(turned.size()) && turned[e] >= 0)
+        s.face = face_map[turned[e]][s.face];
+    }
+}
+
 } // namespace anvil

@@ -62,6 +62,13 @@ double hex_volume(const std::array<Vec3, 8>& x);
 std::vector<std::int64_t> select_nodes(const Mesh& mesh, const Box3& box,
                                        const std::vector<std::int64_t>* candidates = nullptr);
 
+// Turns every element of block `b` so that its thinnest direction (the smallest column
+// of the Jacobian at its centre, ties kept in the order zeta, xi, eta) is its zeta axis:
+// the corners are renumbered by a cyclic turn of the natural axes, which keeps the
+// element's orientation and its node set. The thick-shell element integrates through
+// zeta (docs/element.md). Side sets on the block follow the new face numbers.
+void orient_thickness_zeta(Mesh& mesh, std::size_t b);
+
 // Sorted, unique ids of the nodes used by the elements of block `b`.
 std::vector<std::int64_t> block_nodes(const Mesh& mesh, std::size_t b);
 

@@ -116,6 +116,8 @@ Mesh build_mesh(const Config& config) {
       throw InputError(p.mesh.where, "the part's mesh has no elements");
     mesh.append(m, p.name);
   }
+  for (std::size_t b = 0; b < config.parts.size(); ++b)
+    if (config.parts[b].thick_shell.enabled()) orient_thickness_zeta(mesh, b);
   return mesh;
 }
 

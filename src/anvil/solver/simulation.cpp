@@ -65,6 +65,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     hb.hourglass = part.hourglass;
     hb.bulk_viscosity = part.bulk_viscosity;
     hb.erosion = part.erosion;
+    hb.thick_shell = part.thick_shell;
     const int bad = hb.init(lb.gid, lb.conn, xs, lb.corner_base);
     // Every rank must throw, not only the one holding the element.
     const std::int64_t none = std::numeric_limits<std::int64_t>::max();
@@ -639,6 +640,17 @@ void Simulation::restore(const Checkpoint& c) {
       for (int j = 0; j < 12; ++j)
         if (!b.hourglass_force[j].empty()) b.hourglass_force[j][e] = d[10 + j];
       b.alive[e] = c.element_eroded[static_cast<std::size_t>(k)] != 0 ? 0.0 : 1.0;
+      if (!b.thick_shell.enabled()) continue;
+      const std::int64_t kp = find(c.point_gid, b.gid[e]);
+      if (kp < 0 || c.point_count[static_cast<std::size_t>(kp)] != b.thick_shell.points)
+        throw InputError(fmt::format("{} lacks the {} thick-shell points of element {}", from,
+                                     b.thick_shell.points, b.gid[e] + 1));
+      const double* pd = &c.point_data[static_cast<std::size_t>(kp) * Checkpoint::point_values];
+      for (int p = 0; p < b.thick_shell.points; ++p, pd += 8) {
+        for (int j = 0; j < 6; ++j) b.point_stress[p][j][e] = pd[j];
+        if (!b.point_plastic_strain.empty()) b.point_plastic_strain[p][e] = pd[6];
+        if (!b.point_temperature.empty()) b.point_temperature[p][e] = pd[7];
+      }
     }
   // The eroded elements (padding lanes stay alive, as HexBlock::init made them).
   eroded_ = 0;
@@ -656,6 +668,10 @@ void Simulation::restore(const Checkpoint& c) {
       if (!b.temperature.empty()) b.temperature[e] = b.temperature[n - 1];
       for (auto& a : b.hourglass_force)
         if (!a.empty()) a[e] = a[n - 1];
+      for (auto& ps : b.point_stress)
+        for (auto& a : ps) a[e] = a[n - 1];
+      for (auto& a : b.point_plastic_strain) a[e] = a[n - 1];
+      for (auto& a : b.point_temperature) a[e] = a[n - 1];
     }
   }
   if (sph_) restore_particles(c, from);
