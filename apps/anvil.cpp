@@ -117,6 +117,12 @@ int main(int argc, char** argv) {
   can->add_option("--cycles", cc.cycles, "stop after this many cycles (default: run to 3.2 ms)")
       ->check(CLI::NonNegativeNumber);
   can->add_option("-o,--output", bench_out, "output directory")->capture_default_str();
+  std::string wall = "thick_shell";
+  can->add_option("--wall", wall,
+                  "the can's wall element: thick_shell (3 points through the wall) or one_point "
+                  "(the paper's hexahedron, viscous hourglass control)")
+      ->check(CLI::IsMember({"thick_shell", "one_point"}))
+      ->capture_default_str();
   can->add_flag("--print-deck", write_deck, "print the deck for this rank count and exit");
   can->add_flag("-q,--quiet", quiet, "no progress line");
 
@@ -154,6 +160,8 @@ int main(int argc, char** argv) {
     }
     if (*can) {
       cc.ranks = comm.size();
+      cc.wall = wall == "one_point" ? anvil::CanCrushOptions::Wall::one_point
+                                    : anvil::CanCrushOptions::Wall::thick_shell;
       if (write_deck) {
         if (root) std::printf("%s", anvil::can_crush_deck(cc).c_str());
         return 0;

@@ -29,6 +29,9 @@ std::string can_crush_deck(const CanCrushOptions& o) {
   std::string termination = fmt::format("{{time: {:.17g}", o.end_time);
   if (o.cycles >= 0) termination += fmt::format(", cycles: {}", o.cycles);
   termination += "}";
+  const char* wall = o.wall == CanCrushOptions::Wall::thick_shell
+                         ? "thick_shell: {points: 3}"
+                         : "hourglass: {model: viscous, coefficient: 0.1}";
   return fmt::format(R"(title: Scaled can crush, {} ranks
 termination: {}
 time_step: {{scale: 0.9}}
@@ -40,7 +43,7 @@ parts:
   can:
     mesh: {{generate: can, radius: 0.03, height: 0.1, thickness: 0.001, divisions: [{}, {}, {}]}}
     material: mild_steel
-    hourglass: {{model: viscous, coefficient: 0.1}}
+    {}
   block:
     mesh: {{generate: box, min: [-0.04, -0.04, 0.1005], max: [0.04, 0.04, 0.1105], divisions: [{}, {}, {}]}}
     material: block_steel
@@ -53,7 +56,8 @@ probes:
   - {{name: block, at: [0, 0, 0.1005]}}
 output: {{fields_every: 1.6e-3, history_every: 1.0e-5}}
 )",
-                     o.ranks, termination, can[0], can[1], can[2], block[0], block[1], block[2]);
+                     o.ranks, termination, can[0], can[1], can[2], wall, block[0], block[1],
+                     block[2]);
 }
 
 Config can_crush_config(const CanCrushOptions& o) {
