@@ -334,3 +334,55 @@ TEST(Hex8, AssumedStrainPlasticLimit) {
   hex8::assumed_strain_limit(sy, len, P);
   EXPECT_NEAR(4 * P[2][3] * len[2] / V, -sy, 1e-12 * sy);
 }
+
+namespace {
+
+using namespace anvil;
+
+// orient_thickness_zeta turns each element of a thick-shell block so that its thinnest
+// direction is zeta: here boxes thin in x, in y and in z. The volume stays positive (the
+// turn keeps the orientation), the node set stays, zeta becomes the thin direction, and a
+// side set follows its face (the face on the thin side, xmin of the first box, keeps its
+// four nodes).
+TEST(OrientThickness, ThinnestDirectionBecomesZeta) {
+  Mesh m;
+  ElementBlock b{"wall", {}};
+  const Vec3 size[3] = {{0.001, 0.01, 0.02}, {0.02, 0.001, 0.01}, {0.01, 0.02, 0.001}};
+  for (int k = 0; k < 3; ++k) {
+    const auto first = static_cast<std::int64_t>(m.nodes.size());
+    for (int c = 0; c < 8; ++c) {
+      const double xi = (c == 1 || c == 2 || c == 5 || c == 6) ? 1 : 0;
+      const double eta = (c == 2 || c == 3 || c == 6 || c == 7) ? 1 : 0;
+      const double zeta = c >= 4 ? 1 : 0;
+      m.nodes.push_back({0.1 * k + xi * size[k].x, eta * size[k].y, zeta * size[k].z});
+    }
+    Hex h;
+    for (int c = 0; c < 8; ++c) h[c] = first + c;
+    b.elements.push_back(h);
+  }
+  m.blocks.push_back(b);
+  m.side_sets["xmin"] = {{0, 3}}; // face {3, 0, 4, 7} of element 0: its x = 0 side
+  const std::vector<Hex> before = m.blocks[0].elements;
+  orient_thickness_zeta(m, 0);
+  for (int k = 0; k < 3; ++k) {
+    const Hex& h = m.blocks[0].elements[static_cast<std::size_t>(k)];
+    std::array<Vec3, 8> x;
+    for (int c = 0; c < 8; ++c) x[c] = m.nodes[static_cast<std::size_t>(h[c])];
+    EXPECT_GT(hex_volume(x), 0) << "element " << k;
+    std::vector<std::int64_t> a(h.begin(), h.end()), o(before[k].begin(), before[k].end());
+    std::sort(a.begin(), a.end());
+    std::sort(o.begin(), o.end());
+    EXPECT_EQ(a, o) << "element " << k;
+    // zeta's edge (corner 0 to corner 4) has the element's thickness.
+    const Vec3 d = x[4] - x[0];
+    EXPECT_NEAR(std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z), 0.001, 1e-12) << "element " << k;
+  }
+  const auto& side = m.side_sets["xmin"][0];
+  std::vector<std::int64_t> nodes;
+  for (int c : hex_faces[static_cast<std::size_t>(side.face)])
+    nodes.push_back(m.blocks[0].elements[0][static_cast<std::size_t>(c)]);
+  std::sort(nodes.begin(), nodes.end());
+  EXPECT_EQ(nodes, (std::vector<std::int64_t>{0, 3, 4, 7}));
+}
+
+} // namespace

@@ -485,17 +485,18 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       hex8::rate_and_spin(L, d, w);
       vdouble Q[3][3], s[6];
       hex8::hughes_winget(w, dt, Q);
-      _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) s[k] = simd::load(&b.stress[k][e]);
-      hex8::rotate_symmetric(Q, s);
-      vdouble power =
-          s[0] * d[0] + s[1] * d[1] + s[2] * d[2] + 2.0 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
-      if constexpr (Shell)
+      vdouble power;
+      if constexpr (Shell) { // the element's stress is the points' average (stage B)
         power = shell_point_rates(b, e, l, dt, L, d, Q, np, zeta_p, w_p, nu_ps, M, xs, vs,
                                   scratch(s_pd0));
-      _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) {
-        simd::store(s[k], &b.stress[k][e]);
-        simd::store(d[k], scratch(s_d0 + k) + l);
+      } else {
+        _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) s[k] = simd::load(&b.stress[k][e]);
+        hex8::rotate_symmetric(Q, s);
+        power = s[0] * d[0] + s[1] * d[1] + s[2] * d[2] +
+                2.0 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
+        _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) simd::store(s[k], &b.stress[k][e]);
       }
+      _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) simd::store(d[k], scratch(s_d0 + k) + l);
       simd::store(simd::load(&b.mass[e]) * inv, scratch(s_density) + l);
       simd::store(power, scratch(s_power_old) + l);
       simd::store(vol, scratch(s_volume_mid) + l);
@@ -532,8 +533,10 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         pb.wave_speed = p == 0 ? scratch(s_wave_speed) : scratch(s_q1);
         b.material->update(pb);
         if (p > 0)
-          for (int l = 0; l < nc; ++l)
-            scratch(s_wave_speed)[l] = std::max(scratch(s_wave_speed)[l], scratch(s_q1)[l]);
+          for (int l = 0; l < nc; l += width)
+            simd::store(
+                stdx::max(simd::load(scratch(s_wave_speed) + l), simd::load(scratch(s_q1) + l)),
+                scratch(s_wave_speed) + l);
       }
       auto average = [&](auto&& point, double* out) {
         for (int l = 0; l < nc; l += width) {
