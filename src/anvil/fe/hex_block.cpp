@@ -184,10 +184,10 @@ template <class Use>
 // thickness stress towards the element's average (docs/element.md, "Thick shell").
 // L is the mid-step velocity gradient, d its symmetric part.
 [[gnu::always_inline]] inline vdouble
-shell_point_rates(HexBlock& b, int e, int l, double dt, const vdouble (&L)[3][3],
-                  const vdouble (&d)[6], const vdouble (&Q)[3][3], int np, const double* zeta_p,
-                  const double* w_p, double nu_ps, double M, const double* xs, const double* vs,
-                  double* pd) {
+shell_point_rates(double* const (&ps)[hex8::thick_shell_max_points][6], int e, int l, double dt,
+                  const vdouble (&L)[3][3], const vdouble (&d)[6], const vdouble (&Q)[3][3], int np,
+                  const double* zeta_p, const double* w_p, double nu_ps, double M, const double* xs,
+                  const double* vs, double* pd) {
   constexpr int C = HexWorkspace::chunk;
   vdouble J[3][3], gx[3][4], qz[3][2];
   _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) {
@@ -226,11 +226,9 @@ shell_point_rates(HexBlock& b, int e, int l, double dt, const vdouble (&L)[3][3]
   vdouble szz[hex8::thick_shell_max_points], mean = 0.0;
   for (int p = 0; p < np; ++p) {
     vdouble sp[6];
-    _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) sp[k] =
-        simd::load(&b.point_stress[p][k][e]);
+    _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) sp[k] = simd::load(ps[p][k] + e);
     hex8::rotate_symmetric(Q, sp);
-    _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k)
-        simd::store(sp[k], &b.point_stress[p][k][e]);
+    _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) simd::store(sp[k], ps[p][k] + e);
     szz[p] = Z[0] * sp[0] + Z[1] * sp[1] + Z[2] * sp[2] +
              2.0 * (Z[3] * sp[3] + Z[4] * sp[4] + Z[5] * sp[5]);
     mean += (0.5 * w_p[p]) * szz[p];
@@ -243,7 +241,7 @@ shell_point_rates(HexBlock& b, int e, int l, double dt, const vdouble (&L)[3][3]
     _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) {
       dp[k] = d[k] + zeta_p[p] * A[k] - c * Z[k];
       simd::store(dp[k], pd + (6 * p + k) * C + l);
-      sp[k] = simd::load(&b.point_stress[p][k][e]);
+      sp[k] = simd::load(ps[p][k] + e);
     }
     power += (0.5 * w_p[p]) * (sp[0] * dp[0] + sp[1] * dp[1] + sp[2] * dp[2] +
                                2.0 * (sp[3] * dp[3] + sp[4] * dp[4] + sp[5] * dp[5]));
@@ -252,14 +250,15 @@ shell_point_rates(HexBlock& b, int e, int l, double dt, const vdouble (&L)[3][3]
 }
 
 // Thick shell, stage C: the points' new stress power, sum_p w_p / 2 sigma_p : D_p.
-[[gnu::always_inline]] inline vdouble shell_power(const HexBlock& b, int e, int l, int np,
-                                                  const double* w_p, const double* pd) {
+[[gnu::always_inline]] inline vdouble
+shell_power(double* const (&ps)[hex8::thick_shell_max_points][6], int e, int l, int np,
+            const double* w_p, const double* pd) {
   constexpr int C = HexWorkspace::chunk;
   vdouble power = 0.0;
   for (int p = 0; p < np; ++p) {
     vdouble sp[6], dp[6];
     _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) {
-      sp[k] = simd::load(&b.point_stress[p][k][e]);
+      sp[k] = simd::load(ps[p][k] + e);
       dp[k] = simd::load(pd + (6 * p + k) * C + l);
     }
     power += (0.5 * w_p[p]) * (sp[0] * dp[0] + sp[1] * dp[1] + sp[2] * dp[2] +
@@ -274,14 +273,13 @@ shell_point_rates(HexBlock& b, int e, int l, double dt, const vdouble (&L)[3][3]
 // r[0][1] += (M_xx - nu_ps M_zz) / len0, r[1][0] += (M_yy - nu_ps M_zz) / len1 and the
 // twist r[0][0] += M_xy / len1, r[1][1] += M_xy / len0.
 [[gnu::always_inline]] inline void
-shell_bending_forces(const HexBlock& b, int e, const vdouble& vol, const vdouble (&ax)[3][3],
-                     const vdouble (&len)[3], int np, const double* zeta_p, const double* w_p,
-                     double nu_ps, vdouble (&r)[3][4]) {
+shell_bending_forces(double* const (&ps)[hex8::thick_shell_max_points][6], int e,
+                     const vdouble& vol, const vdouble (&ax)[3][3], const vdouble (&len)[3], int np,
+                     const double* zeta_p, const double* w_p, double nu_ps, vdouble (&r)[3][4]) {
   vdouble m[6];
   _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) {
-    m[k] = (w_p[0] * zeta_p[0]) * simd::load(&b.point_stress[0][k][e]);
-    for (int p = 1; p < np; ++p)
-      m[k] += (w_p[p] * zeta_p[p]) * simd::load(&b.point_stress[p][k][e]);
+    m[k] = (w_p[0] * zeta_p[0]) * simd::load(ps[0][k] + e);
+    for (int p = 1; p < np; ++p) m[k] += (w_p[p] * zeta_p[p]) * simd::load(ps[p][k] + e);
   }
   const vdouble S[3][3] = {{m[0], m[3], m[5]}, {m[3], m[1], m[4]}, {m[5], m[4], m[2]}};
   auto frame = [&](int dd, int ee) {
@@ -422,6 +420,10 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
   [[maybe_unused]] const double* w_p =
       Shell ? hex8::thick_shell_weight[np - 2] : hex8::thick_shell_weight[0];
   [[maybe_unused]] const double nu_ps = (M - 2.0 * b.material->elastic().shear) / M;
+  // The points' stress arrays (ps[p][k]: component k at point p).
+  [[maybe_unused]] double* ps[hex8::thick_shell_max_points][6] = {};
+  for (int p = 0; p < np; ++p)
+    for (int k = 0; k < 6; ++k) ps[p][k] = b.point_stress[p][k].data();
   const bool has_ep = !b.plastic_strain.empty(), has_T = !b.temperature.empty();
   const bool erode_ep = b.erosion.plastic_strain > 0 && has_ep;
   // Nodal assembly (HexWorkspace::begin_nodal_forces), or null.
@@ -487,7 +489,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       hex8::hughes_winget(w, dt, Q);
       vdouble power;
       if constexpr (Shell) { // the element's stress is the points' average (stage B)
-        power = shell_point_rates(b, e, l, dt, L, d, Q, np, zeta_p, w_p, nu_ps, M, xs, vs,
+        power = shell_point_rates(ps, e, l, dt, L, d, Q, np, zeta_p, w_p, nu_ps, M, xs, vs,
                                   scratch(s_pd0));
       } else {
         _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) s[k] = simd::load(&b.stress[k][e]);
@@ -526,7 +528,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         MaterialBatch pb = batch;
         _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) {
           pb.d[k] = scratch(s_pd0 + 6 * p + k);
-          pb.stress[k] = b.point_stress[p][k].data() + e0;
+          pb.stress[k] = ps[p][k] + e0;
         }
         pb.plastic_strain = has_ep ? b.point_plastic_strain[p].data() + e0 : nullptr;
         pb.temperature = has_T ? b.point_temperature[p].data() + e0 : nullptr;
@@ -545,8 +547,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
           simd::store(sum, out + e0 + l);
         }
       };
-      for (int k = 0; k < 6; ++k)
-        average([&](int p) { return b.point_stress[p][k].data(); }, b.stress[k].data());
+      for (int k = 0; k < 6; ++k) average([&](int p) { return ps[p][k]; }, b.stress[k].data());
       if (has_ep)
         average([&](int p) { return b.point_plastic_strain[p].data(); }, b.plastic_strain.data());
       if (has_T)
@@ -677,7 +678,8 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         }
         // Thick shell: the bending forces of the points' stresses (their work is in the
         // internal energy).
-        if constexpr (Shell) shell_bending_forces(b, e, vol, ax, extent, np, zeta_p, w_p, nu_ps, r);
+        if constexpr (Shell)
+          shell_bending_forces(ps, e, vol, ax, extent, np, zeta_p, w_p, nu_ps, r);
         _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
             _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) Qh[i][al] =
                 ax[0][i] * r[0][al] + ax[1][i] * r[1][al] + ax[2][i] * r[2][al];
@@ -694,7 +696,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       // Energies over the step just taken (dt = 0 on the first cycle).
       vdouble power_new =
           s[0] * d[0] + s[1] * d[1] + s[2] * d[2] + 2.0 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
-      if constexpr (Shell) power_new = shell_power(b, e, l, np, w_p, scratch(s_pd0));
+      if constexpr (Shell) power_new = shell_power(ps, e, l, np, w_p, scratch(s_pd0));
       const vdouble vmid = simd::load(scratch(s_volume_mid) + l);
       vdouble dE = dt * vmid * (0.5 * (simd::load(scratch(s_power_old) + l) + power_new) - q * trd);
       const auto dead = simd::load(&b.alive[e]) == 0.0; // eroded elements store no energy
@@ -752,10 +754,10 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
           vdouble sk = simd::load(&b.stress[k][e]);
           stdx::where(dead, sk) = 0.0;
           simd::store(sk, &b.stress[k][e]);
-          for (auto& ps : b.point_stress) {
-            vdouble pk = simd::load(&ps[k][e]);
+          for (auto& pt : b.point_stress) {
+            vdouble pk = simd::load(&pt[k][e]);
             stdx::where(dead, pk) = 0.0;
-            simd::store(pk, &ps[k][e]);
+            simd::store(pk, &pt[k][e]);
           }
         }
       }
@@ -840,8 +842,8 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
           for (int a = 0; a < 8; ++a)
             for (double* r : rows_of) r[8 * k + a] = 0.0;
           for (auto& sk : b.stress) sk[e + k] = 0.0;
-          for (auto& ps : b.point_stress)
-            for (auto& sk : ps) sk[e + k] = 0.0;
+          for (auto& pt : b.point_stress)
+            for (auto& sk : pt) sk[e + k] = 0.0;
           ++result.eroded;
           continue;
         }
