@@ -608,8 +608,11 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
 
 namespace {
 
-// Pass 2's pair loop; Corr: some set normalises its gradient (P is not symmetric).
-template <KernelType K, int D, bool Corr>
+// Pass 2's pair loop. Corr: some set normalises its gradient (P is not symmetric); AS: some
+// set has an artificial stress. Both are template parameters so that the common loop
+// (neither) keeps no value live for them: the velocity difference dies after the
+// viscosity and dv . g, before the stress groups are loaded (GCC kept it, and spilled).
+template <KernelType K, int D, bool Corr, bool AS>
 void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspace& w,
                   SphResult& res) {
   using R2 = NeighbourRead2;
@@ -630,8 +633,6 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
   const bool same_visc = uniform(sets, [](const SetParams& st) {
     return std::array<double, 2>{st.alpha, st.beta};
   });
-  bool any_epsilon = false;
-  for (const auto& st : sets) any_epsilon = any_epsilon || st.epsilon > 0;
   const bool same_as = uniform(sets, [](const SetParams& st) {
     return std::array<double, 3>{st.epsilon, st.w_spacing, st.exponent};
   });
@@ -651,70 +652,76 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
     // arithmetic there instead of broadcasts again in every iteration (GCC has no
     // registers to keep them in; the empty asm makes the array's address escape, so that
     // it stays in memory).
-    // pb[rest + k] holds the value at offset k of NeighbourRead2Rest.
+    // pb[rest + k] holds the value at offset k of NeighbourRead2Rest; pb[visc_a] and
+    // pb[visc_b] the pair's -(alpha_i + alpha_j) and beta_i + beta_j where every set has
+    // the same viscosity (the loop's sums, once per row: the same bits).
     constexpr int rest = sizeof(R2) / sizeof(double);
-    alignas(32) vdouble pb[rest + R2r::inv_rho + 1];
+    constexpr int visc_a = rest + R2r::inv_rho + 1, visc_b = visc_a + 1;
+    alignas(32) vdouble pb[visc_b + 1];
     for (int k = R2::x; k <= R2::rho; ++k) pb[k] = pi[k];
     if constexpr (Corr)
       for (int k = R2r::S6; k < R2r::S6 + 3; ++k) pb[rest + k] = pir[k];
     for (int k = R2r::alpha; k <= R2r::inv_rho; ++k) pb[rest + k] = pir[k];
+    pb[visc_a] = -(pb[rest + R2r::alpha] + pb[rest + R2r::alpha]);
+    pb[visc_b] = pb[rest + R2r::beta] + pb[rest + R2r::beta];
     asm volatile("" : : "r"(pb) : "memory");
     vdouble accv[4] = {0.0, 0.0, 0.0, 0.0}, mumv = 0.0; // force sums, energy rate
     const std::int64_t k_begin = nl.start[r], k_end = k_begin + nl.len[r];
     for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
       const int* idx = index + k0;
-      // In two stages, so that fewer values are live at once: first what the kinematics
-      // of the pair give (gradient, viscosity, the energy rate's dv . g), from the groups
-      // x, h; v, c; S4, S5, rho, m; then the stress groups and the pair's T.
+      double* q[width]; // the partners' lower sums: f, e at q[l], mu at q[l] + 4
+      for (int l = 0; l < width; ++l) q[l] = low2[static_cast<std::size_t>(idx[l])].f;
+      // In stages, so that fewer values are live at once: the gradient from x, h; the
+      // viscosity's approach and dv . g from v, c; the viscosity from S4, S5, rho, m;
+      // then the stress groups and the pair's T.
       vdouble qx[4], qv[4], qr[4];
-      simd::gather4(rdp + R2::x, stride, idx, qx);   // x, h
-      simd::gather4(rdp + R2::v, stride, idx, qv);   // v, c
-      simd::gather4(rdp + R2::S45, stride, idx, qr); // S4, S5, rho, m
-      vdouble dx[3], dv[3];
-      for (int a = 0; a < 3; ++a) {
-        dx[a] = pb[R2::x + a] - qx[a];
-        dv[a] = pb[R2::v + a] - qv[a];
-      }
+      simd::gather4(rdp + R2::x, stride, idx, qx); // x, h
+      vdouble dx[3];
+      for (int a = 0; a < 3; ++a) dx[a] = pb[R2::x + a] - qx[a];
       const vdouble hb = 0.5 * (pb[R2::h] + qx[3]);
       const vdouble r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
       const vdouble dwr = simd::load(dwr_k + k0);
       const vdouble g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
-      const vdouble fn = any_epsilon ? artificial_factor<K, D>(simd::load(wk_k + k0), hb, si, sets,
-                                                               p.set, idx, same_as)
-                                     : vdouble(0.0);
+      simd::gather4(rdp + R2::v, stride, idx, qv); // v, c
+      vdouble dv[3];
+      for (int a = 0; a < 3; ++a) dv[a] = pb[R2::v + a] - qv[a];
       const vdouble vr = dv[0] * dx[0] + dv[1] * dx[1] + dv[2] * dx[2];
+      const vdouble dvg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
+      vdouble fn = 0.0;
+      if constexpr (AS)
+        fn = artificial_factor<K, D>(simd::load(wk_k + k0), hb, si, sets, p.set, idx, same_as);
+      simd::gather4(rdp + R2::S45, stride, idx, qr); // S4, S5, rho, m
       vdouble visc = 0.0;
       const auto approaching = vr < 0.0;
       if (stdx::any_of(approaching)) {
         const vdouble mu = hb * vr / (r2 + 0.01 * hb * hb);
         const vdouble cb = 0.5 * (pb[R2::c] + qv[3]);
-        vdouble qa[4];
-        if (same_visc) {
-          qa[2] = pb[rest + R2r::alpha];
-          qa[3] = pb[rest + R2r::beta];
-        } else {
-          simd::gather4(rdrp + R2r::R45, stride_r, idx, qa); // R4, R5, alpha, beta
-        }
         // Pi_ij = (-alpha c mu + beta mu^2) / rho_ij with rho_ij = (rho_i + rho_j) / 2.
-        const vdouble pv = (-(pb[rest + R2r::alpha] + qa[2]) * cb * mu +
-                            (pb[rest + R2r::beta] + qa[3]) * mu * mu) /
-                           (pb[R2::rho] + qr[2]);
+        vdouble pv;
+        if (same_visc) {
+          pv = (pb[visc_a] * cb * mu + pb[visc_b] * mu * mu) / (pb[R2::rho] + qr[2]);
+        } else {
+          vdouble qa[4];
+          simd::gather4(rdrp + R2r::R45, stride_r, idx, qa); // R4, R5, alpha, beta
+          pv = (-(pb[rest + R2r::alpha] + qa[2]) * cb * mu +
+                (pb[rest + R2r::beta] + qa[3]) * mu * mu) /
+               (pb[R2::rho] + qr[2]);
+        }
         stdx::where(approaching, visc) = pv;
         // The largest approach of the pair for both particles' stable steps.
         vdouble muj = 0.0;
         stdx::where(approaching, muj) = -mu;
         mumv = stdx::max(mumv, muj);
         double* qm[width];
-        for (int l = 0; l < width; ++l) qm[l] = &low2[static_cast<std::size_t>(idx[l])].mu;
+        for (int l = 0; l < width; ++l) qm[l] = q[l] + 4;
         simd::scatter_max(qm, muj);
       }
       // Half the viscous dissipation of the pair heats each particle.
-      const vdouble dvg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
       const vdouble half_visc = 0.5 * visc * dvg;
+      const vdouble irr = pb[rest + R2r::inv_rho] * (1.0 / qr[2]);
       vdouble qs[4], qu[4] = {0.0, 0.0, 0.0, 0.0};
       simd::gather4(rdp + R2::S, stride, idx, qs);                          // S0..S3
       if constexpr (Corr) simd::gather4(rdrp + R2r::S6, stride_r, idx, qu); // S6..S8, has_r
-      const vdouble irr = pb[rest + R2r::inv_rho] * (1.0 / qr[2]);
       // T = (P_i + P_j + f^n (R_i + R_j)) / (rho_i rho_j) - Pi I; T[6..8] (yx zy zx)
       // differ from T[3..5] only where a gradient is normalised (Corr).
       constexpr int nt = Corr ? 9 : 6;
@@ -723,7 +730,7 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
       for (int c = 0; c < nt; ++c)
         T[c] = (pb[c < 6 ? R2::S + c : rest + R2r::S6 + c - 6] + Sj[c]) * irr;
       vdouble rg = 0.0, rgj = 0.0;
-      if (stdx::any_of(fn > 0.0)) {
+      if (AS && stdx::any_of(fn > 0.0)) {
         if constexpr (!Corr) simd::gather4(rdrp + R2r::S6, stride_r, idx, qu); // has_r
         if (pir[R2r::has_r] != 0.0 || stdx::any_of(qu[3] > 0.0)) {
           vdouble qR[4], qR45[4];
@@ -755,12 +762,11 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
                              T[yx] * g[0] + T[1] * g[1] + T[4] * g[2],
                              T[zx] * g[0] + T[zy] * g[1] + T[2] * g[2]};
       for (int a = 0; a < 3; ++a) accv[a] += mj * tg[a];
-      accv[3] += mj * (half_visc - rg);
+      // Without an artificial stress rg = rgj = 0 and x - 0 is x: the same bits.
+      const vdouble ei = AS ? half_visc - rg : half_visc, ej = AS ? half_visc - rgj : half_visc;
+      accv[3] += mj * ei;
       // Particle j's terms: the same T with grad_j W_ji = -g (its force sum is reversed).
-      const vdouble sj[4] = {mi * tg[0], mi * tg[1], mi * tg[2], mi * (half_visc - rgj)};
-      double* q[width]; // the partners' lower sums
-      for (int l = 0; l < width; ++l) q[l] = low2[static_cast<std::size_t>(idx[l])].f;
-      simd::scatter_add4(q, sj);
+      simd::scatter_add4(q, {mi * tg[0], mi * tg[1], mi * tg[2], mi * ej});
     }
     double sums[4];
     simd::lane_sums4(accv, sums);
@@ -903,10 +909,14 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
   }
   const int dim = sets.empty() ? 3 : sets[0].dimensions;
   auto run = [&]<KernelType K, int D>() {
-    if (any_corrected)
-      forces_pairs<K, D, true>(p, sets, w, res);
+    if (any_corrected && any_epsilon)
+      forces_pairs<K, D, true, true>(p, sets, w, res);
+    else if (any_corrected)
+      forces_pairs<K, D, true, false>(p, sets, w, res);
+    else if (any_epsilon)
+      forces_pairs<K, D, false, true>(p, sets, w, res);
     else
-      forces_pairs<K, D, false>(p, sets, w, res);
+      forces_pairs<K, D, false, false>(p, sets, w, res);
   };
   with_kernel(kernel, dim, run);
 }
