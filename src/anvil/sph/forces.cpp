@@ -547,7 +547,9 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
 
   // The energy, time-centred, and pass 2's stress P and artificial stress R: `width`
   // particles at a time where none normalises its gradient or has an artificial stress
-  // (P = sigma, R = 0: the same operations per particle), else one at a time.
+  // (P = sigma, R = 0: the same operations per particle), else one at a time. Where no
+  // set does, pass 2 reads neither R nor S6-S8 (the shear again): they are not written.
+  const bool all_plain = !any_corrected && !any_epsilon;
   auto plain = [&](std::size_t i) {
     const SetParams& st = sets[static_cast<std::size_t>(p.set[i])];
     return !st.corrected && !(st.epsilon > 0);
@@ -567,11 +569,11 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
       simd::store(simd::load(p.energy + i) +
                       0.5 * (simd::load(w.power_old.data() + i) + power) * dt / rho,
                   p.energy + i);
-      for (int k = 0; k < 6; ++k) {
-        simd::store(s[k], p.S[k] + i);
-        simd::store(0.0, p.R[k] + i);
+      for (int k = 0; k < 6; ++k) simd::store(s[k], p.S[k] + i);
+      if (!all_plain) {
+        for (int k = 0; k < 6; ++k) simd::store(0.0, p.R[k] + i);
+        for (int k = 6; k < 9; ++k) simd::store(s[k - 3], p.S[k] + i);
       }
-      for (int k = 6; k < 9; ++k) simd::store(s[k - 3], p.S[k] + i);
       i += width;
       continue;
     }
@@ -652,18 +654,22 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
     // arithmetic there instead of broadcasts again in every iteration (GCC has no
     // registers to keep them in; the empty asm makes the array's address escape, so that
     // it stays in memory).
-    // pb[rest + k] holds the value at offset k of NeighbourRead2Rest; pb[visc_a] and
-    // pb[visc_b] the pair's -(alpha_i + alpha_j) and beta_i + beta_j where every set has
-    // the same viscosity (the loop's sums, once per row: the same bits).
+    // pb[rest + k] holds the value at offset k of NeighbourRead2Rest (S6-S8); then i's
+    // alpha, beta (its set's) and 1/rho (divided here, the same bits as a stored one), and
+    // the pair's -(alpha_i + alpha_j) and beta_i + beta_j where every set has the same
+    // viscosity (the loop's sums, once per row: the same bits).
     constexpr int rest = sizeof(R2) / sizeof(double);
-    constexpr int visc_a = rest + R2r::inv_rho + 1, visc_b = visc_a + 1;
+    constexpr int alpha_i = rest + 3, beta_i = alpha_i + 1, inv_rho = beta_i + 1;
+    constexpr int visc_a = inv_rho + 1, visc_b = visc_a + 1;
     alignas(32) vdouble pb[visc_b + 1];
     for (int k = R2::x; k <= R2::rho; ++k) pb[k] = pi[k];
     if constexpr (Corr)
       for (int k = R2r::S6; k < R2r::S6 + 3; ++k) pb[rest + k] = pir[k];
-    for (int k = R2r::alpha; k <= R2r::inv_rho; ++k) pb[rest + k] = pir[k];
-    pb[visc_a] = -(pb[rest + R2r::alpha] + pb[rest + R2r::alpha]);
-    pb[visc_b] = pb[rest + R2r::beta] + pb[rest + R2r::beta];
+    pb[alpha_i] = si.alpha;
+    pb[beta_i] = si.beta;
+    pb[inv_rho] = 1 / pi[R2::rho];
+    pb[visc_a] = -(pb[alpha_i] + pb[alpha_i]);
+    pb[visc_b] = pb[beta_i] + pb[beta_i];
     asm volatile("" : : "r"(pb) : "memory");
     vdouble accv[4] = {0.0, 0.0, 0.0, 0.0}, mumv = 0.0; // force sums, energy rate
     const std::int64_t k_begin = nl.start[r], k_end = k_begin + nl.len[r];
@@ -703,8 +709,7 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
         } else {
           vdouble qa[4];
           simd::gather4(rdrp + R2r::R45, stride_r, idx, qa); // R4, R5, alpha, beta
-          pv = (-(pb[rest + R2r::alpha] + qa[2]) * cb * mu +
-                (pb[rest + R2r::beta] + qa[3]) * mu * mu) /
+          pv = (-(pb[alpha_i] + qa[2]) * cb * mu + (pb[beta_i] + qa[3]) * mu * mu) /
                (pb[R2::rho] + qr[2]);
         }
         stdx::where(approaching, visc) = pv;
@@ -718,7 +723,7 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
       }
       // Half the viscous dissipation of the pair heats each particle.
       const vdouble half_visc = 0.5 * visc * dvg;
-      const vdouble irr = pb[rest + R2r::inv_rho] * (1.0 / qr[2]);
+      const vdouble irr = pb[inv_rho] * (1.0 / qr[2]);
       vdouble qs[4], qu[4] = {0.0, 0.0, 0.0, 0.0};
       simd::gather4(rdp + R2::S, stride, idx, qs);                          // S0..S3
       if constexpr (Corr) simd::gather4(rdrp + R2r::S6, stride_r, idx, qu); // S6..S8, has_r
@@ -778,8 +783,7 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
     for (int a = 0; a < 3; ++a) p.force[a][i] = pi[R2::mass] * acc[a];
     p.energy_rate[i] = de;
     const double ci = pi[R2::c];
-    const double dt =
-        courant * pi[R2::h] / (ci + 1.2 * (pir[R2r::alpha] * ci + pir[R2r::beta] * mu_max));
+    const double dt = courant * pi[R2::h] / (ci + 1.2 * (si.alpha * ci + si.beta * mu_max));
     if (dt < res.dt_stable || (dt == res.dt_stable && p.gid[i] < res.stable_gid)) {
       res.dt_stable = dt;
       res.stable_gid = p.gid[i];
@@ -835,6 +839,14 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
     any_corrected = any_corrected || st.corrected;
     any_epsilon = any_epsilon || st.epsilon > 0;
   }
+  // The rest records are read only by a normalised gradient, an artificial stress (its
+  // groups S6-S8 and has_r, R0-R3, R4, R5) and sets of different viscosity (alpha, beta):
+  // without those they are not written (forces_pairs reads them under the same conditions).
+  const bool same_visc = uniform(sets, [](const SetParams& st) {
+    return std::array<double, 2>{st.alpha, st.beta};
+  });
+  const bool stress_rest = any_corrected || any_epsilon;
+  const bool any_rest = stress_rest || !same_visc;
   w.read2.resize(p.n_all);
   w.read2r.resize(p.n_all);
   w.low2.resize(p.n_all);
@@ -861,31 +873,29 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
     auto per_set = [&](auto field) {
       return vdouble([&](auto l) { return field(sets[static_cast<std::size_t>(p.set[i0 + l])]); });
     };
-    const vdouble rho = ld(p.rho);
-    vdouble R[6];
-    for (int c = 0; c < 6; ++c) R[c] = ld(p.R[c]);
     put(R2::x, ld(p.x[0]), ld(p.x[1]), ld(p.x[2]), ld(p.h));
     put(R2::v, ld(p.v[0]), ld(p.v[1]), ld(p.v[2]), ld(p.wave_speed));
     put(R2::S, ld(p.S[0]), ld(p.S[1]), ld(p.S[2]), ld(p.S[3]));
-    put(R2::S45, ld(p.S[4]), ld(p.S[5]), rho, ld(p.mass));
-    // The groups only a normalised gradient or an artificial stress reads (forces_pairs
-    // reads them under the same conditions): not written otherwise.
-    if (any_corrected || any_epsilon) {
+    put(R2::S45, ld(p.S[4]), ld(p.S[5]), ld(p.rho), ld(p.mass));
+    if (!any_rest) continue;
+    vdouble R4 = 0.0, R5 = 0.0; // R is zero without an artificial stress
+    if (stress_rest) {
+      vdouble R[4];
+      for (int c = 0; c < 4; ++c) R[c] = ld(p.R[c]);
+      R4 = ld(p.R[4]);
+      R5 = ld(p.R[5]);
       const auto any =
-          R[0] != 0.0 || R[1] != 0.0 || R[2] != 0.0 || R[3] != 0.0 || R[4] != 0.0 || R[5] != 0.0;
+          R[0] != 0.0 || R[1] != 0.0 || R[2] != 0.0 || R[3] != 0.0 || R4 != 0.0 || R5 != 0.0;
       vdouble has_r = 0.0;
       stdx::where(any, has_r) = 1.0;
       put_r(R2r::S6, ld(p.S[6]), ld(p.S[7]), ld(p.S[8]), has_r);
       put_r(R2r::R, R[0], R[1], R[2], R[3]);
     }
-    put_r(R2r::R45, R[4], R[5], per_set([](const SetParams& st) { return st.alpha; }),
+    put_r(R2r::R45, R4, R5, per_set([](const SetParams& st) { return st.alpha; }),
           per_set([](const SetParams& st) { return st.beta; }));
-    put_r(R2r::inv_rho, 1 / rho, 0.0, 0.0, 0.0);
   }
   for (std::size_t i = i0; i < p.n_all; ++i) {
     double* r = w.read2[i].a;
-    double* rr = w.read2r[i].a;
-    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
     for (int a = 0; a < 3; ++a) {
       r[R2::x + a] = p.x[a][i];
       r[R2::v + a] = p.v[a][i];
@@ -893,19 +903,26 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
     r[R2::h] = p.h[i];
     r[R2::c] = p.wave_speed[i];
     r[R2::rho] = p.rho[i];
-    rr[R2r::inv_rho] = 1 / p.rho[i];
     r[R2::mass] = p.mass[i];
     for (int c = 0; c < 6; ++c) r[R2::S + c] = p.S[c][i];
-    for (int c = 6; c < 9; ++c) rr[R2r::S6 + c - 6] = p.S[c][i];
-    int any = 0;
-    for (int c = 0; c < 6; ++c) any |= p.R[c][i] != 0.0;
-    for (int c = 0; c < 4; ++c) rr[R2r::R + c] = p.R[c][i];
-    rr[R2r::R45] = p.R[4][i];
-    rr[R2r::R45 + 1] = p.R[5][i];
-    rr[R2r::has_r] = any ? 1.0 : 0.0;
+    if (!any_rest) continue;
+    double* rr = w.read2r[i].a;
+    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
+    double R[6] = {0, 0, 0, 0, 0, 0};
+    if (stress_rest) {
+      int any = 0;
+      for (int c = 0; c < 6; ++c) {
+        R[c] = p.R[c][i];
+        any |= R[c] != 0.0;
+      }
+      for (int c = 6; c < 9; ++c) rr[R2r::S6 + c - 6] = p.S[c][i];
+      rr[R2r::has_r] = any ? 1.0 : 0.0;
+      for (int c = 0; c < 4; ++c) rr[R2r::R + c] = R[c];
+    }
+    rr[R2r::R45] = R[4];
+    rr[R2r::R45 + 1] = R[5];
     rr[R2r::alpha] = si.alpha;
     rr[R2r::beta] = si.beta;
-    rr[R2r::inv_rho + 1] = rr[R2r::inv_rho + 2] = rr[R2r::inv_rho + 3] = 0; // unused
   }
   const int dim = sets.empty() ? 3 : sets[0].dimensions;
   auto run = [&]<KernelType K, int D>() {
