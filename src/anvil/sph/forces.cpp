@@ -212,8 +212,9 @@ inline vdouble artificial_factor(const vdouble& wk, const vdouble& hb, const Set
 // Pass 1's pair loop for one kernel (the kernel is a template parameter so that the
 // loop has no per-pair branch on it), over the half lists in ascending gid (forces.hpp):
 // each pair's kernel once, for both particles.
-// Corr: some set normalises its gradient (the B sums are kept).
-template <KernelType K, int D, bool Corr>
+// Corr: some set normalises its gradient (the B sums are kept); Sum: some set sums its
+// density (the m W sums are kept).
+template <KernelType K, int D, bool Corr, bool Sum>
 void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double dt,
                       SphWorkspace& w) {
   const std::size_t n = p.n_local;
@@ -228,12 +229,8 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
   double* wk_k = w.wk.data();
   LowerSums1* low1 = w.low1.data();
   double* g_row = w.g_row.data();
-  bool keep_w = false, any_summation = false;
-  for (const auto& st : sets) {
-    // W: pass 2's artificial stress, the rows' sums of the summation density
-    keep_w = keep_w || st.epsilon > 0 || st.summation;
-    any_summation = any_summation || st.summation;
-  }
+  bool keep_w = false; // W: pass 2's artificial stress, the rows' sums of the summation density
+  for (const auto& st : sets) keep_w = keep_w || st.epsilon > 0 || st.summation;
   using S1 = LowerSums1;
   for (std::size_t r = 0; r < nl.row.size(); ++r) {
     const auto i = static_cast<std::size_t>(nl.row[r]);
@@ -275,7 +272,7 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
       simd::gather4(rdp + 4, stride, idx, q1); // v, volume
       const double* gk = g_row + 3 * (k0 - k_begin);
       const vdouble g[3] = {simd::load(gk), simd::load(gk + width), simd::load(gk + 2 * width)};
-      const vdouble wk = keep_w ? simd::load(wk_k + k0) : vdouble(0.0);
+      const vdouble wk = Sum ? simd::load(wk_k + k0) : vdouble(0.0);
       vdouble dx[3] = {0.0, 0.0, 0.0}; // the B sums only
       if constexpr (Corr) {
         vdouble q0[4];
@@ -294,12 +291,12 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
       }
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) Lv[a][b] += dv[a] * g[b];
-      if (si.summation)
+      if (Sum && si.summation)
         sum_mw += valid_lanes(k0, k_end) * vdouble([&](auto l) { return p.mass[idx[l]]; }) * wk;
       if (Corr && si.corrected)
         for (int a = 0; a < 3; ++a)
           for (int b = 0; b < 3; ++b) Bv[a][b] -= (vj * dx[a]) * g[b];
-      const vdouble mw = any_summation ? mi * wk : vdouble(0.0);
+      const vdouble mw = Sum ? mi * wk : vdouble(0.0);
       double* q[width];
       for (int l = 0; l < width; ++l) q[l] = low1[static_cast<std::size_t>(idx[l])].a;
       const vdouble s0[4] = {dvj[0] * g[0], dvj[0] * g[1], dvj[0] * g[2], dvj[1] * g[0]};
@@ -514,10 +511,14 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
   if (any_epsilon || any_summation) w.wk.resize(w.dwr.size());
   const int dim = sets.empty() ? 3 : sets[0].dimensions;
   auto run = [&]<KernelType K, int D>() {
-    if (any_corrected)
-      kinematics_pairs<K, D, true>(p, sets, dt, w);
+    if (any_corrected && any_summation)
+      kinematics_pairs<K, D, true, true>(p, sets, dt, w);
+    else if (any_corrected)
+      kinematics_pairs<K, D, true, false>(p, sets, dt, w);
+    else if (any_summation)
+      kinematics_pairs<K, D, false, true>(p, sets, dt, w);
     else
-      kinematics_pairs<K, D, false>(p, sets, dt, w);
+      kinematics_pairs<K, D, false, false>(p, sets, dt, w);
   };
   with_kernel(kernel, dim, run);
   kinematics_finish(p, sets, dt, any_summation, w);
