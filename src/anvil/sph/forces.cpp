@@ -161,6 +161,17 @@ void with_kernel(KernelType kernel, int dim, Run& run) {
   }
 }
 
+// Zeros a particle's lower sums by vector stores (std::fill copied the value by a call to
+// memcpy per particle; a plain loop becomes a memset, which callgrind counts by the byte).
+[[gnu::always_inline]] inline void zero_lower(LowerSums1& s) {
+  static_assert(sizeof(s.a) / sizeof(double) % width == 0);
+  for (std::size_t k = 0; k < sizeof(s.a) / sizeof(double); k += width) simd::store(0.0, s.a + k);
+}
+[[gnu::always_inline]] inline void zero_lower(LowerSums2& s) {
+  simd::store(0.0, s.f);   // f, e
+  simd::store(0.0, &s.mu); // mu, pad
+}
+
 // Lane l: 1 where entry k0 + l is inside the row (k_end its end), else 0.
 inline vdouble valid_lanes(std::int64_t k0, std::int64_t k_end) {
   const vdouble lane([](auto l) { return static_cast<double>(l); });
@@ -318,6 +329,10 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
         simd::scatter_add4(q, s4);
       }
     }
+    // No later row adds to i's lower sums (its partners' rows come after its lower
+    // neighbours' and its own padding): zero them here, where they are in cache, for the
+    // next step (sph_kinematics).
+    zero_lower(low1[i]);
     if (i >= n) continue; // a ghost's row: its partners' terms only
     // The lanes' sums, four vectors at a time: L's nine and sum m W, then B's nine.
     double ls[12], bs[12];
@@ -496,14 +511,13 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
   std::int64_t longest = 0;
   for (const int len : w.nl.len) longest = std::max<std::int64_t>(longest, len);
   w.g_row.resize(3 * static_cast<std::size_t>(simd::padded_size(static_cast<int>(longest))));
+  // The lower sums start at zero: each row zeroes its particle's after reading them, so
+  // after a pass with a row for every particle they are all zero (and stay so through a
+  // resize or a reordering); otherwise (the first step) by a sweep.
   w.low1.resize(p.n_all);
-  // Zeros by vector stores (std::fill copied the 160-byte value by a call to memcpy per
-  // particle; a plain loop becomes one memset, which callgrind counts by the byte).
-  constexpr int nl1 = sizeof(LowerSums1::a) / sizeof(double), nv1 = nl1 / width * width;
-  for (LowerSums1& ls : w.low1) {
-    for (int k = 0; k < nv1; k += width) simd::store(0.0, ls.a + k);
-    for (int k = nv1; k < nl1; ++k) ls.a[k] = 0.0;
-  }
+  if (!w.low1_zero)
+    for (LowerSums1& ls : w.low1) zero_lower(ls);
+  w.low1_zero = false;
   bool any_epsilon = false;
   for (const auto& st : sets) any_epsilon = any_epsilon || st.epsilon > 0;
   bool any_summation = false;
@@ -521,6 +535,7 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
       kinematics_pairs<K, D, false, false>(p, sets, dt, w);
   };
   with_kernel(kernel, dim, run);
+  w.low1_zero = w.nl.row.size() == p.n_all; // one row per particle (neighbours.hpp)
   kinematics_finish(p, sets, dt, any_summation, w);
 
   // Constitutive update through the batch interface, one run of a set's particles at a
@@ -774,6 +789,7 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
       // Particle j's terms: the same T with grad_j W_ji = -g (its force sum is reversed).
       simd::scatter_add4(q, {mi * tg[0], mi * tg[1], mi * tg[2], mi * ej});
     }
+    zero_lower(low2[i]); // for the next step, as in pass 1
     double sums[4];
     simd::lane_sums4(accv, sums);
     const double acc[3] = {sums[0] - lower.f[0], sums[1] - lower.f[1], sums[2] - lower.f[2]};
@@ -850,8 +866,9 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
   const bool any_rest = stress_rest || !same_visc;
   w.read2.resize(p.n_all);
   w.read2r.resize(p.n_all);
-  w.low2.resize(p.n_all);
-  std::fill(w.low2.begin(), w.low2.end(), LowerSums2{});
+  w.low2.resize(p.n_all); // zeros as pass 1's (sph_kinematics)
+  if (!w.low2_zero) std::fill(w.low2.begin(), w.low2.end(), LowerSums2{});
+  w.low2_zero = false;
   // `width` records at a time: four fields of every record per 4 x 4 transpose.
   std::size_t i0 = 0;
   for (; i0 + width <= p.n_all; i0 += width) {
@@ -937,6 +954,7 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
       forces_pairs<K, D, false, false>(p, sets, w, res);
   };
   with_kernel(kernel, dim, run);
+  w.low2_zero = w.nl.row.size() == p.n_all;
 }
 
 } // namespace anvil::sph

@@ -161,6 +161,9 @@ struct SphWorkspace {
   HugePageVector<LowerSums1> low1; // per particle (own and ghost), pass 1
   std::vector<double> g_row;       // pass 1: a row's kernel gradients, 3 vectors per entry
   HugePageVector<LowerSums2> low2; // and pass 2
+  // low1, low2 hold zeros: each row zeroes its particle's lower sums after the last term
+  // for them, so a pass with a row for every particle leaves them zero for the next step.
+  bool low1_zero = false, low2_zero = false;
   std::vector<double> lgrad[9];    // velocity gradient of own particles (row-major)
   std::vector<double> summed;      // 1 where an own particle's set sums its density
   std::vector<double> d[6];        // rate of deformation of own particles
