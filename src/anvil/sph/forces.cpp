@@ -161,6 +161,17 @@ void with_kernel(KernelType kernel, int dim, Run& run) {
   }
 }
 
+// Zeros a particle's lower sums by vector stores (std::fill copied the value by a call to
+// memcpy per particle; a plain loop becomes a memset, which callgrind counts by the byte).
+[[gnu::always_inline]] inline void zero_lower(LowerSums1& s) {
+  static_assert(sizeof(s.a) / sizeof(double) % width == 0);
+  for (std::size_t k = 0; k < sizeof(s.a) / sizeof(double); k += width) simd::store(0.0, s.a + k);
+}
+[[gnu::always_inline]] inline void zero_lower(LowerSums2& s) {
+  simd::store(0.0, s.f);   // f, e
+  simd::store(0.0, &s.mu); // mu, pad
+}
+
 // Lane l: 1 where entry k0 + l is inside the row (k_end its end), else 0.
 inline vdouble valid_lanes(std::int64_t k0, std::int64_t k_end) {
   const vdouble lane([](auto l) { return static_cast<double>(l); });
@@ -212,8 +223,9 @@ inline vdouble artificial_factor(const vdouble& wk, const vdouble& hb, const Set
 // Pass 1's pair loop for one kernel (the kernel is a template parameter so that the
 // loop has no per-pair branch on it), over the half lists in ascending gid (forces.hpp):
 // each pair's kernel once, for both particles.
-// Corr: some set normalises its gradient (the B sums are kept).
-template <KernelType K, int D, bool Corr>
+// Corr: some set normalises its gradient (the B sums are kept); Sum: some set sums its
+// density (the m W sums are kept).
+template <KernelType K, int D, bool Corr, bool Sum>
 void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double dt,
                       SphWorkspace& w) {
   const std::size_t n = p.n_local;
@@ -228,12 +240,8 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
   double* wk_k = w.wk.data();
   LowerSums1* low1 = w.low1.data();
   double* g_row = w.g_row.data();
-  bool keep_w = false, any_summation = false;
-  for (const auto& st : sets) {
-    // W: pass 2's artificial stress, the rows' sums of the summation density
-    keep_w = keep_w || st.epsilon > 0 || st.summation;
-    any_summation = any_summation || st.summation;
-  }
+  bool keep_w = false; // W: pass 2's artificial stress, the rows' sums of the summation density
+  for (const auto& st : sets) keep_w = keep_w || st.epsilon > 0 || st.summation;
   using S1 = LowerSums1;
   for (std::size_t r = 0; r < nl.row.size(); ++r) {
     const auto i = static_cast<std::size_t>(nl.row[r]);
@@ -275,7 +283,7 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
       simd::gather4(rdp + 4, stride, idx, q1); // v, volume
       const double* gk = g_row + 3 * (k0 - k_begin);
       const vdouble g[3] = {simd::load(gk), simd::load(gk + width), simd::load(gk + 2 * width)};
-      const vdouble wk = keep_w ? simd::load(wk_k + k0) : vdouble(0.0);
+      const vdouble wk = Sum ? simd::load(wk_k + k0) : vdouble(0.0);
       vdouble dx[3] = {0.0, 0.0, 0.0}; // the B sums only
       if constexpr (Corr) {
         vdouble q0[4];
@@ -294,12 +302,12 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
       }
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b) Lv[a][b] += dv[a] * g[b];
-      if (si.summation)
+      if (Sum && si.summation)
         sum_mw += valid_lanes(k0, k_end) * vdouble([&](auto l) { return p.mass[idx[l]]; }) * wk;
       if (Corr && si.corrected)
         for (int a = 0; a < 3; ++a)
           for (int b = 0; b < 3; ++b) Bv[a][b] -= (vj * dx[a]) * g[b];
-      const vdouble mw = any_summation ? mi * wk : vdouble(0.0);
+      const vdouble mw = Sum ? mi * wk : vdouble(0.0);
       double* q[width];
       for (int l = 0; l < width; ++l) q[l] = low1[static_cast<std::size_t>(idx[l])].a;
       const vdouble s0[4] = {dvj[0] * g[0], dvj[0] * g[1], dvj[0] * g[2], dvj[1] * g[0]};
@@ -321,6 +329,10 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
         simd::scatter_add4(q, s4);
       }
     }
+    // No later row adds to i's lower sums (its partners' rows come after its lower
+    // neighbours' and its own padding): zero them here, where they are in cache, for the
+    // next step (sph_kinematics).
+    zero_lower(low1[i]);
     if (i >= n) continue; // a ghost's row: its partners' terms only
     // The lanes' sums, four vectors at a time: L's nine and sum m W, then B's nine.
     double ls[12], bs[12];
@@ -499,14 +511,13 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
   std::int64_t longest = 0;
   for (const int len : w.nl.len) longest = std::max<std::int64_t>(longest, len);
   w.g_row.resize(3 * static_cast<std::size_t>(simd::padded_size(static_cast<int>(longest))));
+  // The lower sums start at zero: each row zeroes its particle's after reading them, so
+  // after a pass with a row for every particle they are all zero (and stay so through a
+  // resize or a reordering); otherwise (the first step) by a sweep.
   w.low1.resize(p.n_all);
-  // Zeros by vector stores (std::fill copied the 160-byte value by a call to memcpy per
-  // particle; a plain loop becomes one memset, which callgrind counts by the byte).
-  constexpr int nl1 = sizeof(LowerSums1::a) / sizeof(double), nv1 = nl1 / width * width;
-  for (LowerSums1& ls : w.low1) {
-    for (int k = 0; k < nv1; k += width) simd::store(0.0, ls.a + k);
-    for (int k = nv1; k < nl1; ++k) ls.a[k] = 0.0;
-  }
+  if (!w.low1_zero)
+    for (LowerSums1& ls : w.low1) zero_lower(ls);
+  w.low1_zero = false;
   bool any_epsilon = false;
   for (const auto& st : sets) any_epsilon = any_epsilon || st.epsilon > 0;
   bool any_summation = false;
@@ -514,12 +525,17 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
   if (any_epsilon || any_summation) w.wk.resize(w.dwr.size());
   const int dim = sets.empty() ? 3 : sets[0].dimensions;
   auto run = [&]<KernelType K, int D>() {
-    if (any_corrected)
-      kinematics_pairs<K, D, true>(p, sets, dt, w);
+    if (any_corrected && any_summation)
+      kinematics_pairs<K, D, true, true>(p, sets, dt, w);
+    else if (any_corrected)
+      kinematics_pairs<K, D, true, false>(p, sets, dt, w);
+    else if (any_summation)
+      kinematics_pairs<K, D, false, true>(p, sets, dt, w);
     else
-      kinematics_pairs<K, D, false>(p, sets, dt, w);
+      kinematics_pairs<K, D, false, false>(p, sets, dt, w);
   };
   with_kernel(kernel, dim, run);
+  w.low1_zero = w.nl.row.size() == p.n_all; // one row per particle (neighbours.hpp)
   kinematics_finish(p, sets, dt, any_summation, w);
 
   // Constitutive update through the batch interface, one run of a set's particles at a
@@ -547,7 +563,9 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
 
   // The energy, time-centred, and pass 2's stress P and artificial stress R: `width`
   // particles at a time where none normalises its gradient or has an artificial stress
-  // (P = sigma, R = 0: the same operations per particle), else one at a time.
+  // (P = sigma, R = 0: the same operations per particle), else one at a time. Where no
+  // set does, pass 2 reads neither R nor S6-S8 (the shear again): they are not written.
+  const bool all_plain = !any_corrected && !any_epsilon;
   auto plain = [&](std::size_t i) {
     const SetParams& st = sets[static_cast<std::size_t>(p.set[i])];
     return !st.corrected && !(st.epsilon > 0);
@@ -567,11 +585,11 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
       simd::store(simd::load(p.energy + i) +
                       0.5 * (simd::load(w.power_old.data() + i) + power) * dt / rho,
                   p.energy + i);
-      for (int k = 0; k < 6; ++k) {
-        simd::store(s[k], p.S[k] + i);
-        simd::store(0.0, p.R[k] + i);
+      for (int k = 0; k < 6; ++k) simd::store(s[k], p.S[k] + i);
+      if (!all_plain) {
+        for (int k = 0; k < 6; ++k) simd::store(0.0, p.R[k] + i);
+        for (int k = 6; k < 9; ++k) simd::store(s[k - 3], p.S[k] + i);
       }
-      for (int k = 6; k < 9; ++k) simd::store(s[k - 3], p.S[k] + i);
       i += width;
       continue;
     }
@@ -608,8 +626,11 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
 
 namespace {
 
-// Pass 2's pair loop; Corr: some set normalises its gradient (P is not symmetric).
-template <KernelType K, int D, bool Corr>
+// Pass 2's pair loop. Corr: some set normalises its gradient (P is not symmetric); AS: some
+// set has an artificial stress. Both are template parameters so that the common loop
+// (neither) keeps no value live for them: the velocity difference dies after the
+// viscosity and dv . g, before the stress groups are loaded (GCC kept it, and spilled).
+template <KernelType K, int D, bool Corr, bool AS>
 void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspace& w,
                   SphResult& res) {
   using R2 = NeighbourRead2;
@@ -630,8 +651,6 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
   const bool same_visc = uniform(sets, [](const SetParams& st) {
     return std::array<double, 2>{st.alpha, st.beta};
   });
-  bool any_epsilon = false;
-  for (const auto& st : sets) any_epsilon = any_epsilon || st.epsilon > 0;
   const bool same_as = uniform(sets, [](const SetParams& st) {
     return std::array<double, 3>{st.epsilon, st.w_spacing, st.exponent};
   });
@@ -651,70 +670,79 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
     // arithmetic there instead of broadcasts again in every iteration (GCC has no
     // registers to keep them in; the empty asm makes the array's address escape, so that
     // it stays in memory).
-    // pb[rest + k] holds the value at offset k of NeighbourRead2Rest.
+    // pb[rest + k] holds the value at offset k of NeighbourRead2Rest (S6-S8); then i's
+    // alpha, beta (its set's) and 1/rho (divided here, the same bits as a stored one), and
+    // the pair's -(alpha_i + alpha_j) and beta_i + beta_j where every set has the same
+    // viscosity (the loop's sums, once per row: the same bits).
     constexpr int rest = sizeof(R2) / sizeof(double);
-    alignas(32) vdouble pb[rest + R2r::inv_rho + 1];
+    constexpr int alpha_i = rest + 3, beta_i = alpha_i + 1, inv_rho = beta_i + 1;
+    constexpr int visc_a = inv_rho + 1, visc_b = visc_a + 1;
+    alignas(32) vdouble pb[visc_b + 1];
     for (int k = R2::x; k <= R2::rho; ++k) pb[k] = pi[k];
     if constexpr (Corr)
       for (int k = R2r::S6; k < R2r::S6 + 3; ++k) pb[rest + k] = pir[k];
-    for (int k = R2r::alpha; k <= R2r::inv_rho; ++k) pb[rest + k] = pir[k];
+    pb[alpha_i] = si.alpha;
+    pb[beta_i] = si.beta;
+    pb[inv_rho] = 1 / pi[R2::rho];
+    pb[visc_a] = -(pb[alpha_i] + pb[alpha_i]);
+    pb[visc_b] = pb[beta_i] + pb[beta_i];
     asm volatile("" : : "r"(pb) : "memory");
     vdouble accv[4] = {0.0, 0.0, 0.0, 0.0}, mumv = 0.0; // force sums, energy rate
     const std::int64_t k_begin = nl.start[r], k_end = k_begin + nl.len[r];
     for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
       const int* idx = index + k0;
-      // In two stages, so that fewer values are live at once: first what the kinematics
-      // of the pair give (gradient, viscosity, the energy rate's dv . g), from the groups
-      // x, h; v, c; S4, S5, rho, m; then the stress groups and the pair's T.
+      double* q[width]; // the partners' lower sums: f, e at q[l], mu at q[l] + 4
+      for (int l = 0; l < width; ++l) q[l] = low2[static_cast<std::size_t>(idx[l])].f;
+      // In stages, so that fewer values are live at once: the gradient from x, h; the
+      // viscosity's approach and dv . g from v, c; the viscosity from S4, S5, rho, m;
+      // then the stress groups and the pair's T.
       vdouble qx[4], qv[4], qr[4];
-      simd::gather4(rdp + R2::x, stride, idx, qx);   // x, h
-      simd::gather4(rdp + R2::v, stride, idx, qv);   // v, c
-      simd::gather4(rdp + R2::S45, stride, idx, qr); // S4, S5, rho, m
-      vdouble dx[3], dv[3];
-      for (int a = 0; a < 3; ++a) {
-        dx[a] = pb[R2::x + a] - qx[a];
-        dv[a] = pb[R2::v + a] - qv[a];
-      }
+      simd::gather4(rdp + R2::x, stride, idx, qx); // x, h
+      vdouble dx[3];
+      for (int a = 0; a < 3; ++a) dx[a] = pb[R2::x + a] - qx[a];
       const vdouble hb = 0.5 * (pb[R2::h] + qx[3]);
       const vdouble r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
       const vdouble dwr = simd::load(dwr_k + k0);
       const vdouble g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
-      const vdouble fn = any_epsilon ? artificial_factor<K, D>(simd::load(wk_k + k0), hb, si, sets,
-                                                               p.set, idx, same_as)
-                                     : vdouble(0.0);
+      simd::gather4(rdp + R2::v, stride, idx, qv); // v, c
+      vdouble dv[3];
+      for (int a = 0; a < 3; ++a) dv[a] = pb[R2::v + a] - qv[a];
       const vdouble vr = dv[0] * dx[0] + dv[1] * dx[1] + dv[2] * dx[2];
+      const vdouble dvg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
+      vdouble fn = 0.0;
+      if constexpr (AS)
+        fn = artificial_factor<K, D>(simd::load(wk_k + k0), hb, si, sets, p.set, idx, same_as);
+      simd::gather4(rdp + R2::S45, stride, idx, qr); // S4, S5, rho, m
       vdouble visc = 0.0;
       const auto approaching = vr < 0.0;
       if (stdx::any_of(approaching)) {
         const vdouble mu = hb * vr / (r2 + 0.01 * hb * hb);
         const vdouble cb = 0.5 * (pb[R2::c] + qv[3]);
-        vdouble qa[4];
-        if (same_visc) {
-          qa[2] = pb[rest + R2r::alpha];
-          qa[3] = pb[rest + R2r::beta];
-        } else {
-          simd::gather4(rdrp + R2r::R45, stride_r, idx, qa); // R4, R5, alpha, beta
-        }
         // Pi_ij = (-alpha c mu + beta mu^2) / rho_ij with rho_ij = (rho_i + rho_j) / 2.
-        const vdouble pv = (-(pb[rest + R2r::alpha] + qa[2]) * cb * mu +
-                            (pb[rest + R2r::beta] + qa[3]) * mu * mu) /
-                           (pb[R2::rho] + qr[2]);
+        vdouble pv;
+        if (same_visc) {
+          pv = (pb[visc_a] * cb * mu + pb[visc_b] * mu * mu) / (pb[R2::rho] + qr[2]);
+        } else {
+          vdouble qa[4];
+          simd::gather4(rdrp + R2r::R45, stride_r, idx, qa); // R4, R5, alpha, beta
+          pv = (-(pb[alpha_i] + qa[2]) * cb * mu + (pb[beta_i] + qa[3]) * mu * mu) /
+               (pb[R2::rho] + qr[2]);
+        }
         stdx::where(approaching, visc) = pv;
         // The largest approach of the pair for both particles' stable steps.
         vdouble muj = 0.0;
         stdx::where(approaching, muj) = -mu;
         mumv = stdx::max(mumv, muj);
         double* qm[width];
-        for (int l = 0; l < width; ++l) qm[l] = &low2[static_cast<std::size_t>(idx[l])].mu;
+        for (int l = 0; l < width; ++l) qm[l] = q[l] + 4;
         simd::scatter_max(qm, muj);
       }
       // Half the viscous dissipation of the pair heats each particle.
-      const vdouble dvg = dv[0] * g[0] + dv[1] * g[1] + dv[2] * g[2];
       const vdouble half_visc = 0.5 * visc * dvg;
+      const vdouble irr = pb[inv_rho] * (1.0 / qr[2]);
       vdouble qs[4], qu[4] = {0.0, 0.0, 0.0, 0.0};
       simd::gather4(rdp + R2::S, stride, idx, qs);                          // S0..S3
       if constexpr (Corr) simd::gather4(rdrp + R2r::S6, stride_r, idx, qu); // S6..S8, has_r
-      const vdouble irr = pb[rest + R2r::inv_rho] * (1.0 / qr[2]);
       // T = (P_i + P_j + f^n (R_i + R_j)) / (rho_i rho_j) - Pi I; T[6..8] (yx zy zx)
       // differ from T[3..5] only where a gradient is normalised (Corr).
       constexpr int nt = Corr ? 9 : 6;
@@ -723,7 +751,7 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
       for (int c = 0; c < nt; ++c)
         T[c] = (pb[c < 6 ? R2::S + c : rest + R2r::S6 + c - 6] + Sj[c]) * irr;
       vdouble rg = 0.0, rgj = 0.0;
-      if (stdx::any_of(fn > 0.0)) {
+      if (AS && stdx::any_of(fn > 0.0)) {
         if constexpr (!Corr) simd::gather4(rdrp + R2r::S6, stride_r, idx, qu); // has_r
         if (pir[R2r::has_r] != 0.0 || stdx::any_of(qu[3] > 0.0)) {
           vdouble qR[4], qR45[4];
@@ -755,13 +783,13 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
                              T[yx] * g[0] + T[1] * g[1] + T[4] * g[2],
                              T[zx] * g[0] + T[zy] * g[1] + T[2] * g[2]};
       for (int a = 0; a < 3; ++a) accv[a] += mj * tg[a];
-      accv[3] += mj * (half_visc - rg);
+      // Without an artificial stress rg = rgj = 0 and x - 0 is x: the same bits.
+      const vdouble ei = AS ? half_visc - rg : half_visc, ej = AS ? half_visc - rgj : half_visc;
+      accv[3] += mj * ei;
       // Particle j's terms: the same T with grad_j W_ji = -g (its force sum is reversed).
-      const vdouble sj[4] = {mi * tg[0], mi * tg[1], mi * tg[2], mi * (half_visc - rgj)};
-      double* q[width]; // the partners' lower sums
-      for (int l = 0; l < width; ++l) q[l] = low2[static_cast<std::size_t>(idx[l])].f;
-      simd::scatter_add4(q, sj);
+      simd::scatter_add4(q, {mi * tg[0], mi * tg[1], mi * tg[2], mi * ej});
     }
+    zero_lower(low2[i]); // for the next step, as in pass 1
     double sums[4];
     simd::lane_sums4(accv, sums);
     const double acc[3] = {sums[0] - lower.f[0], sums[1] - lower.f[1], sums[2] - lower.f[2]};
@@ -772,8 +800,7 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
     for (int a = 0; a < 3; ++a) p.force[a][i] = pi[R2::mass] * acc[a];
     p.energy_rate[i] = de;
     const double ci = pi[R2::c];
-    const double dt =
-        courant * pi[R2::h] / (ci + 1.2 * (pir[R2r::alpha] * ci + pir[R2r::beta] * mu_max));
+    const double dt = courant * pi[R2::h] / (ci + 1.2 * (si.alpha * ci + si.beta * mu_max));
     if (dt < res.dt_stable || (dt == res.dt_stable && p.gid[i] < res.stable_gid)) {
       res.dt_stable = dt;
       res.stable_gid = p.gid[i];
@@ -829,10 +856,19 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
     any_corrected = any_corrected || st.corrected;
     any_epsilon = any_epsilon || st.epsilon > 0;
   }
+  // The rest records are read only by a normalised gradient, an artificial stress (its
+  // groups S6-S8 and has_r, R0-R3, R4, R5) and sets of different viscosity (alpha, beta):
+  // without those they are not written (forces_pairs reads them under the same conditions).
+  const bool same_visc = uniform(sets, [](const SetParams& st) {
+    return std::array<double, 2>{st.alpha, st.beta};
+  });
+  const bool stress_rest = any_corrected || any_epsilon;
+  const bool any_rest = stress_rest || !same_visc;
   w.read2.resize(p.n_all);
   w.read2r.resize(p.n_all);
-  w.low2.resize(p.n_all);
-  std::fill(w.low2.begin(), w.low2.end(), LowerSums2{});
+  w.low2.resize(p.n_all); // zeros as pass 1's (sph_kinematics)
+  if (!w.low2_zero) std::fill(w.low2.begin(), w.low2.end(), LowerSums2{});
+  w.low2_zero = false;
   // `width` records at a time: four fields of every record per 4 x 4 transpose.
   std::size_t i0 = 0;
   for (; i0 + width <= p.n_all; i0 += width) {
@@ -855,31 +891,29 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
     auto per_set = [&](auto field) {
       return vdouble([&](auto l) { return field(sets[static_cast<std::size_t>(p.set[i0 + l])]); });
     };
-    const vdouble rho = ld(p.rho);
-    vdouble R[6];
-    for (int c = 0; c < 6; ++c) R[c] = ld(p.R[c]);
     put(R2::x, ld(p.x[0]), ld(p.x[1]), ld(p.x[2]), ld(p.h));
     put(R2::v, ld(p.v[0]), ld(p.v[1]), ld(p.v[2]), ld(p.wave_speed));
     put(R2::S, ld(p.S[0]), ld(p.S[1]), ld(p.S[2]), ld(p.S[3]));
-    put(R2::S45, ld(p.S[4]), ld(p.S[5]), rho, ld(p.mass));
-    // The groups only a normalised gradient or an artificial stress reads (forces_pairs
-    // reads them under the same conditions): not written otherwise.
-    if (any_corrected || any_epsilon) {
+    put(R2::S45, ld(p.S[4]), ld(p.S[5]), ld(p.rho), ld(p.mass));
+    if (!any_rest) continue;
+    vdouble R4 = 0.0, R5 = 0.0; // R is zero without an artificial stress
+    if (stress_rest) {
+      vdouble R[4];
+      for (int c = 0; c < 4; ++c) R[c] = ld(p.R[c]);
+      R4 = ld(p.R[4]);
+      R5 = ld(p.R[5]);
       const auto any =
-          R[0] != 0.0 || R[1] != 0.0 || R[2] != 0.0 || R[3] != 0.0 || R[4] != 0.0 || R[5] != 0.0;
+          R[0] != 0.0 || R[1] != 0.0 || R[2] != 0.0 || R[3] != 0.0 || R4 != 0.0 || R5 != 0.0;
       vdouble has_r = 0.0;
       stdx::where(any, has_r) = 1.0;
       put_r(R2r::S6, ld(p.S[6]), ld(p.S[7]), ld(p.S[8]), has_r);
       put_r(R2r::R, R[0], R[1], R[2], R[3]);
     }
-    put_r(R2r::R45, R[4], R[5], per_set([](const SetParams& st) { return st.alpha; }),
+    put_r(R2r::R45, R4, R5, per_set([](const SetParams& st) { return st.alpha; }),
           per_set([](const SetParams& st) { return st.beta; }));
-    put_r(R2r::inv_rho, 1 / rho, 0.0, 0.0, 0.0);
   }
   for (std::size_t i = i0; i < p.n_all; ++i) {
     double* r = w.read2[i].a;
-    double* rr = w.read2r[i].a;
-    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
     for (int a = 0; a < 3; ++a) {
       r[R2::x + a] = p.x[a][i];
       r[R2::v + a] = p.v[a][i];
@@ -887,28 +921,40 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
     r[R2::h] = p.h[i];
     r[R2::c] = p.wave_speed[i];
     r[R2::rho] = p.rho[i];
-    rr[R2r::inv_rho] = 1 / p.rho[i];
     r[R2::mass] = p.mass[i];
     for (int c = 0; c < 6; ++c) r[R2::S + c] = p.S[c][i];
-    for (int c = 6; c < 9; ++c) rr[R2r::S6 + c - 6] = p.S[c][i];
-    int any = 0;
-    for (int c = 0; c < 6; ++c) any |= p.R[c][i] != 0.0;
-    for (int c = 0; c < 4; ++c) rr[R2r::R + c] = p.R[c][i];
-    rr[R2r::R45] = p.R[4][i];
-    rr[R2r::R45 + 1] = p.R[5][i];
-    rr[R2r::has_r] = any ? 1.0 : 0.0;
+    if (!any_rest) continue;
+    double* rr = w.read2r[i].a;
+    const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
+    double R[6] = {0, 0, 0, 0, 0, 0};
+    if (stress_rest) {
+      int any = 0;
+      for (int c = 0; c < 6; ++c) {
+        R[c] = p.R[c][i];
+        any |= R[c] != 0.0;
+      }
+      for (int c = 6; c < 9; ++c) rr[R2r::S6 + c - 6] = p.S[c][i];
+      rr[R2r::has_r] = any ? 1.0 : 0.0;
+      for (int c = 0; c < 4; ++c) rr[R2r::R + c] = R[c];
+    }
+    rr[R2r::R45] = R[4];
+    rr[R2r::R45 + 1] = R[5];
     rr[R2r::alpha] = si.alpha;
     rr[R2r::beta] = si.beta;
-    rr[R2r::inv_rho + 1] = rr[R2r::inv_rho + 2] = rr[R2r::inv_rho + 3] = 0; // unused
   }
   const int dim = sets.empty() ? 3 : sets[0].dimensions;
   auto run = [&]<KernelType K, int D>() {
-    if (any_corrected)
-      forces_pairs<K, D, true>(p, sets, w, res);
+    if (any_corrected && any_epsilon)
+      forces_pairs<K, D, true, true>(p, sets, w, res);
+    else if (any_corrected)
+      forces_pairs<K, D, true, false>(p, sets, w, res);
+    else if (any_epsilon)
+      forces_pairs<K, D, false, true>(p, sets, w, res);
     else
-      forces_pairs<K, D, false>(p, sets, w, res);
+      forces_pairs<K, D, false, false>(p, sets, w, res);
   };
   with_kernel(kernel, dim, run);
+  w.low2_zero = w.nl.row.size() == p.n_all;
 }
 
 } // namespace anvil::sph

@@ -93,6 +93,8 @@ struct SphView {
   // repeat the shear) unless the set normalises its gradient.
   double* S[9] = {};
   double* R[6] = {}; // artificial stress, Pa
+  // (S6-S8 and R are written only where some set normalises its gradient or has an
+  // artificial stress: pass 2 reads them only then.)
   // own, out of pass 2
   double* force[3] = {};         // N
   double* energy_rate = nullptr; // J/(kg s) from viscosity and artificial stress
@@ -117,17 +119,18 @@ struct alignas(64) NeighbourRead1 {
 // 32^3 particles the records of the +2 lattice planes a sweep of rows reads no longer fit
 // in a 1 MB L2 cache). NeighbourRead2: x, h; v, c; S0-S3; S4, S5, rho, m: every value a
 // pair needs without a normalised gradient or an artificial stress (a neighbour's 1/rho
-// is divided in the loop, the same bits as the row particle's inv_rho).
-// NeighbourRead2Rest: a normalised gradient reads the first group (S6-S8), the artificial
-// stress the first (has_r), second and third, sets of different viscosity the third
-// (alpha, beta); the row particle reads its own alpha, beta and inv_rho.
+// is divided in the loop, the row particle's once per row).
+// NeighbourRead2Rest (96 bytes, whole 32-byte groups): a normalised gradient reads the
+// first group (S6-S8), the artificial stress the first (has_r), second and third, sets of
+// different viscosity the third (alpha, beta); written only where one of them is there.
+// The row particle takes its own alpha, beta from its set.
 struct alignas(64) NeighbourRead2 {
   static constexpr int x = 0, h = 3, v = 4, c = 7, S = 8, S45 = 12, rho = 14, mass = 15;
   double a[16];
 };
-struct alignas(64) NeighbourRead2Rest {
-  static constexpr int S6 = 0, has_r = 3, R = 4, R45 = 8, alpha = 10, beta = 11, inv_rho = 12;
-  double a[16];
+struct alignas(32) NeighbourRead2Rest {
+  static constexpr int S6 = 0, has_r = 3, R = 4, R45 = 8, alpha = 10, beta = 11;
+  double a[12];
 };
 
 // A particle's running sums over its lower neighbours (their rows' terms for it), in
@@ -158,6 +161,9 @@ struct SphWorkspace {
   HugePageVector<LowerSums1> low1; // per particle (own and ghost), pass 1
   std::vector<double> g_row;       // pass 1: a row's kernel gradients, 3 vectors per entry
   HugePageVector<LowerSums2> low2; // and pass 2
+  // low1, low2 hold zeros: each row zeroes its particle's lower sums after the last term
+  // for them, so a pass with a row for every particle leaves them zero for the next step.
+  bool low1_zero = false, low2_zero = false;
   std::vector<double> lgrad[9];    // velocity gradient of own particles (row-major)
   std::vector<double> summed;      // 1 where an own particle's set sums its density
   std::vector<double> d[6];        // rate of deformation of own particles
