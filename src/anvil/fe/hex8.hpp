@@ -204,7 +204,10 @@ ANVIL_HEX8_INLINE void corotational_frame(const V (&J)[3][3], V (&e)[3][3], V (&
 //   g_xy = t_x il_1 + t_y il_0, g_yz = t_y il_2 + t_z il_1, g_zx = t_z il_0 + t_x il_2:
 //   r[0][0] = mu w (g_xy il_1 + g_zx il_2), r[1][1] = mu w (g_xy il_0 + g_yz il_2),
 //   r[2][2] = mu w (g_yz il_1 + g_zx il_0).
-template <class V>
+// Zeta = false leaves out the zeta group (the normal modes (0, 1) and (1, 0) and the
+// twist modes' g_xy part: r[0][1] = r[1][0] = 0), whose stresses a thick shell
+// integrates at its points through the thickness instead (docs/element.md).
+template <bool Zeta = true, class V>
 ANVIL_HEX8_INLINE void assumed_strain_rate(double E, double mu, const V (&len)[3],
                                            const V (&q)[3][4], V (&r)[3][4]) {
   const V i01 = 1.0 / (len[0] * len[1]);
@@ -215,13 +218,46 @@ ANVIL_HEX8_INLINE void assumed_strain_rate(double E, double mu, const V (&len)[3
     _Pragma("GCC unroll 3") for (int al = 0; al < 3; ++al) if (al != d) r[d][al] = k * q[d][al];
     r[d][3] = (1.0 / 3.0) * k * q[d][3];
   }
-  const V gxy = q[0][0] * il[1] + q[1][1] * il[0];
   const V gyz = q[1][1] * il[2] + q[2][2] * il[1];
   const V gzx = q[2][2] * il[0] + q[0][0] * il[2];
   const V mw = mu * w;
-  r[0][0] = mw * (gxy * il[1] + gzx * il[2]);
-  r[1][1] = mw * (gxy * il[0] + gyz * il[2]);
+  if constexpr (Zeta) {
+    const V gxy = q[0][0] * il[1] + q[1][1] * il[0];
+    r[0][0] = mw * (gxy * il[1] + gzx * il[2]);
+    r[1][1] = mw * (gxy * il[0] + gyz * il[2]);
+  } else {
+    r[0][1] = 0.0;
+    r[1][0] = 0.0;
+    r[0][0] = mw * (gzx * il[2]);
+    r[1][1] = mw * (gyz * il[2]);
+  }
   r[2][2] = mw * (gyz * il[1] + gzx * il[0]);
+}
+
+// One group of the plastic limits below: the fibre stresses of the normal modes (d, al)
+// and (e, be) and the shear moment t (iv = 2 / V, ks = sqrt 3 iv), checked with von Mises'
+// criterion against sy (sy2 = sy^2) and scaled back onto it when past it (then phi > 0);
+// returns the factor.
+template <class V>
+ANVIL_HEX8_INLINE V limit_group(V (&Q)[3][4], const V (&len)[3], const V& iv, const V& ks,
+                                const V& sy, const V& sy2, int d, int al, int e, int be,
+                                const V& t) {
+  using std::sqrt;
+  const V sa = Q[d][al] * len[d] * iv, sb = Q[e][be] * len[e] * iv, ss = t * ks;
+  const V phi = sa * sa - sa * sb + sb * sb + ss * ss;
+  const V k = simd::select(phi > sy2, sy / sqrt(phi), V(1.0));
+  Q[d][al] *= k;
+  Q[e][be] *= k;
+  return k;
+}
+
+// The xi eta zeta modes' limit: each clipped to |s| <= sy on its own.
+template <class V>
+ANVIL_HEX8_INLINE void limit_xi_eta_zeta(const V& sy, const V (&len)[3], V (&Q)[3][4]) {
+  _Pragma("GCC unroll 3") for (int d = 0; d < 3; ++d) {
+    const V cap = (sy * (1.0 / 256.0)) * (len[(d + 1) % 3] * len[(d + 2) % 3]); // |s| <= sy
+    Q[d][3] = simd::select(Q[d][3] > cap, cap, simd::select(Q[d][3] < -cap, -cap, Q[d][3]));
+  }
 }
 
 // The plastic limit of the assumed-strain hourglass forces (docs/element.md, "Plastic
@@ -244,7 +280,6 @@ ANVIL_HEX8_INLINE void assumed_strain_rate(double E, double mu, const V (&len)[3
 // one-point stress (the membrane) does not enter: see docs/element.md.
 template <class V>
 ANVIL_HEX8_INLINE void assumed_strain_limit(const V& sy, const V (&len)[3], V (&Q)[3][4]) {
-  using std::sqrt;
   const V iv = 128.0 / (len[0] * len[1] * len[2]); // 2 / V
   const V il2 = 1.0 / len[2];
   // Shear moments from the twist forces (A^-1 Q; det A = 2 il0 il1 il2).
@@ -254,15 +289,8 @@ ANVIL_HEX8_INLINE void assumed_strain_limit(const V& sy, const V (&len)[3], V (&
   const V tzx = 0.5 * (qx * len[2] + qz * len[0] - qy * (len[2] * len[0] / len[1]));
   const V ks = 1.7320508075688772 * iv;
   const V sy2 = sy * sy;
-  // One group: normal modes (d, al) and (e, be), shear moment t; returns the factor.
   auto group = [&](int d, int al, int e, int be, const V& t) {
-    const V sa = Q[d][al] * len[d] * iv, sb = Q[e][be] * len[e] * iv, ss = t * ks;
-    const V phi = sa * sa - sa * sb + sb * sb + ss * ss;
-    // Past the surface (then phi > 0): back onto it; else unchanged.
-    const V k = simd::select(phi > sy2, sy / sqrt(phi), V(1.0));
-    Q[d][al] *= k;
-    Q[e][be] *= k;
-    return k;
+    return limit_group(Q, len, iv, ks, sy, sy2, d, al, e, be, t);
   };
   const V kz = group(0, 1, 1, 0, txy);
   const V ky = group(0, 2, 2, 0, tzx);
@@ -273,10 +301,7 @@ ANVIL_HEX8_INLINE void assumed_strain_limit(const V& sy, const V (&len)[3], V (&
   Q[0][0] = simd::select(scaled, sxy * il1 + szx * il2, Q[0][0]);
   Q[1][1] = simd::select(scaled, sxy * il0 + syz * il2, Q[1][1]);
   Q[2][2] = simd::select(scaled, syz * il1 + szx * il0, Q[2][2]);
-  _Pragma("GCC unroll 3") for (int d = 0; d < 3; ++d) {
-    const V cap = (sy * (1.0 / 256.0)) * (len[(d + 1) % 3] * len[(d + 2) % 3]); // |s| <= sy
-    Q[d][3] = simd::select(Q[d][3] > cap, cap, simd::select(Q[d][3] < -cap, -cap, Q[d][3]));
-  }
+  limit_xi_eta_zeta(sy, len, Q);
 }
 
 // Gauss points and weights on [-1, 1] through the thickness of a thick-shell element
@@ -294,62 +319,25 @@ inline constexpr double thick_shell_weight[4][5] = {
     {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
      0.2369268850561891}};
 
-// The thick shell's stiffness rate for the hourglass modes its points do not integrate:
-// assumed_strain_rate without the zeta group (the normal modes (0, 1) and (1, 0), and the
-// twist modes' g_xy part), whose stresses vary through the thickness (zeta) and live at
-// the integration points. r[0][1] = r[1][0] = 0.
-template <class V>
-ANVIL_HEX8_INLINE void thick_shell_rate(double E, double mu, const V (&len)[3], const V (&q)[3][4],
-                                        V (&r)[3][4]) {
-  const V i01 = 1.0 / (len[0] * len[1]);
-  const V il[3] = {len[1] * i01, len[0] * i01, 1.0 / len[2]};
-  const V w = (1.0 / 192.0) * len[0] * len[1] * len[2];
-  _Pragma("GCC unroll 3") for (int d = 0; d < 3; ++d) {
-    const V k = (E * w) * (il[d] * il[d]);
-    _Pragma("GCC unroll 3") for (int al = 0; al < 3; ++al) if (al != d) r[d][al] = k * q[d][al];
-    r[d][3] = (1.0 / 3.0) * k * q[d][3];
-  }
-  r[0][1] = 0.0;
-  r[1][0] = 0.0;
-  const V gyz = q[1][1] * il[2] + q[2][2] * il[1];
-  const V gzx = q[2][2] * il[0] + q[0][0] * il[2];
-  const V mw = mu * w;
-  r[0][0] = mw * (gzx * il[2]);
-  r[1][1] = mw * (gyz * il[2]);
-  r[2][2] = mw * (gyz * il[1] + gzx * il[0]);
-}
-
-// The plastic limit of thick_shell_rate's forces: assumed_strain_limit's eta and xi groups
-// and xi eta zeta clips (the zeta group yields at the integration points). With no
-// zeta-group force, the twist forces give the shear moments directly: T_zx = Q_x len2,
-// T_yz = Q_y len2 (and Q_z = T_yz il1 + T_zx il0).
+// The plastic limit of assumed_strain_rate<false>'s forces (the thick shell's):
+// assumed_strain_limit's eta and xi groups and xi eta zeta clips (the zeta group yields at the
+// integration points). With no zeta-group force, the twist forces give the shear moments directly:
+// T_zx = Q_x len2, T_yz = Q_y len2 (and Q_z = T_yz il1 + T_zx il0).
 template <class V>
 ANVIL_HEX8_INLINE void thick_shell_limit(const V& sy, const V (&len)[3], V (&Q)[3][4]) {
-  using std::sqrt;
   const V iv = 128.0 / (len[0] * len[1] * len[2]); // 2 / V
   const V tyz = Q[1][1] * len[2], tzx = Q[0][0] * len[2];
   const V ks = 1.7320508075688772 * iv;
   const V sy2 = sy * sy;
-  auto group = [&](int d, int al, int e, int be, const V& t) {
-    const V sa = Q[d][al] * len[d] * iv, sb = Q[e][be] * len[e] * iv, ss = t * ks;
-    const V phi = sa * sa - sa * sb + sb * sb + ss * ss;
-    const V k = simd::select(phi > sy2, sy / sqrt(phi), V(1.0));
-    Q[d][al] *= k;
-    Q[e][be] *= k;
-    return k;
-  };
-  const V ky = group(0, 2, 2, 0, tzx);
-  const V kx = group(1, 2, 2, 1, tyz);
+  const V ky = limit_group(Q, len, iv, ks, sy, sy2, 0, 2, 2, 0, tzx);
+  const V kx = limit_group(Q, len, iv, ks, sy, sy2, 1, 2, 2, 1, tyz);
   const V syz = tyz * kx, szx = tzx * ky;
   const V il0 = 1.0 / len[0], il1 = 1.0 / len[1], il2 = 1.0 / len[2];
   const auto scaled = (ky < 1.0) || (kx < 1.0);
   Q[0][0] = simd::select(scaled, szx * il2, Q[0][0]);
   Q[1][1] = simd::select(scaled, syz * il2, Q[1][1]);
   Q[2][2] = simd::select(scaled, syz * il1 + szx * il0, Q[2][2]);
-  _Pragma("GCC unroll 3") for (int d = 0; d < 3; ++d) {
-    const V cap = (sy * (1.0 / 256.0)) * (len[(d + 1) % 3] * len[(d + 2) % 3]); // |s| <= sy
-    Q[d][3] = simd::select(Q[d][3] > cap, cap, simd::select(Q[d][3] < -cap, -cap, Q[d][3]));
-  }
+  limit_xi_eta_zeta(sy, len, Q);
 }
 
 // Hourglass shape vectors gamma_alpha = Gamma_alpha - (1/V)(Gamma_alpha . x_i) B_i, which

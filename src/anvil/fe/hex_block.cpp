@@ -657,7 +657,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         // (hex8::assumed_strain_limit); the work of the forces includes what that dissipates.
         vdouble r[3][4], old[3][4];
         if constexpr (Shell)
-          hex8::thick_shell_rate(hg_E, hg_mu, extent, ql, r);
+          hex8::assumed_strain_rate<false>(hg_E, hg_mu, extent, ql, r);
         else
           hex8::assumed_strain_rate(hg_E, hg_mu, extent, ql, r);
         _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
