@@ -5,7 +5,7 @@
 #  1. the deck runs uninterrupted on 1 rank;
 #  2. on 2 ranks it is stopped at cycle 1000, after the erosion, and restarted on 3;
 # the final checkpoints must hold the same state bit for bit (eroded flags included), and
-# both summaries count the 18 eroded elements. Before version 3 the restarted run brought
+# both summaries count the 18 eroded elements, and the energy balance holds (2%). Before version 3 the restarted run brought
 # the eroded elements back (it ended after 12,278 cycles instead of 13,337).
 set -euo pipefail
 anvil=$1
@@ -28,4 +28,14 @@ run 3 "$anvil" run "$deck" -o stopped -q --restart stopped/checkpoint.anvil
 "$compare" full/checkpoint.anvil stopped/checkpoint.anvil
 grep -q '"eroded_elements": 18' full/summary.json
 grep -q '"eroded_elements": 18' stopped/summary.json
+# The energy balance stays a number: an element that inverts and erodes does not count
+# the increments of its last, inverted step (they were not finite, and the balance was
+# NaN from the first erosion on). Measured 0.77%; the eroded elements take their energy
+# with them but for that step, so the balance holds to about a percent: tolerance 2%.
+/usr/bin/python3 - full/summary.json <<'PY'
+import json, math, sys
+b = json.load(open(sys.argv[1]))["energy"]["balance_error"]
+if b is None or not math.isfinite(b) or abs(b) > 0.02:
+    sys.exit(f"energy balance error {b}: expected finite and under 2%")
+PY
 echo "restart with erosion: identical state after stop on 2 ranks and restart on 3"

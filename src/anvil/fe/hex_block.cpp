@@ -703,8 +703,12 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       const bool any_dead = stdx::any_of(dead);
       stdx::where(dead, dE) = 0.0;
       stdx::where(dead, hg_power) = 0.0;
-      simd::store(simd::load(&b.internal_energy[e]) + dE, &b.internal_energy[e]);
-      simd::store(simd::load(&b.hourglass_energy[e]) + dt * hg_power, &b.hourglass_energy[e]);
+      // (The old values stay at hand for an element that erodes below: the increments of
+      // its last step, from an inverted or failing shape, are not counted.)
+      const vdouble ie_old = simd::load(&b.internal_energy[e]);
+      const vdouble he_old = simd::load(&b.hourglass_energy[e]);
+      simd::store(ie_old + dE, &b.internal_energy[e]);
+      simd::store(he_old + dt * hg_power, &b.hourglass_energy[e]);
       simd::store(vol, &b.volume[e]);
 
       // Stable time step: Flanagan-Belytschko bound on the maximum eigenvalue,
@@ -839,6 +843,8 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         if (erode) { // delete it now: this cycle's forces already leave it out
           b.alive[e + k] = 0.0;
           ++b.eroded;
+          b.internal_energy[e + k] = ie_old[k]; // its energies as before this step
+          b.hourglass_energy[e + k] = he_old[k];
           for (int a = 0; a < 8; ++a)
             for (double* r : rows_of) r[8 * k + a] = 0.0;
           for (auto& sk : b.stress) sk[e + k] = 0.0;
