@@ -32,7 +32,8 @@ enum Slot : int {
   s_power_old, // old (rotated) stress : D
   s_volume_mid,
   s_q0,
-  s_flow = s_q0, // flow stress (assumed strain; s_q* hold the stiffness form's rotation)
+  s_flow = s_q0, // flow stress (assumed strain; s_q* hold the stiffness form's rotation,
+                 // s_q1 a thick shell's wave speed at each point after the first)
   s_q1,
   s_q2,
   s_q3,

@@ -24,6 +24,7 @@ namespace {
 // with every element alive (1, 2) and no thick-shell state (1-3).
 constexpr char magic[8] = {'A', 'N', 'V', 'I', 'L', 'C', 'K', '4'};
 constexpr std::size_t magic_version = 7;
+static_assert(Checkpoint::point_values == 8 * ThickShell::max_points);
 
 // Sends this rank's records to rank 0, which keeps them in ascending global id.
 template <int Width>
@@ -143,7 +144,7 @@ Checkpoint capture(const Simulation& sim, const OutputState& outputs) {
   for (const auto& b : sim.blocks())
     for (int e = 0; b.thick_shell.enabled() && e < b.size(); ++e) {
       gid.push_back(b.gid[e]);
-      for (int p = 0; p < 5; ++p) {
+      for (int p = 0; p < ThickShell::max_points; ++p) {
         const bool in = p < b.thick_shell.points;
         for (int k = 0; k < 6; ++k) data.push_back(in ? b.point_stress[p][k][e] : 0.0);
         data.push_back(in && !b.point_plastic_strain.empty() ? b.point_plastic_strain[p][e] : 0.0);

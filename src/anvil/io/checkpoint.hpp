@@ -32,8 +32,8 @@ struct Checkpoint {
   static constexpr int particle_values = 18;
   // Per thick-shell element (version 4): stress (6), plastic strain and temperature at
   // each of up to five points through the thickness (zero past the element's points).
-  static constexpr int point_values = 8 * 5;
-  std::string deck; // the deck the run came from (for messages)
+  static constexpr int point_values = 8 * 5; // 5: ThickShell::max_points
+  std::string deck;                          // the deck the run came from (for messages)
   std::string file; // the file it was read from (for messages; empty when captured)
   double time = 0, dt = 0, dt_prev = 0, dt_initial = 0;
   std::int64_t cycle = 0;

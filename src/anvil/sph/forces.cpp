@@ -161,6 +161,20 @@ void with_kernel(KernelType kernel, int dim, Run& run) {
   }
 }
 
+// Calls run.template operator()<A, B>() with two flags of the model as template arguments
+// (the pair loops are instantiated per pair of options, so that neither tests per pair).
+template <class Run>
+void with_flags(bool a, bool b, Run&& run) {
+  if (a && b)
+    run.template operator()<true, true>();
+  else if (a)
+    run.template operator()<true, false>();
+  else if (b)
+    run.template operator()<false, true>();
+  else
+    run.template operator()<false, false>();
+}
+
 // Zeros a particle's lower sums by vector stores (std::fill copied the value by a call to
 // memcpy per particle; a plain loop becomes a memset, which callgrind counts by the byte).
 [[gnu::always_inline]] inline void zero_lower(LowerSums1& s) {
@@ -525,14 +539,8 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
   if (any_epsilon || any_summation) w.wk.resize(w.dwr.size());
   const int dim = sets.empty() ? 3 : sets[0].dimensions;
   auto run = [&]<KernelType K, int D>() {
-    if (any_corrected && any_summation)
-      kinematics_pairs<K, D, true, true>(p, sets, dt, w);
-    else if (any_corrected)
-      kinematics_pairs<K, D, true, false>(p, sets, dt, w);
-    else if (any_summation)
-      kinematics_pairs<K, D, false, true>(p, sets, dt, w);
-    else
-      kinematics_pairs<K, D, false, false>(p, sets, dt, w);
+    with_flags(any_corrected, any_summation,
+               [&]<bool Corr, bool Sum>() { kinematics_pairs<K, D, Corr, Sum>(p, sets, dt, w); });
   };
   with_kernel(kernel, dim, run);
   w.low1_zero = w.nl.row.size() == p.n_all; // one row per particle (neighbours.hpp)
@@ -944,14 +952,8 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
   }
   const int dim = sets.empty() ? 3 : sets[0].dimensions;
   auto run = [&]<KernelType K, int D>() {
-    if (any_corrected && any_epsilon)
-      forces_pairs<K, D, true, true>(p, sets, w, res);
-    else if (any_corrected)
-      forces_pairs<K, D, true, false>(p, sets, w, res);
-    else if (any_epsilon)
-      forces_pairs<K, D, false, true>(p, sets, w, res);
-    else
-      forces_pairs<K, D, false, false>(p, sets, w, res);
+    with_flags(any_corrected, any_epsilon,
+               [&]<bool Corr, bool Eps>() { forces_pairs<K, D, Corr, Eps>(p, sets, w, res); });
   };
   with_kernel(kernel, dim, run);
   w.low2_zero = w.nl.row.size() == p.n_all;
