@@ -45,11 +45,18 @@ void Mesh::translate(const Vec3& d) {
   for (auto& p : nodes) p += d;
 }
 
+namespace {
+
+// Natural coordinates of the hexahedron's corners.
+constexpr int corner_xi[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+                                 {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
+
+} // namespace
+
 double hex_volume(const std::array<Vec3, 8>& x) {
   // det J of the trilinear map is of degree two in each parent coordinate, so the
   // 2x2x2 Gauss rule integrates it exactly.
-  static constexpr double s[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
-                                     {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
+  const auto& s = corner_xi;
   const double g = 1.0 / std::sqrt(3.0);
   double v = 0;
   for (int q = 0; q < 8; ++q) {
@@ -95,10 +102,6 @@ std::vector<std::int64_t> block_nodes(const Mesh& mesh, std::size_t b) {
 }
 
 namespace {
-
-// Natural coordinates of the hexahedron's corners.
-constexpr int corner_xi[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
-                                 {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
 
 // turn[t][k]: the old corner that becomes corner k when the old axis t (0 xi, 1 eta)
 // becomes zeta by a cyclic turn of the axes (t = 0: (xi, eta, zeta) -> (zeta, xi, eta)
