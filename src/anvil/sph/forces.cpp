@@ -638,7 +638,10 @@ namespace {
 // set has an artificial stress. Both are template parameters so that the common loop
 // (neither) keeps no value live for them: the velocity difference dies after the
 // viscosity and dv . g, before the stress groups are loaded (GCC kept it, and spilled).
-template <KernelType K, int D, bool Corr, bool AS>
+// SameVisc: every set has the same viscosity coefficients (a template parameter too: as a
+// run-time test in the loop, GCC kept the partners' indices on the stack for the other
+// branch's gather, four stores per four pairs and a test).
+template <KernelType K, int D, bool Corr, bool AS, bool SameVisc>
 void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspace& w,
                   SphResult& res) {
   using R2 = NeighbourRead2;
@@ -656,9 +659,6 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
   const double* dwr_k = w.dwr.data();
   const double* wk_k = w.wk.data();
   LowerSums2* low2 = w.low2.data();
-  const bool same_visc = uniform(sets, [](const SetParams& st) {
-    return std::array<double, 2>{st.alpha, st.beta};
-  });
   const bool same_as = uniform(sets, [](const SetParams& st) {
     return std::array<double, 3>{st.epsilon, st.w_spacing, st.exponent};
   });
@@ -728,7 +728,7 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
         const vdouble cb = 0.5 * (pb[R2::c] + qv[3]);
         // Pi_ij = (-alpha c mu + beta mu^2) / rho_ij with rho_ij = (rho_i + rho_j) / 2.
         vdouble pv;
-        if (same_visc) {
+        if constexpr (SameVisc) {
           pv = (pb[visc_a] * cb * mu + pb[visc_b] * mu * mu) / (pb[R2::rho] + qr[2]);
         } else {
           vdouble qa[4];
@@ -952,8 +952,12 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
   }
   const int dim = sets.empty() ? 3 : sets[0].dimensions;
   auto run = [&]<KernelType K, int D>() {
-    with_flags(any_corrected, any_epsilon,
-               [&]<bool Corr, bool Eps>() { forces_pairs<K, D, Corr, Eps>(p, sets, w, res); });
+    with_flags(any_corrected, any_epsilon, [&]<bool Corr, bool Eps>() {
+      if (same_visc)
+        forces_pairs<K, D, Corr, Eps, true>(p, sets, w, res);
+      else
+        forces_pairs<K, D, Corr, Eps, false>(p, sets, w, res);
+    });
   };
   with_kernel(kernel, dim, run);
   w.low2_zero = w.nl.row.size() == p.n_all;
