@@ -116,16 +116,14 @@ inline void stream_fence() {
 }
 
 // Gathers four consecutive doubles from `width` records and transposes them:
-// out[a][l] = p[stride * idx[l] + a], a = 0..3 (stride in doubles; each record's four
-// values 32-byte aligned). Moves values, no arithmetic. With AVX: four vector loads and
-// eight shuffles instead of sixteen scalar loads.
-inline void gather4(const double* p, int stride, const int* idx, vdouble (&out)[4]) {
+// out[a][l] = row[l][a], a = 0..3 (each row[l] 32-byte aligned). Moves values, no
+// arithmetic. With AVX: four vector loads and eight shuffles instead of sixteen scalar
+// loads.
+inline void gather4(const double* const* row, vdouble (&out)[4]) {
 #if defined(__AVX__)
   if constexpr (width == 4) {
-    const __m256d r0 = _mm256_load_pd(p + static_cast<std::ptrdiff_t>(stride) * idx[0]);
-    const __m256d r1 = _mm256_load_pd(p + static_cast<std::ptrdiff_t>(stride) * idx[1]);
-    const __m256d r2 = _mm256_load_pd(p + static_cast<std::ptrdiff_t>(stride) * idx[2]);
-    const __m256d r3 = _mm256_load_pd(p + static_cast<std::ptrdiff_t>(stride) * idx[3]);
+    const __m256d r0 = _mm256_load_pd(row[0]), r1 = _mm256_load_pd(row[1]);
+    const __m256d r2 = _mm256_load_pd(row[2]), r3 = _mm256_load_pd(row[3]);
     const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
     const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
     out[0] = vdouble(_mm256_permute2f128_pd(t0, t2, 0x20));
@@ -135,8 +133,13 @@ inline void gather4(const double* p, int stride, const int* idx, vdouble (&out)[
     return;
   }
 #endif
-  for (int a = 0; a < 4; ++a)
-    out[a] = vdouble([&](auto l) { return p[static_cast<std::ptrdiff_t>(stride) * idx[l] + a]; });
+  for (int a = 0; a < 4; ++a) out[a] = vdouble([&](auto l) { return row[l][a]; });
+}
+// The same from the records p + stride idx[l] (stride in doubles).
+inline void gather4(const double* p, int stride, const int* idx, vdouble (&out)[4]) {
+  const double* row[width];
+  for (int l = 0; l < width; ++l) row[l] = p + static_cast<std::ptrdiff_t>(stride) * idx[l];
+  gather4(row, out);
 }
 
 #if defined(__AVX__)

@@ -650,9 +650,9 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
   const NeighbourList& nl = w.nl;
   const R2* rd = w.read2.data();
   const R2r* rdr = w.read2r.data();
-  const double* rdp = rd->a;
   const double* rdrp = rdr->a;
-  constexpr int stride = sizeof(R2) / sizeof(double), stride_r = sizeof(R2r) / sizeof(double);
+  constexpr int stride_r = sizeof(R2r) / sizeof(double);
+  static_assert(sizeof(R2) == 2 * sizeof(LowerSums2));
   // The arrays' addresses in locals: the partners' sums are stored through double
   // pointers, which could otherwise alias the vectors' own pointers (reloaded every time).
   const int* index = nl.index.data();
@@ -699,20 +699,32 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
     const std::int64_t k_begin = nl.start[r], k_end = k_begin + nl.len[r];
     for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
       const int* idx = index + k0;
-      double* q[width]; // the partners' lower sums: f, e at q[l], mu at q[l] + 4
-      for (int l = 0; l < width; ++l) q[l] = low2[static_cast<std::size_t>(idx[l])].f;
+      // The partners' records and lower sums from one byte offset per partner (the record
+      // is twice the lower sums: an address mode's scale instead of a second shift).
+      double* q[width];        // the partners' lower sums: f, e at q[l], mu at q[l] + 4
+      const double* qd[width]; // and their records
+      for (int l = 0; l < width; ++l) {
+        const std::ptrdiff_t o = static_cast<std::ptrdiff_t>(idx[l]) * sizeof(LowerSums2);
+        q[l] = reinterpret_cast<LowerSums2*>(reinterpret_cast<char*>(low2) + o)->f;
+        qd[l] = reinterpret_cast<const R2*>(reinterpret_cast<const char*>(rd) + 2 * o)->a;
+      }
+      auto gather = [&](int offset, vdouble(&out)[4]) {
+        const double* row[width];
+        for (int l = 0; l < width; ++l) row[l] = qd[l] + offset;
+        simd::gather4(row, out);
+      };
       // In stages, so that fewer values are live at once: the gradient from x, h; the
       // viscosity's approach and dv . g from v, c; the viscosity from S4, S5, rho, m;
       // then the stress groups and the pair's T.
       vdouble qx[4], qv[4], qr[4];
-      simd::gather4(rdp + R2::x, stride, idx, qx); // x, h
+      gather(R2::x, qx); // x, h
       vdouble dx[3];
       for (int a = 0; a < 3; ++a) dx[a] = pb[R2::x + a] - qx[a];
       const vdouble hb = 0.5 * (pb[R2::h] + qx[3]);
       const vdouble r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
       const vdouble dwr = simd::load(dwr_k + k0);
       const vdouble g[3] = {dwr * dx[0], dwr * dx[1], dwr * dx[2]};
-      simd::gather4(rdp + R2::v, stride, idx, qv); // v, c
+      gather(R2::v, qv); // v, c
       vdouble dv[3];
       for (int a = 0; a < 3; ++a) dv[a] = pb[R2::v + a] - qv[a];
       const vdouble vr = dv[0] * dx[0] + dv[1] * dx[1] + dv[2] * dx[2];
@@ -720,7 +732,7 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
       vdouble fn = 0.0;
       if constexpr (AS)
         fn = artificial_factor<K, D>(simd::load(wk_k + k0), hb, si, sets, p.set, idx, same_as);
-      simd::gather4(rdp + R2::S45, stride, idx, qr); // S4, S5, rho, m
+      gather(R2::S45, qr); // S4, S5, rho, m
       vdouble visc = 0.0;
       const auto approaching = vr < 0.0;
       if (stdx::any_of(approaching)) {
@@ -749,7 +761,7 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
       const vdouble half_visc = 0.5 * visc * dvg;
       const vdouble irr = pb[inv_rho] * (1.0 / qr[2]);
       vdouble qs[4], qu[4] = {0.0, 0.0, 0.0, 0.0};
-      simd::gather4(rdp + R2::S, stride, idx, qs);                          // S0..S3
+      gather(R2::S, qs);                                                    // S0..S3
       if constexpr (Corr) simd::gather4(rdrp + R2r::S6, stride_r, idx, qu); // S6..S8, has_r
       // T = (P_i + P_j + f^n (R_i + R_j)) / (rho_i rho_j) - Pi I; T[6..8] (yx zy zx)
       // differ from T[3..5] only where a gradient is normalised (Corr).
