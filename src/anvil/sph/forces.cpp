@@ -279,18 +279,26 @@ void kinematics_pairs(const SphView& p, std::span<const SetParams> sets, double 
     // the processor overlaps. In one loop with the sums, the chain from the square root
     // to dwr held back the dozens of products that wait for it (perf, 32^3 cube: a third
     // of the loop's samples on the instructions after the square root and the division).
-    for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
-      vdouble q0[4];
-      simd::gather4(rdp, stride, index + k0, q0); // x, h
-      vdouble dx[3];
-      for (int a = 0; a < 3; ++a) dx[a] = xi[a] - q0[a];
-      const vdouble hb = 0.5 * (pi.h + q0[3]);
-      vdouble wk, dwr;
-      pair_kernel<K, D>(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2], hb, wk, dwr);
-      simd::store(dwr, dwr_k + k0);
-      if (keep_w) simd::store(wk, wk_k + k0);
-      for (int a = 0; a < 3; ++a) simd::store(dwr * dx[a], g_row + 3 * (k0 - k_begin) + a * width);
-    }
+    // (KeepW: W is stored, a template parameter so that the loop tests nothing per pair.)
+    auto kernels = [&]<bool KeepW>() {
+      for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
+        vdouble q0[4];
+        simd::gather4(rdp, stride, index + k0, q0); // x, h
+        vdouble dx[3];
+        for (int a = 0; a < 3; ++a) dx[a] = xi[a] - q0[a];
+        const vdouble hb = 0.5 * (pi.h + q0[3]);
+        vdouble wk, dwr;
+        pair_kernel<K, D>(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2], hb, wk, dwr);
+        simd::store(dwr, dwr_k + k0);
+        if constexpr (KeepW) simd::store(wk, wk_k + k0);
+        for (int a = 0; a < 3; ++a)
+          simd::store(dwr * dx[a], g_row + 3 * (k0 - k_begin) + a * width);
+      }
+    };
+    if (keep_w)
+      kernels.template operator()<true>();
+    else
+      kernels.template operator()<false>();
     for (std::int64_t k0 = k_begin; k0 < k_end; k0 += width) {
       const int* idx = index + k0;
       vdouble q1[4];
