@@ -242,56 +242,44 @@ FaceCorners ContactPhase::corners() const {
 }
 
 // The bound. The lists stay valid while every node and every capture-box side is within
-// h = 0.45 skin of where it was at the build (lists_valid in search.cpp). At the
-// reference (a cycle that computed every box exactly and found the lists valid) each node
-// and side has a deviation e from the build, so it may still move h - e. A box's sides
+// h = 0.45 skin of where it was at the build (lists_valid in search.cpp). A box's sides
 // move by at most m = delta (1 + A (B + 4 delta)) when no corner of the face has moved
-// more than delta since the reference: a corner term moves by delta, the swept corner
-// also by 2 d |n' - n| <= 4 d |N' - N| / |N| (N the cross product of the diagonals D1, D2,
-// n = N / |N|), and the pad by 0.05 |size' - size| <= 0.025 |N' - N| / size; and
-// |N' - N| <= 2 delta (|D1| + |D2|) + 4 delta^2. So A = 4 d / |N| + 0.025 / size and
-// B = 2 (|D1| + |D2|), at the reference. A flat face (|N| = 0) never passes.
+// more than delta since a reference (a cycle that computed its box exactly): a corner term
+// moves by delta, the swept corner also by 2 d |n' - n| <= 4 d |N' - N| / |N| (N the
+// cross product of the diagonals D1, D2, n = N / |N|), and the pad by 0.05 |size' - size|
+// <= 0.025 |N' - N| / size; and |N' - N| <= 2 delta (|D1| + |D2|) + 4 delta^2. So A = 4 d /
+// |N| + 0.025 / size and B = 2 (|D1| + |D2|), at the reference. A flat face (|N| = 0)
+// never passes. On one rank each face has its own reference, and its budget is h less its
+// box's deviation from the build there; the nodes are tested exactly every cycle
+// (lazy_bound_holds()). Set here, on a cycle that computed every box and found the lists
+// valid.
 void ContactPhase::set_lazy_reference() {
-  const std::size_t np = surf_local_.size(), nf = my_face_gid_.size();
+  const std::size_t nf = my_face_gid_.size();
+  const std::size_t nfp = static_cast<std::size_t>(simd::padded_size(static_cast<int>(nf)));
   const SearchWorkspace& w = search_;
   const double h = 0.45 * w.skin;
-  ref_node_budget_.assign(np, std::numeric_limits<double>::infinity());
-  for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
-    const auto p = static_cast<std::size_t>(node_point_[k]);
-    double e = 0;
-    for (int i = 0; i < 3; ++i) e = std::max(e, std::abs(xs_[i][p] - w.node_ref[3 * k + i]));
-    ref_node_budget_[p] = h - e;
-  }
-  ref_face_budget_.resize(nf);
-  for (std::size_t f = 0; f < nf; ++f) {
-    double e = 0;
-    for (int i = 0; i < 3; ++i) {
-      e = std::max(e, std::abs(cap_.lo[i][f] - w.box_ref[i * nf + f]));
-      e = std::max(e, std::abs(cap_.hi[i][f] - w.box_ref[(3 + i) * nf + f]));
-    }
-    ref_face_budget_[f] = h - e;
-  }
-  set_bound_geometry();
+  for (auto& v : sf_x_) v.resize(nfp);
+  sf_a_.assign(nfp, 0.0);
+  sf_b_.assign(nfp, 0.0);
+  sf_due_.assign(nfp, 0.0); // (the padding is looked at once, and never fails)
+  sf_budget_.assign(nfp, std::numeric_limits<double>::infinity());
+  fail_.reserve(nfp);
+  for (std::size_t f = 0; f < nf; ++f) sf_budget_[f] = h - build_deviation(f);
+  for (std::size_t f = 0; f < nfp; ++f) set_bound_reference(f);
   lazy_ = true;
   lazy_builds_ = w.builds;
 }
 
-void ContactPhase::set_bound_geometry() {
-  const std::size_t np = surf_local_.size(), nf = my_face_gid_.size();
-  for (int i = 0; i < 3; ++i) ref_x_[i].assign(xs_[i].begin(), xs_[i].end());
-  ref_a_.resize(nf);
-  ref_b_.resize(nf);
-  // From this cycle's captures (every face's): a loop the compiler vectorises.
-  const double* len = cap_.len.data();
-  const double* diag = cap_.diag.data();
-  const double* depth = depth_pad_.data();
-  double* a = ref_a_.data();
-  double* b = ref_b_.data();
-  for (std::size_t f = 0; f < nf; ++f) {
-    a[f] = bound_a(depth[f], len[f]);
-    b[f] = 2 * diag[f];
+// One rank: the largest deviation of face f's exact box (cap_) from its box at the build.
+double ContactPhase::build_deviation(std::size_t f) const {
+  const std::size_t nf = my_face_gid_.size();
+  const double* r = search_.box_ref.data();
+  double e = 0;
+  for (int i = 0; i < 3; ++i) {
+    e = std::max(e, std::abs(cap_.lo[i][f] - r[static_cast<std::size_t>(i) * nf + f]));
+    e = std::max(e, std::abs(cap_.hi[i][f] - r[static_cast<std::size_t>(3 + i) * nf + f]));
   }
-  point_move_.resize(np);
+  return e;
 }
 
 // Several ranks. A lazy cycle keeps the last full cycle's destinations, plans and received
@@ -412,19 +400,24 @@ void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live
   shared_ = true; // (never with extra nodes anywhere: they change every cycle)
 }
 
-void ContactPhase::set_face_reference(std::size_t f) {
+void ContactPhase::set_bound_reference(std::size_t f) {
   for (int a = 0; a < 4; ++a) {
     const auto p = static_cast<std::size_t>(corner_[a][f]);
     for (int i = 0; i < 3; ++i) sf_x_[3 * a + i][f] = xs_[i][p];
   }
   if (f >= my_face_gid_.size()) return; // padding
+  sf_a_[f] = bound_a(my_face_depth_[f], cap_.len[f]);
+  sf_b_[f] = 2 * cap_.diag[f];
+  sf_due_[f] = drift_ + 0.999999 * largest_delta(f); // delta is 0 at the reference
+}
+
+void ContactPhase::set_face_reference(std::size_t f) {
+  set_bound_reference(f);
+  if (f >= my_face_gid_.size()) return; // padding
   for (int i = 0; i < 3; ++i) {
     sf_box_[i][f] = cap_.lo[i][f];
     sf_box_[3 + i][f] = cap_.hi[i][f];
   }
-  sf_a_[f] = bound_a(my_face_depth_[f], cap_.len[f]);
-  sf_b_[f] = 2 * cap_.diag[f];
-  sf_due_[f] = drift_ + 0.999999 * largest_delta(f); // delta is 0 at the reference
   if (!alive(f)) return;
   // The centre moves no more than the corners, at most 0.45 g while the bound holds: only
   // a face whose centre is nearer its rank's box side can change rank.
@@ -474,6 +467,11 @@ bool ContactPhase::shared_bound_holds() {
                                std::abs(xs_[2][p] - sn_x_[2][k])});
     bad |= static_cast<unsigned>(!(e <= sn_budget_[k]));
   }
+  find_failing_faces();
+  return bad == 0;
+}
+
+void ContactPhase::find_failing_faces() {
   fail_.clear();
   // A face whose corners have moved delta from its reference at some cycle can have moved
   // at most delta + (drift_ now - drift_ then) since: it is looked at again only when that
@@ -492,7 +490,6 @@ bool ContactPhase::shared_bound_holds() {
         sf_due_[g] = drift_ + 0.999999 * (largest_delta(g) - delta);
     }
   }
-  return bad == 0;
 }
 
 bool ContactPhase::rebase_faces() {
@@ -574,35 +571,32 @@ void ContactPhase::update_face_rank(std::size_t f, const double (&c)[3]) {
 }
 
 bool ContactPhase::lazy_bound_holds() {
-  const std::size_t np = surf_local_.size(), nf = my_face_gid_.size();
+  const SearchWorkspace& w = search_;
+  const double h = 0.45 * w.skin;
   unsigned bad = 0; // also when anything is not a number
-  for (std::size_t k = 0; k < np; ++k) {
-    const double dx = xs_[0][k] - ref_x_[0][k], dy = xs_[1][k] - ref_x_[1][k],
-                 dz = xs_[2][k] - ref_x_[2][k];
-    point_move_[k] = std::sqrt(dx * dx + dy * dy + dz * dz);
-    bad |= static_cast<unsigned>(!(point_move_[k] <= ref_node_budget_[k]));
+  // The nodes exactly, as lists_valid() tests them (the node items are node_out_).
+  for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
+    const auto p = static_cast<std::size_t>(node_point_[k]);
+    const double* r = &w.node_ref[3 * k];
+    const double e = std::max(
+        {std::abs(xs_[0][p] - r[0]), std::abs(xs_[1][p] - r[1]), std::abs(xs_[2][p] - r[2])});
+    bad |= static_cast<unsigned>(!(e <= h));
   }
-  // The faces simd::width at a time, then one at a time: the same operations per face.
-  const double* move = point_move_.data();
-  constexpr auto W = static_cast<std::size_t>(simd::width);
-  std::size_t f = 0;
-  for (; f + W <= nf; f += W) {
-    simd::vdouble d = 0.0;
-    for (int a = 0; a < 4; ++a) {
-      const simd::vdouble p = simd::gather(move, corner_[a].data() + f);
-      where(d < p, d) = p;
-    }
-    const simd::vdouble m =
-        side_move(d, simd::load(ref_a_.data() + f), simd::load(ref_b_.data() + f));
-    bad |= static_cast<unsigned>(!all_of(1.001 * m <= simd::load(ref_face_budget_.data() + f)));
+  if (bad != 0) return false;
+  // The faces by their bounds; those whose bound fails get their exact box, tested as
+  // lists_valid() would, and this cycle as their reference.
+  find_failing_faces();
+  if (fail_.empty()) return true;
+  compute_captures(corners(), fail_, cap_);
+  for (int f : fail_)
+    bad |= static_cast<unsigned>(!(build_deviation(static_cast<std::size_t>(f)) <= h));
+  if (bad != 0) return false;
+  for (int fi : fail_) {
+    const auto f = static_cast<std::size_t>(fi);
+    sf_budget_[f] = h - build_deviation(f);
+    set_bound_reference(f);
   }
-  for (; f < nf; ++f) {
-    double d = 0;
-    for (int a = 0; a < 4; ++a) d = std::max(d, move[static_cast<std::size_t>(corner_[a][f])]);
-    const double m = side_move(d, ref_a_[f], ref_b_[f]);
-    bad |= static_cast<unsigned>(!(1.001 * m <= ref_face_budget_[f]));
-  }
-  return bad == 0;
+  return true;
 }
 
 void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers) {

@@ -159,15 +159,11 @@ private:
   // candidate list get their positions, velocities and plane packed (pack_face).
   bool in_place_ = false;
   // One rank, every face alive, no extra nodes: a cycle may skip the capture boxes of the
-  // faces in no candidate list when a bound shows the lists still valid (detect()). The
-  // reference of that bound, set on the last cycle that computed every box:
-  bool lazy_ = false;                   // it is set
-  std::int64_t lazy_builds_ = -1;       // for the lists of this build (search_.builds)
-  std::vector<double> ref_x_[3];        // per point: x* then
-  std::vector<double> ref_node_budget_; // per point: how far its node may still move, m
-  std::vector<double> ref_a_, ref_b_;   // per face: the bound's coefficients (lazy_bound_holds)
-  std::vector<double> ref_face_budget_; // per face: how far its box sides may still move, m
-  std::vector<double> point_move_;      // per point: |x* - ref_x| this cycle, m
+  // faces in no candidate list when the nodes and a bound of the boxes show the lists still
+  // valid (lazy_bound_holds(); the faces' references sf_*, as on several ranks). Set on the
+  // last cycle that computed every box:
+  bool lazy_ = false;             // it is set
+  std::int64_t lazy_builds_ = -1; // for the lists of this build (search_.builds)
   // Several ranks: a bound of the same kind, per item, with budgets from the receivers'
   // candidate lists and from the ghosting, lets a cycle keep the last full cycle's
   // destinations, plans and received layout and send only what the receivers' lists read
@@ -188,7 +184,7 @@ private:
   std::vector<double> sf_a_, sf_b_;          // per face (padded): the bound's coefficients
   // drift_: the sum over cycles of the largest move of any point's x* since the previous
   // cycle, m. sf_due_: per face (padded), the drift_ at which its corners may first have
-  // moved too far for its budget (shared_bound_holds() looks at it again then).
+  // moved too far for its budget (find_failing_faces() looks at it again then).
   double drift_ = 0;
   std::vector<double> sf_due_;
   std::vector<double> sf_budget_, sf_ghost_; // per face (padded): how far its box sides may
@@ -254,9 +250,8 @@ private:
   FaceCorners corners() const;
   // Sets the bound's reference from this cycle's exact boxes and the lists just checked.
   void set_lazy_reference();
-  // The bound's geometric reference (positions, coefficients) from this cycle's points;
-  // the budgets are the caller's.
-  void set_bound_geometry();
+  // One rank: the largest deviation of face f's box (cap_) from the build's.
+  double build_deviation(std::size_t f) const;
   // Several ranks, after a full cycle's search (collective): the receivers' budgets and
   // keep flags back to the senders, the bound's reference, and the subset plans.
   void set_shared_reference(const FaceBoxes& boxes, std::size_t live, bool recomputed);
@@ -270,6 +265,11 @@ private:
   bool rebase_faces();
   // Face f's reference: this cycle's corners and exact box (cap_), and its rank.
   void set_face_reference(std::size_t f);
+  // Its bound's part (corners and coefficients, when it is next looked at), given its
+  // budget.
+  void set_bound_reference(std::size_t f);
+  // fail_: the faces whose bound fails (the others are within their budgets).
+  void find_failing_faces();
   // A lazy cycle's fields of a received face, into face_in_[j] and its box.
   void unpack_motion(const FaceMotion& m, std::size_t j);
   // Face f's element has not eroded.
@@ -279,8 +279,9 @@ private:
   bool compute_destinations(std::size_t live);
   // my_face_rank_ of face f from its centre c (Rcb::owner's answer).
   void update_face_rank(std::size_t f, const double (&c)[3]);
-  // True when the bound shows every node and every capture-box side within 0.45 skin of
-  // where the candidate lists were built, without computing the boxes.
+  // One rank: true when every node and every capture-box side is within 0.45 skin of where
+  // the candidate lists were built, computing the boxes only of the faces whose bound
+  // fails (they get new references).
   bool lazy_bound_holds();
 };
 
