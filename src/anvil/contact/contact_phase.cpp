@@ -13,8 +13,7 @@ namespace {
 // The bound of a face's capture box (derived above set_lazy_reference()):
 // its sides move by at most m = delta (1 + A (B + 4 delta)) when no corner has moved more
 // than delta since the reference, with A and B from the reference geometry (len = |D1 x
-// D2|, diag = |D1| + |D2| of the diagonals, depth the face's contact depth). One rank and
-// several ranks, scalar and vector, use these two.
+// D2|, diag = |D1| + |D2| of the diagonals, depth the face's contact depth).
 inline double bound_a(double depth, double len) {
   return 4 * depth / len + 0.025 / std::sqrt(0.5 * len);
 }
@@ -258,16 +257,26 @@ void ContactPhase::set_lazy_reference() {
   const std::size_t nfp = static_cast<std::size_t>(simd::padded_size(static_cast<int>(nf)));
   const SearchWorkspace& w = search_;
   const double h = 0.45 * w.skin;
-  for (auto& v : sf_x_) v.resize(nfp);
-  sf_a_.assign(nfp, 0.0);
-  sf_b_.assign(nfp, 0.0);
+  sf_ref_.resize(nfp);
   sf_due_.assign(nfp, 0.0); // (the padding is looked at once, and never fails)
   sf_budget_.assign(nfp, std::numeric_limits<double>::infinity());
   fail_.reserve(nfp);
   for (std::size_t f = 0; f < nf; ++f) sf_budget_[f] = h - build_deviation(f);
   for (std::size_t f = 0; f < nfp; ++f) set_bound_reference(f);
+  const std::size_t nn = my_nodes_.size();
+  node_due_.assign(static_cast<std::size_t>(simd::padded_size(static_cast<int>(nn))),
+                   std::numeric_limits<double>::infinity());
+  for (std::size_t k = 0; k < nn; ++k) node_due_[k] = drift_ + 0.999999 * (h - node_deviation(k));
   lazy_ = true;
   lazy_builds_ = w.builds;
+}
+
+// One rank: owned node k's largest coordinate deviation from its position at the build.
+double ContactPhase::node_deviation(std::size_t k) const {
+  const auto p = static_cast<std::size_t>(node_point_[k]);
+  const double* r = &search_.node_ref[3 * k];
+  return std::max(
+      {std::abs(xs_[0][p] - r[0]), std::abs(xs_[1][p] - r[1]), std::abs(xs_[2][p] - r[2])});
 }
 
 // One rank: the largest deviation of face f's exact box (cap_) from its box at the build.
@@ -388,10 +397,8 @@ void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live
   fail_.reserve(nfp);
   near_.reserve(nf);
 
-  for (auto& v : sf_x_) v.resize(nfp);
+  sf_ref_.resize(nfp);
   for (auto& v : sf_box_) v.resize(nf);
-  sf_a_.assign(nfp, 0.0);
-  sf_b_.assign(nfp, 0.0);
   sf_due_.resize(nfp);
   sf_near_.assign(nf, 0);
   near_.clear();
@@ -401,14 +408,21 @@ void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live
 }
 
 void ContactPhase::set_bound_reference(std::size_t f) {
+  FaceRef& r = sf_ref_[f];
   for (int a = 0; a < 4; ++a) {
-    const auto p = static_cast<std::size_t>(corner_[a][f]);
-    for (int i = 0; i < 3; ++i) sf_x_[3 * a + i][f] = xs_[i][p];
+    r.corner[a] = corner_[a][f];
+    for (int i = 0; i < 3; ++i) r.x[a][i] = xs_[i][static_cast<std::size_t>(r.corner[a])];
   }
+  r.a = r.b = r.largest = 0;
   if (f >= my_face_gid_.size()) return; // padding
-  sf_a_[f] = bound_a(my_face_depth_[f], cap_.len[f]);
-  sf_b_[f] = 2 * cap_.diag[f];
-  sf_due_[f] = drift_ + 0.999999 * largest_delta(f); // delta is 0 at the reference
+  r.a = bound_a(my_face_depth_[f], cap_.len[f]);
+  r.b = 2 * cap_.diag[f];
+  // The largest delta for which the first bound holds: the root of 1.001 m(delta) = budget.
+  const double beta = sf_budget_[f] / 1.001, p = 1 + r.a * r.b;
+  r.largest = beta < std::numeric_limits<double>::infinity()
+                  ? 2 * beta / (p + std::sqrt(p * p + 16 * r.a * beta))
+                  : beta;
+  sf_due_[f] = drift_ + 0.999999 * drift_allowed(f, {0, 0, 0}); // no motion at the reference
 }
 
 void ContactPhase::set_face_reference(std::size_t f) {
@@ -433,32 +447,62 @@ void ContactPhase::set_face_reference(std::size_t f) {
   }
 }
 
-// Face f's delta: the largest distance of a corner from where it was at its reference.
-double ContactPhase::corner_delta(std::size_t f) const {
-  double d2 = 0;
+// Face f's motion since its reference: delta, the largest distance of a corner from where
+// it was then; the mean move T of its corners (t: its largest coordinate), and the largest
+// distance r of a corner from where T alone would have taken it. The box of the face moved
+// by T is its box moved by T (the plane, size and warp are those of the reference), so its
+// sides have moved at most t + m(r), and at most m(delta) (m: side_move(), with A and B of
+// the reference geometry). A NaN gives a NaN.
+ContactPhase::FaceMotionBound ContactPhase::face_motion(std::size_t f) const {
+  const FaceRef& ref = sf_ref_[f];
+  double u[4][3], T[3] = {0, 0, 0};
   for (int a = 0; a < 4; ++a) {
-    const auto p = static_cast<std::size_t>(corner_[a][f]);
-    double s = 0;
+    const auto p = static_cast<std::size_t>(ref.corner[a]);
     for (int i = 0; i < 3; ++i) {
-      const double d = xs_[i][p] - sf_x_[3 * a + i][f];
-      s += d * d;
+      u[a][i] = xs_[i][p] - ref.x[a][i];
+      T[i] += 0.25 * u[a][i];
     }
-    if (d2 < s || s != s) d2 = s;
   }
-  return std::sqrt(d2);
+  double t = 0, r2 = 0, d2 = 0;
+  for (int i = 0; i < 3; ++i)
+    if (!(t >= std::abs(T[i]))) t = std::abs(T[i]);
+  for (int a = 0; a < 4; ++a) {
+    double q = 0, e = 0;
+    for (int i = 0; i < 3; ++i) {
+      const double d = u[a][i] - T[i];
+      q += d * d;
+      e += u[a][i] * u[a][i];
+    }
+    if (!(r2 >= q)) r2 = q;
+    if (!(d2 >= e)) d2 = e;
+  }
+  return {std::sqrt(d2), t, std::sqrt(r2)};
 }
 
-// The largest delta for which face f's bound holds: the root of
-// 1.001 delta (1 + A (B + 4 delta)) = budget (infinite for an infinite budget).
-double ContactPhase::largest_delta(std::size_t f) const {
-  const double a = sf_a_[f], b = sf_b_[f], beta = sf_budget_[f] / 1.001;
+// Whether face f's sides are within its budget by either bound, with 0.1% for rounding.
+bool ContactPhase::within_budget(std::size_t f, const FaceMotionBound& m) const {
+  const double a = sf_ref_[f].a, b = sf_ref_[f].b;
+  return 1.001 * std::min(side_move(m.delta, a, b), m.t + side_move(m.r, a, b)) <= sf_budget_[f];
+}
+
+// How much further drift_ may grow before both of face f's bounds could fail, from its
+// motion now: in that time no corner moves more than s, so delta grows at most s, T moves
+// at most s and r grows at most 2 s. The larger of the largest s with
+// 1.001 m(delta + s) <= budget and of the largest s with 1.001 (t + s + m(r + 2 s)) <=
+// budget (with D = r + 2 s the root of 4 A D^2 + (1.5 + A B) D = budget / 1.001 - t + r /
+// 2); infinite for an infinite budget.
+double ContactPhase::drift_allowed(std::size_t f, const FaceMotionBound& m) const {
+  const FaceRef& r = sf_ref_[f];
+  const double a = r.a, b = r.b, beta = sf_budget_[f] / 1.001;
   if (!(beta < std::numeric_limits<double>::infinity())) return beta;
-  const double p = 1 + a * b;
-  return 2 * beta / (p + std::sqrt(p * p + 16 * a * beta));
+  const double s1 = r.largest - m.delta;
+  const double c = beta - m.t + 0.5 * m.r;
+  const double p2 = 1.5 + a * b;
+  const double s2 = 0.5 * (2 * c / (p2 + std::sqrt(p2 * p2 + 16 * a * c)) - m.r);
+  return std::max(s1, s2);
 }
 
-// The face bound of lazy_bound_holds(), per face from its own reference: delta is the
-// largest distance of a corner from where it was then.
+// The nodes against their budgets, and the faces by their bounds (find_failing_faces()).
 bool ContactPhase::shared_bound_holds() {
   unsigned bad = 0; // also when anything is not a number
   for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
@@ -473,21 +517,19 @@ bool ContactPhase::shared_bound_holds() {
 
 void ContactPhase::find_failing_faces() {
   fail_.clear();
-  // A face whose corners have moved delta from its reference at some cycle can have moved
-  // at most delta + (drift_ now - drift_ then) since: it is looked at again only when that
-  // could exceed the largest delta its budget allows (sf_due_), and the others pass.
+  // No corner moves more than the growth of drift_ in the meantime: a face is looked at
+  // again only when its bound could fail (sf_due_, drift_allowed()), and the others pass.
   const std::size_t nfp = sf_budget_.size();
-  const double *A = sf_a_.data(), *B = sf_b_.data(), *budget = sf_budget_.data();
   for (std::size_t f = 0; f < nfp; f += simd::width) {
     if (all_of(simd::load(sf_due_.data() + f) >= drift_)) continue; // (a NaN is looked at)
     for (int l = 0; l < simd::width; ++l) {
       const std::size_t g = f + static_cast<std::size_t>(l);
       if (sf_due_[g] >= drift_) continue;
-      const double delta = corner_delta(g);
-      if (!(1.001 * side_move(delta, A[g], B[g]) <= budget[g]))
+      const FaceMotionBound m = face_motion(g);
+      if (!within_budget(g, m))
         fail_.push_back(static_cast<int>(g));
       else
-        sf_due_[g] = drift_ + 0.999999 * (largest_delta(g) - delta);
+        sf_due_[g] = drift_ + 0.999999 * drift_allowed(g, m);
     }
   }
 }
@@ -574,13 +616,17 @@ bool ContactPhase::lazy_bound_holds() {
   const SearchWorkspace& w = search_;
   const double h = 0.45 * w.skin;
   unsigned bad = 0; // also when anything is not a number
-  // The nodes exactly, as lists_valid() tests them (the node items are node_out_).
-  for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
-    const auto p = static_cast<std::size_t>(node_point_[k]);
-    const double* r = &w.node_ref[3 * k];
-    const double e = std::max(
-        {std::abs(xs_[0][p] - r[0]), std::abs(xs_[1][p] - r[1]), std::abs(xs_[2][p] - r[2])});
-    bad |= static_cast<unsigned>(!(e <= h));
+  // The nodes exactly, as lists_valid() tests them, each when its deviation could have
+  // reached h (node_due_: a node moves no more than the growth of drift_).
+  const std::size_t nn = node_due_.size();
+  for (std::size_t k0 = 0; k0 < nn; k0 += simd::width) {
+    if (all_of(simd::load(node_due_.data() + k0) >= drift_)) continue; // (a NaN is looked at)
+    for (std::size_t k = k0; k < k0 + simd::width; ++k) {
+      if (node_due_[k] >= drift_) continue; // (the padding never is)
+      const double e = node_deviation(k);
+      bad |= static_cast<unsigned>(!(e <= h));
+      node_due_[k] = drift_ + 0.999999 * (h - e);
+    }
   }
   if (bad != 0) return false;
   // The faces by their bounds; those whose bound fails get their exact box, tested as

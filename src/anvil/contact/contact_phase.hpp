@@ -164,6 +164,8 @@ private:
   // last cycle that computed every box:
   bool lazy_ = false;             // it is set
   std::int64_t lazy_builds_ = -1; // for the lists of this build (search_.builds)
+  std::vector<double> node_due_;  // per owned node (padded): the drift_ (below) at which it
+                                  // may first have moved 0.45 skin from the build
   // Several ranks: a bound of the same kind, per item, with budgets from the receivers'
   // candidate lists and from the ghosting, lets a cycle keep the last full cycle's
   // destinations, plans and received layout and send only what the receivers' lists read
@@ -178,10 +180,14 @@ private:
   std::vector<double> sn_x_[3];              // per owned contact node: x* at its reference
   std::vector<double> sn_budget_, sn_ghost_; // per node: how far it may move from there
                                              // (largest coordinate), and for the ghosting
-  std::vector<double> sf_x_[12];             // per face (padded): corner a, coordinate i at
-                                             // its reference ([3 a + i])
-  std::vector<double> sf_box_[6];            // per face: capture box then (lo, then hi)
-  std::vector<double> sf_a_, sf_b_;          // per face (padded): the bound's coefficients
+  struct alignas(64) FaceRef {               // per face (padded), at its reference:
+    double x[4][3];                          // its corners' x*
+    double a, b;                             // the bound's coefficients
+    double largest; // the largest corner move its budget allows (first bound)
+    int corner[4];  // its corners' points (corner_)
+  };
+  std::vector<FaceRef> sf_ref_;   // what a look at a face reads, together
+  std::vector<double> sf_box_[6]; // per face: capture box then (lo, then hi)
   // drift_: the sum over cycles of the largest move of any point's x* since the previous
   // cycle, m. sf_due_: per face (padded), the drift_ at which its corners may first have
   // moved too far for its budget (find_failing_faces() looks at it again then).
@@ -250,16 +256,24 @@ private:
   FaceCorners corners() const;
   // Sets the bound's reference from this cycle's exact boxes and the lists just checked.
   void set_lazy_reference();
-  // One rank: the largest deviation of face f's box (cap_) from the build's.
+  // One rank: the largest deviation of face f's box (cap_) from the build's, and of owned
+  // node k's position.
   double build_deviation(std::size_t f) const;
+  double node_deviation(std::size_t k) const;
   // Several ranks, after a full cycle's search (collective): the receivers' budgets and
   // keep flags back to the senders, the bound's reference, and the subset plans.
   void set_shared_reference(const FaceBoxes& boxes, std::size_t live, bool recomputed);
   // Several ranks: true when every node is within its budget; fail_ gets the faces whose
   // bound fails.
   bool shared_bound_holds();
-  double corner_delta(std::size_t f) const;  // largest move of f's corners since its reference
-  double largest_delta(std::size_t f) const; // the largest that f's budget allows
+  struct FaceMotionBound {
+    double delta; // largest move of a corner, m
+    double t, r;  // largest coordinate of the corners' mean move; largest move about it, m
+  };
+  FaceMotionBound face_motion(std::size_t f) const; // f's since its reference
+  bool within_budget(std::size_t f, const FaceMotionBound& m) const;
+  // How much drift_ may grow before f's bound could fail, from its motion m now.
+  double drift_allowed(std::size_t f, const FaceMotionBound& m) const;
   // The faces of fail_ checked exactly: true when each is within its budget; each then
   // gets this cycle as its reference, its budgets less what it used.
   bool rebase_faces();
