@@ -122,6 +122,7 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
   depth_pad_.assign(padded, 0.0);
   std::copy(my_face_depth_.begin(), my_face_depth_.end(), depth_pad_.begin());
   cap_.resize(nf_all);
+  packed_.assign(nf_all, -1);
   last_face_.assign(fe.node_gid.size(), -1);
   allowance_.assign(fe.node_gid.size(), 0.0);
   gathered_.assign(4 * static_cast<std::size_t>(comm.size()), 0.0);
@@ -223,9 +224,12 @@ void ContactPhase::unpack_motion(const FaceMotion& m, std::size_t j) {
     it.hi[i] = m.hi[i];
     recv_box_[i][j] = m.lo[i];
     recv_box_[3 + i][j] = m.hi[i];
+    recv_box_[6 + i][j] = m.normal[i];
   }
   it.offset = m.offset;
   it.warp = m.warp;
+  recv_box_[9][j] = m.offset;
+  recv_box_[10][j] = m.warp;
 }
 
 bool ContactPhase::alive(std::size_t f) const {
@@ -818,9 +822,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       std::vector<ContactNodeItem>& held = node_plan_.stays() ? node_out_ : node_in_;
       for (std::size_t j = 0; j < node_sub_in_.size(); ++j)
         held[node_sub_.base_position(j)] = node_sub_in_[j];
-      if (in_place_) {
-        for (int f : sub_faces_) pack_face(static_cast<std::size_t>(f), nd);
-      } else {
+      if (!in_place_) { // (in place: the items the search reads are packed below)
         face_sub_.forward_packed(face_sub_in_, [&](std::size_t k, FaceMotion& m) {
           pack_cycle(static_cast<std::size_t>(face_src_[k]), nd, m);
         });
@@ -868,11 +870,19 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
   opt.dt = dt;
   FaceBoxes boxes;
   if (in_place_) {
-    // The boxes straight from cap_; the items of the faces in some candidate list only.
+    // The boxes and planes straight from cap_ (of the faces in some candidate list only on
+    // a lazy cycle).
+    auto part = [nf](const std::vector<double>& v) {
+      return std::span<const double>(v.data(), nf);
+    };
     for (int i = 0; i < 3; ++i) {
-      boxes.lo[i] = std::span<const double>(cap_.lo[i].data(), nf);
-      boxes.hi[i] = std::span<const double>(cap_.hi[i].data(), nf);
+      boxes.lo[i] = part(cap_.lo[i]);
+      boxes.hi[i] = part(cap_.hi[i]);
+      boxes.normal[i] = part(cap_.normal[i]);
     }
+    boxes.offset = part(cap_.offset);
+    boxes.warp = part(cap_.warp);
+    boxes.depth = part(depth_pad_);
     if (!lazy_cycle && !lazy) {
       ScopedPhase t(timers, Phase::contact_search);
       update_candidate_lists(*search_nodes_, face_local_, boxes, opt, search_);
@@ -880,31 +890,54 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     if (!lazy) {
       ScopedPhase t(timers, Phase::transfer);
       if (lazy_cycle) compute_captures(corners(), search_.needed, cap_);
-      for (int f : search_.needed) pack_face(static_cast<std::size_t>(f), nd);
       if (!lazy_cycle && alone && extra_.empty() && search_.built) set_lazy_reference();
     }
+    // The cheap tests read the arrays; only the items of the faces queued for the detailed
+    // check (and so of the pairs) get this cycle's corners, velocities and plane.
+    {
+      ScopedPhase t(timers, Phase::contact_search);
+      queue_candidates(*search_nodes_, boxes, search_);
+    }
+    {
+      ScopedPhase t(timers, Phase::transfer);
+      for (int f : search_.query_face)
+        if (packed_[static_cast<std::size_t>(f)] != stats_.cycles) {
+          packed_[static_cast<std::size_t>(f)] = stats_.cycles;
+          pack_face(static_cast<std::size_t>(f), nd);
+        }
+    }
+    ScopedPhase t(timers, Phase::contact_search);
+    check_queued(*search_nodes_, face_local_, opt, search_, pairs_);
   } else {
     lazy_ = false;
-    // The boxes of the received items, as find_contacts() reads them (a lazy cycle has
-    // updated those of the items the lists read).
+    // The boxes and planes of the received items, as find_contacts() reads them (a lazy
+    // cycle has updated those of the items the lists read; the depths do not change).
     const std::size_t nr = face_in_.size();
-    for (int s = 0; s < 6; ++s) recv_box_[s].resize(nr);
+    for (auto& v : recv_box_) v.resize(nr);
     if (!lazy)
-      for (std::size_t j = 0; j < nr; ++j)
+      for (std::size_t j = 0; j < nr; ++j) {
+        const ContactFaceItem& it = face_in_[j];
         for (int i = 0; i < 3; ++i) {
-          recv_box_[i][j] = face_in_[j].lo[i];
-          recv_box_[3 + i][j] = face_in_[j].hi[i];
+          recv_box_[i][j] = it.lo[i];
+          recv_box_[3 + i][j] = it.hi[i];
+          recv_box_[6 + i][j] = it.normal[i];
         }
+        recv_box_[9][j] = it.offset;
+        recv_box_[10][j] = it.warp;
+        recv_box_[11][j] = it.depth;
+      }
     for (int i = 0; i < 3; ++i) {
       boxes.lo[i] = recv_box_[i];
       boxes.hi[i] = recv_box_[3 + i];
+      boxes.normal[i] = recv_box_[6 + i];
     }
+    boxes.offset = recv_box_[9];
+    boxes.warp = recv_box_[10];
+    boxes.depth = recv_box_[11];
     if (!lazy) {
       ScopedPhase t(timers, Phase::contact_search);
       update_candidate_lists(*search_nodes_, face_in_, boxes, opt, search_);
     }
-  }
-  {
     ScopedPhase t(timers, Phase::contact_search);
     find_pairs(*search_nodes_, *search_faces_, boxes, opt, search_, pairs_);
   }

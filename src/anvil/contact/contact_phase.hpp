@@ -155,9 +155,11 @@ private:
   std::vector<double> depth_pad_; // per face, padded: its depth
   FaceCaptures cap_;              // per face: mean plane and capture box of this cycle
   // True when every node and face stays on this rank (one copy each): the search then
-  // reads the boxes from cap_ and the items in place, and only the faces in some
-  // candidate list get their positions, velocities and plane packed (pack_face).
+  // reads the boxes and planes from cap_ and the items in place, and only the faces it
+  // queues for the detailed check get their positions, velocities and plane packed
+  // (pack_face).
   bool in_place_ = false;
+  std::vector<std::int64_t> packed_; // per face: the cycle (stats_.cycles) it was packed
   // One rank, every face alive, no extra nodes: a cycle may skip the capture boxes of the
   // faces in no candidate list when the nodes and a bound of the boxes show the lists still
   // valid (lazy_bound_holds(); the faces' references sf_*, as on several ranks). Set on the
@@ -214,7 +216,8 @@ private:
   Migration node_sub_, face_sub_; // the kept part of node_plan_, face_plan_
   std::vector<ContactNodeItem> node_sub_in_;
   std::vector<FaceMotion> face_sub_in_;
-  std::vector<double> recv_box_[6]; // capture boxes of face_in_ (lo x, y, z, hi x, y, z)
+  // FaceBoxes of face_in_: lo x, y, z, hi x, y, z, normal x, y, z, offset, warp, depth.
+  std::vector<double> recv_box_[12];
 
   Rcb rcb_;
   std::vector<Box3> rank_box_; // rcb_.box(r) of every rank, since the last partition

@@ -242,8 +242,7 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
 // half the candidates pass the box test, in no pattern a predictor could learn): every
 // entry is written, and the count advances by the test's result.
 template <bool Side>
-int filter_entries(const int* list, int b, int e, const FaceBoxes& boxes,
-                   const ContactFaceItem* faces, const Vec3& p, int* out) {
+int filter_entries(const int* list, int b, int e, const FaceBoxes& boxes, const Vec3& p, int* out) {
   const double *l0 = boxes.lo[0].data(), *l1 = boxes.lo[1].data(), *l2 = boxes.lo[2].data();
   const double *h0 = boxes.hi[0].data(), *h1 = boxes.hi[1].data(), *h2 = boxes.hi[2].data();
   using u = unsigned;
@@ -258,13 +257,17 @@ int filter_entries(const int* list, int b, int e, const FaceBoxes& boxes,
   }
   if constexpr (Side) {
     // Of those, in place: side = dot(p, normal) - offset within [-(2 depth + warp), warp].
+    const double *n0 = boxes.normal[0].data(), *n1 = boxes.normal[1].data(),
+                 *n2 = boxes.normal[2].data();
+    const double *offset = boxes.offset.data(), *warp = boxes.warp.data(),
+                 *depth = boxes.depth.data();
     int m = 0;
     for (int i = 0; i < n; ++i) {
       const int f = out[i];
-      const auto& fc = faces[static_cast<std::size_t>(f)];
-      const double side = dot(p, Vec3{fc.normal[0], fc.normal[1], fc.normal[2]}) - fc.offset;
+      const auto k = static_cast<std::size_t>(f);
+      const double side = dot(p, Vec3{n0[k], n1[k], n2[k]}) - offset[k];
       out[m] = f;
-      m += static_cast<int>((u(side > fc.warp) | u(side < -(2 * fc.depth + fc.warp))) ^ 1u);
+      m += static_cast<int>((u(side > warp[k]) | u(side < -(2 * depth[k] + warp[k]))) ^ 1u);
     }
     n = m;
   }
@@ -291,16 +294,25 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
                    const std::vector<ContactFaceItem>& faces, const SearchOptions& opt,
                    SearchWorkspace& w, std::vector<ContactPair>& pairs) {
   FaceBoxes boxes;
-  for (int i = 0; i < 6; ++i) w.box[i].resize(faces.size());
-  for (std::size_t f = 0; f < faces.size(); ++f)
+  for (auto& b : w.box) b.resize(faces.size());
+  for (std::size_t f = 0; f < faces.size(); ++f) {
     for (int i = 0; i < 3; ++i) {
       w.box[i][f] = faces[f].lo[i];
       w.box[3 + i][f] = faces[f].hi[i];
+      w.box[6 + i][f] = faces[f].normal[i];
     }
+    w.box[9][f] = faces[f].offset;
+    w.box[10][f] = faces[f].warp;
+    w.box[11][f] = faces[f].depth;
+  }
   for (int i = 0; i < 3; ++i) {
     boxes.lo[i] = w.box[i];
     boxes.hi[i] = w.box[3 + i];
+    boxes.normal[i] = w.box[6 + i];
   }
+  boxes.offset = w.box[9];
+  boxes.warp = w.box[10];
+  boxes.depth = w.box[11];
   update_candidate_lists(nodes, faces, boxes, opt, w);
   find_pairs(nodes, faces, boxes, opt, w, pairs);
 }
@@ -308,16 +320,28 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
 void find_pairs(const std::vector<ContactNodeItem>& nodes,
                 const std::vector<ContactFaceItem>& faces, const FaceBoxes& boxes,
                 const SearchOptions& opt, SearchWorkspace& w, std::vector<ContactPair>& pairs) {
-  pairs.clear();
-  if (nodes.empty() || faces.empty()) return;
+  if (faces.empty()) {
+    pairs.clear();
+    return;
+  }
+  queue_candidates(nodes, boxes, w);
+  check_queued(nodes, faces, opt, w, pairs);
+}
 
-  const double tol = 1 + opt.parametric_tolerance;
+void queue_candidates(const std::vector<ContactNodeItem>& nodes, const FaceBoxes& boxes,
+                      SearchWorkspace& w) {
+  w.query_face.clear();
+  w.query_start.assign(w.active.size() + 1, 0);
+  if (nodes.empty() || boxes.lo[0].empty()) return;
+
   // Room for the filtered entries of the longest range.
   const auto room = static_cast<std::size_t>(w.longest);
   if (w.cand.size() < room) w.cand.resize(room);
   if (w.own.size() < room) w.own.resize(room);
   int* const cand = w.cand.data();
   int* const own = w.own.data();
+  const double *n0 = boxes.normal[0].data(), *n1 = boxes.normal[1].data(),
+               *n2 = boxes.normal[2].data();
   // The surfaces face each other when at least one of the node's own faces opposes the
   // candidate (normals at more than about 107 degrees). At a convex edge a node just
   // outside is "behind" the side face, but none of its faces opposes that face; in a
@@ -326,41 +350,53 @@ void find_pairs(const std::vector<ContactNodeItem>& nodes,
   auto faces_oppose = [&](int nown, const Vec3& fn) {
     if (nown == 0) return true;
     for (int i = 0; i < nown; ++i) {
-      const double* q = faces[static_cast<std::size_t>(own[i])].normal;
-      if (q[0] * fn.x + q[1] * fn.y + q[2] * fn.z < -0.3) return true;
+      const auto q = static_cast<std::size_t>(own[i]);
+      if (n0[q] * fn.x + n1[q] * fn.y + n2[q] * fn.z < -0.3) return true;
     }
     return false;
   };
-  // Pass 1, node by node: the candidates whose capture box holds the node and behind
-  // whose mean plane it lies, not deeper than a tracked pair may go; then, if there are
-  // any, the node's own faces whose box holds it; of the candidates, those that face the
-  // node's surface are queued for the detailed check. (A node just outside a convex edge
-  // can be "behind" the side face there while it is in front of the top face.)
-  w.query_start.assign(w.active.size() + 1, 0);
-  w.query_face.clear();
-  w.queries.clear();
+  // Node by node: the candidates whose capture box holds the node and behind whose mean
+  // plane it lies, not deeper than a tracked pair may go; then, if there are any, the
+  // node's own faces whose box holds it; of the candidates, those that face the node's
+  // surface are queued for the detailed check. (A node just outside a convex edge can be
+  // "behind" the side face there while it is in front of the top face.)
   for (std::size_t k = 0; k < w.active.size(); ++k) {
-    w.query_start[k] = static_cast<int>(w.queries.size());
-    const auto n = static_cast<std::size_t>(w.active[k]);
-    const auto& nd = nodes[n];
+    w.query_start[k] = static_cast<int>(w.query_face.size());
+    const auto& nd = nodes[static_cast<std::size_t>(w.active[k])];
     const Vec3 p{nd.x[0], nd.x[1], nd.x[2]};
-    const int ncand = filter_entries<true>(w.list.data(), w.list_start[k], w.own_start[k], boxes,
-                                           faces.data(), p, cand);
+    const int ncand =
+        filter_entries<true>(w.list.data(), w.list_start[k], w.own_start[k], boxes, p, cand);
     if (ncand == 0) continue;
-    const int nown = filter_entries<false>(w.list.data(), w.own_start[k], w.list_start[k + 1],
-                                           boxes, faces.data(), p, own);
+    const int nown =
+        filter_entries<false>(w.list.data(), w.own_start[k], w.list_start[k + 1], boxes, p, own);
     for (int i = 0; i < ncand; ++i) {
       const int f = cand[i];
-      const auto& fc = faces[static_cast<std::size_t>(f)];
-      if (!faces_oppose(nown, Vec3{fc.normal[0], fc.normal[1], fc.normal[2]})) continue;
+      const auto q = static_cast<std::size_t>(f);
+      if (faces_oppose(nown, Vec3{n0[q], n1[q], n2[q]})) w.query_face.push_back(f);
+    }
+  }
+  w.query_start[w.active.size()] = static_cast<int>(w.query_face.size());
+}
+
+void check_queued(const std::vector<ContactNodeItem>& nodes,
+                  const std::vector<ContactFaceItem>& faces, const SearchOptions& opt,
+                  SearchWorkspace& w, std::vector<ContactPair>& pairs) {
+  pairs.clear();
+  if (w.query_face.empty()) return;
+  const double tol = 1 + opt.parametric_tolerance;
+  // Pass 1: the queries, node by node.
+  w.queries.clear();
+  for (std::size_t k = 0; k < w.active.size(); ++k) {
+    const auto& nd = nodes[static_cast<std::size_t>(w.active[k])];
+    const Vec3 p{nd.x[0], nd.x[1], nd.x[2]};
+    for (int j = w.query_start[k]; j < w.query_start[k + 1]; ++j) {
+      const auto& fc = faces[static_cast<std::size_t>(w.query_face[static_cast<std::size_t>(j)])];
       w.queries.push_back(
           {{Vec3{fc.x[0][0], fc.x[0][1], fc.x[0][2]}, Vec3{fc.x[1][0], fc.x[1][1], fc.x[1][2]},
             Vec3{fc.x[2][0], fc.x[2][1], fc.x[2][2]}, Vec3{fc.x[3][0], fc.x[3][1], fc.x[3][2]}},
            p});
-      w.query_face.push_back(f);
     }
   }
-  w.query_start[w.active.size()] = static_cast<int>(w.queries.size());
   // Pass 2: the feet of the normals, `simd::width` at a time.
   w.feet.resize(w.queries.size());
   project_on_quads(w.queries, w.feet);

@@ -94,10 +94,12 @@ struct SearchOptions {
   double skin = 0.1;
 };
 
-// The capture boxes of the faces (structure of arrays, one entry per face of the face
-// list): what the search tests every cycle. The items' own lo/hi are not read.
+// The capture boxes, mean planes and depths of the faces (structure of arrays, one entry
+// per face of the face list): what the search tests every cycle. The items' own lo, hi,
+// normal, offset, warp and depth are not read.
 struct FaceBoxes {
   std::span<const double> lo[3], hi[3];
+  std::span<const double> normal[3], offset, warp, depth;
 };
 
 // Scratch space and candidate lists kept between cycles (no allocation in steady state).
@@ -134,7 +136,7 @@ struct SearchWorkspace {
   int longest = 0;                    // the longest range of candidates or own faces
   std::vector<int> needed;            // the faces in some list, ascending (each once)
   std::vector<char> mark;             // per face: in some list (scratch of the build)
-  std::vector<double> box[6];         // find_contacts(): the items' boxes as FaceBoxes
+  std::vector<double> box[12];        // find_contacts(): the items' FaceBoxes
   std::int64_t builds = 0;            // lists built since the workspace was made
 };
 
@@ -155,10 +157,21 @@ void find_contacts(const std::vector<ContactNodeItem>& nodes,
 bool update_candidate_lists(const std::vector<ContactNodeItem>& nodes,
                             const std::vector<ContactFaceItem>& faces, const FaceBoxes& boxes,
                             const SearchOptions& options, SearchWorkspace& work);
-// Second: the exact capture-box test of the listed candidates and the detailed check.
+// Second: the exact capture-box test of the listed candidates and the detailed check:
+// queue_candidates() then check_queued().
 void find_pairs(const std::vector<ContactNodeItem>& nodes,
                 const std::vector<ContactFaceItem>& faces, const FaceBoxes& boxes,
                 const SearchOptions& options, SearchWorkspace& work,
                 std::vector<ContactPair>& pairs);
+// The two halves of find_pairs(). First, from the boxes and planes alone (no face item is
+// read): the candidates that pass the cheap tests (box, mean-plane side, facing surfaces),
+// per active node, into work.query_start and work.query_face. Then the detailed check of
+// those, which reads the items of the faces in work.query_face only (ids, depths,
+// positions and velocities): the caller may fill just those in between.
+void queue_candidates(const std::vector<ContactNodeItem>& nodes, const FaceBoxes& boxes,
+                      SearchWorkspace& work);
+void check_queued(const std::vector<ContactNodeItem>& nodes,
+                  const std::vector<ContactFaceItem>& faces, const SearchOptions& options,
+                  SearchWorkspace& work, std::vector<ContactPair>& pairs);
 
 } // namespace anvil
