@@ -41,9 +41,10 @@ void FaceCaptures::resize(std::size_t n) {
 
 namespace {
 constexpr int kFields = 16; // arrays of FaceCaptures
+constexpr int kSearch = 11; // of which the search reads the first (up to warp)
 
 // One vector of faces: lane l is the face whose corners are points c[a][l] and whose
-// depth is depth[l]. r: normal (3), lo (3), hi (3), centre (3), offset, warp, len, diag.
+// depth is depth[l]. r: normal (3), lo (3), hi (3), offset, warp, centre (3), len, diag.
 [[gnu::always_inline]] inline void capture_lanes(const FaceCorners& in, const int* const c4[4],
                                                  const vdouble& depth, vdouble (&r)[kFields]) {
   vdouble x[4][3];
@@ -85,10 +86,10 @@ constexpr int kFields = 16; // arrays of FaceCaptures
     r[i] = nu[i];
     r[3 + i] = lo - pad;
     r[6 + i] = hi + pad;
-    r[9 + i] = c[i];
+    r[11 + i] = c[i];
   }
-  r[12] = c[0] * nu[0] + c[1] * nu[1] + c[2] * nu[2];
-  r[13] = warp;
+  r[9] = c[0] * nu[0] + c[1] * nu[1] + c[2] * nu[2];
+  r[10] = warp;
   r[14] = len;
   r[15] = sqrt(d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2]) +
           sqrt(d2[0] * d2[0] + d2[1] * d2[1] + d2[2] * d2[2]);
@@ -98,8 +99,8 @@ double* field(FaceCaptures& out, int k) {
   if (k < 3) return out.normal[k].data();
   if (k < 6) return out.lo[k - 3].data();
   if (k < 9) return out.hi[k - 6].data();
-  if (k < 12) return out.centre[k - 9].data();
-  if (k < 14) return k == 12 ? out.offset.data() : out.warp.data();
+  if (k < 11) return k == 9 ? out.offset.data() : out.warp.data();
+  if (k < 14) return out.centre[k - 11].data();
   return k == 14 ? out.len.data() : out.diag.data();
 }
 } // namespace
@@ -117,8 +118,10 @@ void compute_captures(const FaceCorners& in, FaceCaptures& out) {
   }
 }
 
-void compute_captures(const FaceCorners& in, std::span<const int> which, FaceCaptures& out) {
+void compute_captures(const FaceCorners& in, std::span<const int> which, FaceCaptures& out,
+                      bool search_only) {
   out.resize(in.n);
+  const int fields = search_only ? kSearch : kFields;
   double* dst[kFields];
   for (int k = 0; k < kFields; ++k) dst[k] = field(out, k);
   for (std::size_t j = 0; j < which.size(); j += simd::width) {
@@ -133,7 +136,7 @@ void compute_captures(const FaceCorners& in, std::span<const int> which, FaceCap
     const int* c4[4] = {c[0], c[1], c[2], c[3]};
     vdouble r[kFields];
     capture_lanes(in, c4, simd::load(dep), r);
-    for (int k = 0; k < kFields; ++k)
+    for (int k = 0; k < fields; ++k)
       for (int l = 0; l < simd::width; ++l) dst[k][face[l]] = r[k][l];
   }
 }

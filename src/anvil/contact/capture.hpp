@@ -34,7 +34,9 @@ struct FaceCorners {
 };
 void compute_captures(const FaceCorners& faces, FaceCaptures& out);
 // The same for the faces listed in `which` only (any order, each once); the other
-// entries of out keep their values.
-void compute_captures(const FaceCorners& faces, std::span<const int> which, FaceCaptures& out);
+// entries of out keep their values. With search_only, only what the search reads (normal,
+// offset, warp, lo, hi) is written: centre, len and diag keep theirs too.
+void compute_captures(const FaceCorners& faces, std::span<const int> which, FaceCaptures& out,
+                      bool search_only = false);
 
 } // namespace anvil

@@ -816,7 +816,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     }
     if (lazy) {
       // Only the items some receiver's lists read, and of a face only what changes.
-      compute_captures(corners(), sub_faces_, cap_);
+      compute_captures(corners(), sub_faces_, cap_, true);
       node_sub_.forward_packed(node_sub_in_,
                                [&](std::size_t k, ContactNodeItem& it) { pack_node(k, nd, it); });
       std::vector<ContactNodeItem>& held = node_plan_.stays() ? node_out_ : node_in_;
@@ -889,7 +889,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     }
     if (!lazy) {
       ScopedPhase t(timers, Phase::transfer);
-      if (lazy_cycle) compute_captures(corners(), search_.needed, cap_);
+      if (lazy_cycle) compute_captures(corners(), search_.needed, cap_, true);
       if (!lazy_cycle && alone && extra_.empty() && search_.built) set_lazy_reference();
     }
     // The cheap tests read the arrays; only the items of the faces queued for the detailed
