@@ -210,6 +210,16 @@ void ContactPhase::pack_cycle(std::size_t f, const ContactNodes& nd, Item& it) c
 }
 
 void ContactPhase::unpack_motion(const FaceMotion& m, std::size_t j) {
+  for (int i = 0; i < 3; ++i) {
+    recv_box_[i][j] = m.lo[i];
+    recv_box_[3 + i][j] = m.hi[i];
+    recv_box_[6 + i][j] = m.normal[i];
+  }
+  recv_box_[9][j] = m.offset;
+  recv_box_[10][j] = m.warp;
+}
+
+void ContactPhase::complete_item(const FaceMotion& m, std::size_t j) {
   ContactFaceItem& it = face_in_[j];
   for (int a = 0; a < 4; ++a) {
     for (int i = 0; i < 3; ++i) {
@@ -222,14 +232,9 @@ void ContactPhase::unpack_motion(const FaceMotion& m, std::size_t j) {
     it.normal[i] = m.normal[i];
     it.lo[i] = m.lo[i];
     it.hi[i] = m.hi[i];
-    recv_box_[i][j] = m.lo[i];
-    recv_box_[3 + i][j] = m.hi[i];
-    recv_box_[6 + i][j] = m.normal[i];
   }
   it.offset = m.offset;
   it.warp = m.warp;
-  recv_box_[9][j] = m.offset;
-  recv_box_[10][j] = m.warp;
 }
 
 bool ContactPhase::alive(std::size_t f) const {
@@ -398,6 +403,8 @@ void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live
   face_sub_.reserve(face_plan_.send_count() * sizeof(FaceMotion));
   node_sub_in_.reserve(node_plan_.recv_count());
   face_sub_in_.reserve(face_plan_.recv_count());
+  motion_.resize(face_plan_.recv_count());
+  unpacked_.assign(face_plan_.recv_count(), -1);
   fail_.reserve(nfp);
   near_.reserve(nf);
 
@@ -826,8 +833,11 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
         face_sub_.forward_packed(face_sub_in_, [&](std::size_t k, FaceMotion& m) {
           pack_cycle(static_cast<std::size_t>(face_src_[k]), nd, m);
         });
-        for (std::size_t j = 0; j < face_sub_in_.size(); ++j)
-          unpack_motion(face_sub_in_[j], face_sub_.base_position(j));
+        for (std::size_t j = 0; j < face_sub_in_.size(); ++j) {
+          const std::size_t b = face_sub_.base_position(j);
+          unpack_motion(face_sub_in_[j], b);
+          motion_[b] = static_cast<int>(j);
+        }
       }
       stats_.bytes_sent +=
           static_cast<double>(node_sub_.sent_elsewhere() * sizeof(ContactNodeItem) +
@@ -938,8 +948,24 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       ScopedPhase t(timers, Phase::contact_search);
       update_candidate_lists(*search_nodes_, face_in_, boxes, opt, search_);
     }
+    {
+      ScopedPhase t(timers, Phase::contact_search);
+      queue_candidates(*search_nodes_, boxes, search_);
+    }
+    if (lazy) {
+      // The received motions of the faces queued for the detailed check into their items
+      // (the others' items are not read this cycle).
+      ScopedPhase t(timers, Phase::transfer);
+      for (int f : search_.query_face) {
+        const auto j = static_cast<std::size_t>(f);
+        if (unpacked_[j] != stats_.cycles) {
+          unpacked_[j] = stats_.cycles;
+          complete_item(face_sub_in_[static_cast<std::size_t>(motion_[j])], j);
+        }
+      }
+    }
     ScopedPhase t(timers, Phase::contact_search);
-    find_pairs(*search_nodes_, *search_faces_, boxes, opt, search_, pairs_);
+    check_queued(*search_nodes_, *search_faces_, opt, search_, pairs_);
   }
   if (!alone && !lazy && !extra_somewhere) {
     ScopedPhase t(timers, Phase::transfer);

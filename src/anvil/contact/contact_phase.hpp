@@ -216,6 +216,8 @@ private:
   Migration node_sub_, face_sub_; // the kept part of node_plan_, face_plan_
   std::vector<ContactNodeItem> node_sub_in_;
   std::vector<FaceMotion> face_sub_in_;
+  std::vector<int> motion_;            // per received face: its index in face_sub_in_
+  std::vector<std::int64_t> unpacked_; // per received face: the cycle its item was completed
   // FaceBoxes of face_in_: lo x, y, z, hi x, y, z, normal x, y, z, offset, warp, depth.
   std::vector<double> recv_box_[12];
 
@@ -287,8 +289,10 @@ private:
   void set_bound_reference(std::size_t f);
   // fail_: the faces whose bound fails (the others are within their budgets).
   void find_failing_faces();
-  // A lazy cycle's fields of a received face, into face_in_[j] and its box.
+  // A lazy cycle's fields of a received face: the box and plane (recv_box_), and the
+  // rest of them into its item face_in_[j] (only for the faces the search checks).
   void unpack_motion(const FaceMotion& m, std::size_t j);
+  void complete_item(const FaceMotion& m, std::size_t j);
   // Face f's element has not eroded.
   bool alive(std::size_t f) const;
   // Several ranks: node and face destinations (faces by their enlarged capture box); true
