@@ -53,11 +53,12 @@ enum Slot : int {
 // memory operands, instead of keeping everything live (x, v and B alone are 72 vectors
 // against 16 registers).
 enum Tmp : int {
-  t_edge0 = 0,         // 36 edge sums (3 edge + i)
-  t_b0 = t_edge0 + 36, // 24 gradient entries 12 B_ia (3 a + i), stage C
-  t_xm0 = t_b0 + 24,   // 8 mid-step x coordinates, stage A
-  t_rows0 = t_xm0 + 8, // corner forces as in the corner slots, 8 per lane, component i
-                       // at (t_rows0 + 8 i) width: nodal assembly without the slots
+  t_edge0 = 0,          // 36 edge sums (3 edge + i)
+  t_b0 = t_edge0 + 36,  // 24 gradient entries 12 B_ia (3 a + i), stage C
+  t_xm0 = t_b0 + 24,    // mid-step coordinates (8 i + a: x for all forms, y and z for the
+                        // thick shell), stage A
+  t_rows0 = t_xm0 + 24, // corner forces as in the corner slots, 8 per lane, component i
+                        // at (t_rows0 + 8 i) width: nodal assembly without the slots
   t_count = t_rows0 + 24
 };
 
@@ -111,8 +112,8 @@ void pack_nodes(const NodalView& n, int lo, int hi, double* __restrict p) {
 // Stage A1: loads the corner positions and velocities of elements e..e+width-1 from the
 // packed nodes, keeps them in the chunk scratch (xs, vs: lane offset included) for stage
 // C, and writes the edge sums of the mid-step positions x - h v (and their x
-// coordinates) to the stage scratch t. conn: the block's eight corner index arrays;
-// ahead: the element to prefetch for.
+// coordinates, all three for the thick shell) to the stage scratch t. conn: the block's eight
+// corner index arrays; ahead: the element to prefetch for.
 template <int Form>
 void gather(const int* const (&conn)[8], const double* packed, int e, int ahead, double h,
             double* __restrict xs, double* __restrict vs, double* __restrict t) {
@@ -135,6 +136,10 @@ void gather(const int* const (&conn)[8], const double* packed, int e, int ahead,
       xm[a][i] = x - h * v;
     }
     simd::store(xm[a][0], t + (t_xm0 + a) * W);
+    if constexpr (Form == 2) {
+      simd::store(xm[a][1], t + (t_xm0 + 8 + a) * W);
+      simd::store(xm[a][2], t + (t_xm0 + 16 + a) * W);
+    }
   }
   vdouble s[12][3];
   hex8::edge_sums(xm, s);
@@ -183,18 +188,19 @@ template <class Use>
 // k_yy = q_y,eta zeta / len1, twist k_xy = q_x,eta zeta / len1 + q_y,xi zeta / len0)
 // with the plane-stress thickness rate -nu_ps (k_xx + k_yy); c_p drives each point's
 // thickness stress towards the element's average (docs/element.md, "Thick shell").
-// L is the mid-step velocity gradient, d its symmetric part.
+// L is the mid-step velocity gradient, d its symmetric part; xm the mid-step positions in the
+// stage scratch (8 i + a), vs the velocities in the chunk scratch.
 [[gnu::always_inline]] inline vdouble
 shell_point_rates(double* const (&ps)[hex8::thick_shell_max_points][6], int e, int l, double dt,
                   const vdouble (&L)[3][3], const vdouble (&d)[6], const vdouble (&Q)[3][3], int np,
-                  const double* zeta_p, const double* w_p, double nu_ps, double M, const double* xs,
+                  const double* zeta_p, const double* w_p, double nu_ps, double M, const double* xm,
                   const double* vs, double* pd) {
   constexpr int C = HexWorkspace::chunk;
   vdouble J[3][3], gx[3][4], qz[3][2];
   _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) {
     vdouble col[8], gv[4];
     _Pragma("GCC unroll 8") for (int a = 0; a < 8; ++a) col[a] =
-        simd::load(xs + (3 * a + i) * C + l) - (0.5 * dt) * simd::load(vs + (3 * a + i) * C + l);
+        simd::load(xm + (8 * i + a) * width);
     hex8::gamma_sums(col, gx[i]);
     hex8::natural_sums(col, J[i]);
     _Pragma("GCC unroll 8") for (int a = 0; a < 8; ++a) col[a] =
@@ -250,38 +256,48 @@ shell_point_rates(double* const (&ps)[hex8::thick_shell_max_points][6], int e, i
   return power;
 }
 
-// Thick shell, stage C: the points' new stress power, sum_p w_p / 2 sigma_p : D_p.
+// Thick shell, stage C: from the points' new stresses (each loaded once), the element's
+// stress, their Gauss average sum_p w_p / 2 sigma_p (for the membrane forces and the
+// outputs); their new stress power sum_p w_p / 2 sigma_p : D_p; and their first moments
+// m = sum_p w_p zeta_p sigma_p (for shell_bending_forces).
 [[gnu::always_inline]] inline vdouble
-shell_power(double* const (&ps)[hex8::thick_shell_max_points][6], int e, int l, int np,
-            const double* w_p, const double* pd) {
+shell_point_sums(double* const (&ps)[hex8::thick_shell_max_points][6], int e, int l, int np,
+                 const double* zeta_p, const double* w_p, const double* pd, vdouble (&s)[6],
+                 vdouble (&m)[6]) {
   constexpr int C = HexWorkspace::chunk;
   vdouble power = 0.0;
-  for (int p = 0; p < np; ++p) {
+  auto point = [&](int p, auto&& sum) { // np >= 2
     vdouble sp[6], dp[6];
     _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) {
       sp[k] = simd::load(ps[p][k] + e);
       dp[k] = simd::load(pd + (6 * p + k) * C + l);
+      sum(k, sp[k]);
     }
     power += (0.5 * w_p[p]) * (sp[0] * dp[0] + sp[1] * dp[1] + sp[2] * dp[2] +
                                2.0 * (sp[3] * dp[3] + sp[4] * dp[4] + sp[5] * dp[5]));
-  }
+  };
+  point(0, [&](int k, const vdouble& sp) {
+    s[k] = (0.5 * w_p[0]) * sp;
+    m[k] = (w_p[0] * zeta_p[0]) * sp;
+  });
+  for (int p = 1; p < np; ++p)
+    point(p, [&](int k, const vdouble& sp) {
+      s[k] += (0.5 * w_p[p]) * sp;
+      m[k] += (w_p[p] * zeta_p[p]) * sp;
+    });
   return power;
 }
 
 // Thick shell, stage C: adds to the generalized hourglass forces r (co-rotational frame)
 // those of the points' stresses, whose power is the bending part of their stress power:
-// the first moments M = int sigma zeta dV = V / 2 sum_p w_p zeta_p sigma_p in the frame give
-// r[0][1] += (M_xx - nu_ps M_zz) / len0, r[1][0] += (M_yy - nu_ps M_zz) / len1 and the
-// twist r[0][0] += M_xy / len1, r[1][1] += M_xy / len0.
-[[gnu::always_inline]] inline void
-shell_bending_forces(double* const (&ps)[hex8::thick_shell_max_points][6], int e,
-                     const vdouble& vol, const vdouble (&ax)[3][3], const vdouble (&len)[3], int np,
-                     const double* zeta_p, const double* w_p, double nu_ps, vdouble (&r)[3][4]) {
-  vdouble m[6];
-  _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) {
-    m[k] = (w_p[0] * zeta_p[0]) * simd::load(ps[0][k] + e);
-    for (int p = 1; p < np; ++p) m[k] += (w_p[p] * zeta_p[p]) * simd::load(ps[p][k] + e);
-  }
+// the first moments M = int sigma zeta dV = V / 2 sum_p w_p zeta_p sigma_p in the frame (m:
+// the sum, shell_point_sums) give r[0][1] += (M_xx - nu_ps M_zz) / len0,
+// r[1][0] += (M_yy - nu_ps M_zz) / len1 and the twist r[0][0] += M_xy / len1,
+// r[1][1] += M_xy / len0.
+[[gnu::always_inline]] inline void shell_bending_forces(const vdouble (&m)[6], const vdouble& vol,
+                                                        const vdouble (&ax)[3][3],
+                                                        const vdouble (&len)[3], double nu_ps,
+                                                        vdouble (&r)[3][4]) {
   const vdouble S[3][3] = {{m[0], m[3], m[5]}, {m[3], m[1], m[4]}, {m[5], m[4], m[2]}};
   auto frame = [&](int dd, int ee) {
     vdouble sum = 0.0;
@@ -490,8 +506,8 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       hex8::hughes_winget(w, dt, Q);
       vdouble power;
       if constexpr (Shell) { // the element's stress is the points' average (stage B)
-        power = shell_point_rates(ps, e, l, dt, L, d, Q, np, zeta_p, w_p, nu_ps, M, xs, vs,
-                                  scratch(s_pd0));
+        power = shell_point_rates(ps, e, l, dt, L, d, Q, np, zeta_p, w_p, nu_ps, M, t + t_xm0 * W,
+                                  vs, scratch(s_pd0));
       } else {
         _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) s[k] = simd::load(&b.stress[k][e]);
         hex8::rotate_symmetric(Q, s);
@@ -523,8 +539,8 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
     batch.temperature = has_T ? b.temperature.data() + e0 : nullptr;
     batch.wave_speed = scratch(s_wave_speed);
     if constexpr (Shell) {
-      // Each point through the thickness, then the element's averages (stress for the
-      // membrane forces and the outputs, the state for the flow stress and erosion).
+      // Each point through the thickness, then the element's averages of the state (for
+      // the flow stress and erosion).
       for (int p = 0; p < np; ++p) {
         MaterialBatch pb = batch;
         _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) {
@@ -548,7 +564,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
           simd::store(sum, out + e0 + l);
         }
       };
-      for (int k = 0; k < 6; ++k) average([&](int p) { return ps[p][k]; }, b.stress[k].data());
+      // (The stress average is formed in stage C, with the points' other sums.)
       if (has_ep)
         average([&](int p) { return b.point_plastic_strain[p].data(); }, b.plastic_strain.data());
       if (has_T)
@@ -586,9 +602,15 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       const vdouble rho = mass * inv;
       const vdouble c = simd::load(scratch(s_wave_speed) + l);
       vdouble d[6], s[6];
-      _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) {
-        d[k] = simd::load(scratch(s_d0 + k) + l);
-        s[k] = simd::load(&b.stress[k][e]);
+      _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) d[k] = simd::load(scratch(s_d0 + k) + l);
+      // Thick shell: the element's stress is the points' average, formed here with their
+      // stress power and moments.
+      [[maybe_unused]] vdouble shell_power_new, shell_m[6];
+      if constexpr (Shell) {
+        shell_power_new = shell_point_sums(ps, e, l, np, zeta_p, w_p, scratch(s_pd0), s, shell_m);
+        _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) simd::store(s[k], &b.stress[k][e]);
+      } else {
+        _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) s[k] = simd::load(&b.stress[k][e]);
       }
       const vdouble trd = d[0] + d[1] + d[2];
       // Characteristic length: the element's stable-step length V / sqrt(2 B:B) scaled
@@ -679,8 +701,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         }
         // Thick shell: the bending forces of the points' stresses (their work is in the
         // internal energy).
-        if constexpr (Shell)
-          shell_bending_forces(ps, e, vol, ax, extent, np, zeta_p, w_p, nu_ps, r);
+        if constexpr (Shell) shell_bending_forces(shell_m, vol, ax, extent, nu_ps, r);
         _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
             _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) Qh[i][al] =
                 ax[0][i] * r[0][al] + ax[1][i] * r[1][al] + ax[2][i] * r[2][al];
@@ -697,7 +718,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       // Energies over the step just taken (dt = 0 on the first cycle).
       vdouble power_new =
           s[0] * d[0] + s[1] * d[1] + s[2] * d[2] + 2.0 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
-      if constexpr (Shell) power_new = shell_power(ps, e, l, np, w_p, scratch(s_pd0));
+      if constexpr (Shell) power_new = shell_power_new;
       const vdouble vmid = simd::load(scratch(s_volume_mid) + l);
       vdouble dE = dt * vmid * (0.5 * (simd::load(scratch(s_power_old) + l) + power_new) - q * trd);
       const auto dead = simd::load(&b.alive[e]) == 0.0; // eroded elements store no energy
