@@ -19,7 +19,8 @@ namespace {
 
 using simd::padded_size;
 
-// Chunk scratch inside HexWorkspace: one array of `chunk` values per entry.
+// Chunk scratch inside HexWorkspace: one array of `chunk` values per entry, slot_stride
+// apart.
 enum Slot : int {
   s_d0,
   s_d1,
@@ -63,6 +64,14 @@ enum Tmp : int {
 };
 
 constexpr int prefetch_ahead = 32; // elements
+
+// Distance between the chunk scratch's arrays, in doubles: a chunk plus half a cache line,
+// so that no two arrays' entries of one lane share their address's low 12 bits. With a
+// distance of exactly one chunk (512 bytes) every eighth array's did, and a load whose
+// address matches an earlier store's in those bits can wait for it ("4K aliasing"; with
+// this stride the thick shell's FE phase measured 7% faster, the viscous element's 3%:
+// docs/performance.md, "The chunk scratch's stride").
+constexpr int slot_stride = HexWorkspace::chunk + 4;
 
 // Nodal positions and velocities packed per node (x0 v0 x1 v1 x2 v2, padded to a cache
 // line), so that a corner's six values come from one line in three 128-bit loads.
@@ -117,7 +126,7 @@ void pack_nodes(const NodalView& n, int lo, int hi, double* __restrict p) {
 template <int Form>
 void gather(const int* const (&conn)[8], const double* packed, int e, int ahead, double h,
             double* __restrict xs, double* __restrict vs, double* __restrict t) {
-  constexpr int C = HexWorkspace::chunk;
+  constexpr int S = slot_stride;
   constexpr int W = width;
   vdouble xm[8][3];
   _Pragma("GCC unroll 8") for (int a = 0; a < 8; ++a) {
@@ -131,8 +140,8 @@ void gather(const int* const (&conn)[8], const double* packed, int e, int ahead,
     _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) {
       vdouble x, v;
       simd::gather_pairs(packed + 2 * i, off, x, v);
-      simd::store(x, xs + (3 * a + i) * C);
-      simd::store(v, vs + (3 * a + i) * C);
+      simd::store(x, xs + (3 * a + i) * S);
+      simd::store(v, vs + (3 * a + i) * S);
       xm[a][i] = x - h * v;
     }
     simd::store(xm[a][0], t + (t_xm0 + a) * W);
@@ -151,10 +160,10 @@ void gather(const int* const (&conn)[8], const double* packed, int e, int ahead,
 // Edge sums of the positions in the chunk scratch (stage C; xs at the lane offset), one
 // direction at a time (eight positions live, each loaded once).
 void edge_sums(const double* __restrict xs, double* __restrict t) {
-  constexpr int C = HexWorkspace::chunk;
+  constexpr int S = slot_stride;
   _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) {
     vdouble x[8];
-    _Pragma("GCC unroll 8") for (int a = 0; a < 8; ++a) x[a] = simd::load(xs + (3 * a + i) * C);
+    _Pragma("GCC unroll 8") for (int a = 0; a < 8; ++a) x[a] = simd::load(xs + (3 * a + i) * S);
     _Pragma("GCC unroll 12") for (int k = 0; k < 12; ++k) simd::store(
         x[hex8::edge_nodes[k][0]] + x[hex8::edge_nodes[k][1]], t + (t_edge0 + 3 * k + i) * width);
     simd::stage_barrier();
@@ -195,7 +204,7 @@ shell_point_rates(double* const (&ps)[hex8::thick_shell_max_points][6], int e, i
                   const vdouble (&L)[3][3], const vdouble (&d)[6], const vdouble (&Q)[3][3], int np,
                   const double* zeta_p, const double* w_p, double nu_ps, double M, const double* xm,
                   const double* vs, double* pd) {
-  constexpr int C = HexWorkspace::chunk;
+  constexpr int S = slot_stride;
   vdouble J[3][3], gx[3][4], qz[3][2];
   _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) {
     vdouble col[8], gv[4];
@@ -204,7 +213,7 @@ shell_point_rates(double* const (&ps)[hex8::thick_shell_max_points][6], int e, i
     hex8::gamma_sums(col, gx[i]);
     hex8::natural_sums(col, J[i]);
     _Pragma("GCC unroll 8") for (int a = 0; a < 8; ++a) col[a] =
-        simd::load(vs + (3 * a + i) * C + l);
+        simd::load(vs + (3 * a + i) * S + l);
     hex8::gamma_sums(col, gv);
     qz[i][0] = gv[0];
     qz[i][1] = gv[1];
@@ -247,7 +256,7 @@ shell_point_rates(double* const (&ps)[hex8::thick_shell_max_points][6], int e, i
     vdouble dp[6], sp[6];
     _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) {
       dp[k] = d[k] + zeta_p[p] * A[k] - c * Z[k];
-      simd::store(dp[k], pd + (6 * p + k) * C + l);
+      simd::store(dp[k], pd + (6 * p + k) * S + l);
       sp[k] = simd::load(ps[p][k] + e);
     }
     power += (0.5 * w_p[p]) * (sp[0] * dp[0] + sp[1] * dp[1] + sp[2] * dp[2] +
@@ -264,13 +273,13 @@ shell_point_rates(double* const (&ps)[hex8::thick_shell_max_points][6], int e, i
 shell_point_sums(double* const (&ps)[hex8::thick_shell_max_points][6], int e, int l, int np,
                  const double* zeta_p, const double* w_p, const double* pd, vdouble (&s)[6],
                  vdouble (&m)[6]) {
-  constexpr int C = HexWorkspace::chunk;
+  constexpr int S = slot_stride;
   vdouble power = 0.0;
   auto point = [&](int p, auto&& sum) { // np >= 2
     vdouble sp[6], dp[6];
     _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) {
       sp[k] = simd::load(ps[p][k] + e);
-      dp[k] = simd::load(pd + (6 * p + k) * C + l);
+      dp[k] = simd::load(pd + (6 * p + k) * S + l);
       sum(k, sp[k]);
     }
     power += (0.5 * w_p[p]) * (sp[0] * dp[0] + sp[1] * dp[1] + sp[2] * dp[2] +
@@ -370,7 +379,8 @@ int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array
 }
 
 HexWorkspace::HexWorkspace()
-    : buf_(static_cast<std::size_t>(s_count) * chunk + static_cast<std::size_t>(t_count) * width,
+    : buf_(static_cast<std::size_t>(s_count) * slot_stride +
+               static_cast<std::size_t>(t_count) * width,
            0.0) {}
 
 // The sums are zero between assemblies: end_nodal_forces clears what it reads (the lines
@@ -420,7 +430,9 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
   constexpr bool Shell = Form == 2;
   const int n = b.size();
   constexpr int C = HexWorkspace::chunk;
-  auto scratch = [&](int slot) { return work.buf_.data() + static_cast<std::size_t>(slot) * C; };
+  auto scratch = [&](int slot) {
+    return work.buf_.data() + static_cast<std::size_t>(slot) * slot_stride;
+  };
   const double M = b.material->elastic().plane_wave_modulus();
   const bool stiff = !Asq && b.hourglass.model == HourglassControl::Model::stiffness;
   const double hg = b.hourglass.coefficient;
@@ -460,7 +472,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
   const double* packed = work.nodes_.data();
   const int* conn[8];
   for (int a = 0; a < 8; ++a) conn[a] = b.conn[a].data();
-  double* t = work.buf_.data() + static_cast<std::size_t>(s_count) * C; // stage scratch
+  double* t = work.buf_.data() + static_cast<std::size_t>(s_count) * slot_stride; // stage scratch
   constexpr int W = width;
   auto tmp = [t](int k) { return simd::load(t + k * W); };
   // The smallest stable step: the element's if it is smaller, or equal with a smaller id.
@@ -474,8 +486,8 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
   vdouble best_dt = 1e300, best_e = -1.0; // per lane: smallest step so far and its element
   const double* xs = scratch(s_x0);
   const double* vs = scratch(s_v0);
-  auto xc = [&](int a, int i, int l) { return simd::load(xs + (3 * a + i) * C + l); };
-  auto vc = [&](int a, int i, int l) { return simd::load(vs + (3 * a + i) * C + l); };
+  auto xc = [&](int a, int i, int l) { return simd::load(xs + (3 * a + i) * slot_stride + l); };
+  auto vc = [&](int a, int i, int l) { return simd::load(vs + (3 * a + i) * slot_stride + l); };
 
   for (int e0 = 0; e0 < n; e0 += C) {
     const int nc = padded_size(std::min(C, n - e0)); // lanes in this chunk, whole vectors
