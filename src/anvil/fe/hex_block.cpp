@@ -601,11 +601,13 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       });
       simd::stage_barrier();
       auto Bt = [&](int a, int i) { return tmp(t_b0 + 3 * a + i); }; // 12 B_ia
-      vdouble vol12 = xc(0, 0, l) * Bt(0, 0), bb144 = Bt(0, 0) * Bt(0, 0);
+      vdouble vol12 = xc(0, 0, l) * Bt(0, 0), bbd[3]; // 144 B:B by direction (short sums)
       _Pragma("GCC unroll 12") for (int a = 1; a < 8; ++a) vol12 += xc(a, 0, l) * Bt(a, 0);
-      _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a)
-          _Pragma("GCC unroll 12") for (int i = (a == 0 ? 1 : 0); i < 3; ++i) bb144 +=
-          Bt(a, i) * Bt(a, i);
+      _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) {
+        bbd[i] = Bt(0, i) * Bt(0, i);
+        _Pragma("GCC unroll 12") for (int a = 1; a < 8; ++a) bbd[i] += Bt(a, i) * Bt(a, i);
+      }
+      const vdouble bb144 = (bbd[0] + bbd[1]) + bbd[2];
       for (auto& row : G)
         for (auto& x : row) x *= 1.0 / 12.0;
       const vdouble vol = vol12 * (1.0 / 12.0);
@@ -652,7 +654,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         hex8::gamma_sums(col, vg[i]);
       }
       vdouble Qh[3][4];
-      vdouble hg_power = 0.0;
+      vdouble hgp[3] = {0.0, 0.0, 0.0}; // hourglass power by direction (three short sums)
       const vdouble kv = (0.25 * hg) * rho * c * len * len;
       const vdouble ks = (hg * M / 3.0) * bb * inv;
       // Assumed strain: the co-rotational axes and extents, and q in those axes.
@@ -672,7 +674,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
                                 simd::load(scratch(s_q0 + 3 * i + 2) + l) * old[2];
             Qh[i][al] = rot + dt * ks * qa[i];
             simd::store(Qh[i][al], &b.hourglass_force[3 * al + i][e]);
-            hg_power += 0.5 * (rot + Qh[i][al]) * qa[i];
+            hgp[i] += 0.5 * (rot + Qh[i][al]) * qa[i];
           }
         } else if constexpr (Asq) {
           _Pragma("GCC unroll 12") for (int d = 0; d < 3; ++d) ql[d][al] =
@@ -680,7 +682,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         } else {
           _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) {
             Qh[i][al] = kv * qa[i];
-            hg_power += Qh[i][al] * qa[i];
+            hgp[i] += Qh[i][al] * qa[i];
           }
         }
       }
@@ -709,7 +711,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
             _Pragma("GCC unroll 12") for (int d = 0; d < 3; ++d) {
           simd::store(r[d][al], &b.hourglass_force[3 * al + d][e]);
-          hg_power += 0.5 * (old[d][al] + r[d][al]) * ql[d][al];
+          hgp[d] += 0.5 * (old[d][al] + r[d][al]) * ql[d][al];
         }
         // Thick shell: the bending forces of the points' stresses (their work is in the
         // internal energy).
@@ -733,6 +735,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       if constexpr (Shell) power_new = shell_power_new;
       const vdouble vmid = simd::load(scratch(s_volume_mid) + l);
       vdouble dE = dt * vmid * (0.5 * (simd::load(scratch(s_power_old) + l) + power_new) - q * trd);
+      vdouble hg_power = (hgp[0] + hgp[1]) + hgp[2];
       const auto dead = simd::load(&b.alive[e]) == 0.0; // eroded elements store no energy
       const bool any_dead = stdx::any_of(dead);
       stdx::where(dead, dE) = 0.0;
@@ -762,10 +765,10 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       vdouble dte;
       if (!stiff && !Asq) {
         const vdouble kr = (0.25 * 8.0) * kv * lc / mass;
-        vdouble hh = h[0][0] * h[0][0];
-        _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al)
-            _Pragma("GCC unroll 12") for (int i = (al == 0 ? 1 : 0); i < 3; ++i) hh +=
-            h[al][i] * h[al][i];
+        vdouble hhd[3]; // sum of h_al,i^2, by direction
+        _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) hhd[i] =
+            ((h[0][i] * h[0][i] + h[1][i] * h[1][i]) + h[2][i] * h[2][i]) + h[3][i] * h[3][i];
+        const vdouble hh = (hhd[0] + hhd[1]) + hhd[2];
         const vdouble cheap = hex8::hourglass_damping_bound_frobenius(bb, hh);
         vdouble qh = qv + kr * cheap;
         dte = lc / (qh + stdx::sqrt(qh * qh + c * c));
@@ -802,7 +805,8 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
 
       // Corner forces f_a = -(S B_a + sum_al Q_al Gamma_al,a), formed and stored one
       // component at a time (the hourglass part of all eight corners comes from four
-      // values), with their sum kept for the finiteness check.
+      // values), with their sum kept for the finiteness check (a sum of sums, not one
+      // chain of 24 additions).
       // With nodal assembly, the rows go to the corner slots only where the block asks for
       // them (corner_rows) and otherwise to the stage scratch, for the assembly after the
       // bookkeeping (which may erode an element).
@@ -814,8 +818,8 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a) {
           fa[a] = S[i][0] * Bt(a, 0) + S[i][1] * Bt(a, 1) + S[i][2] * Bt(a, 2) - hgf[a];
           if (any_dead) stdx::where(dead, fa[a]) = 0.0;
-          check += fa[a];
         }
+        check += ((fa[0] + fa[1]) + (fa[2] + fa[3])) + ((fa[4] + fa[5]) + (fa[6] + fa[7]));
         // Element-major slots: the lanes' eight corners are contiguous, whole rows that
         // the gather reads only after the kernel, streamed past the cache when aligned.
         double* row = corners.f[i] + b.corner_base + 8 * static_cast<std::size_t>(e);
