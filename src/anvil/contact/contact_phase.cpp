@@ -10,6 +10,19 @@ namespace anvil {
 
 namespace {
 
+// Writes face j's capture box and mean plane (lo, hi, normal, offset, warp) from a received
+// item or motion into the search's arrays (lo x y z, hi x y z, normal x y z, offset, warp).
+template <class Face>
+void put_box_and_plane(std::vector<double> (&box)[12], std::size_t j, const Face& f) {
+  for (int i = 0; i < 3; ++i) {
+    box[i][j] = f.lo[i];
+    box[3 + i][j] = f.hi[i];
+    box[6 + i][j] = f.normal[i];
+  }
+  box[9][j] = f.offset;
+  box[10][j] = f.warp;
+}
+
 // The bound of a face's capture box (derived above set_lazy_reference()):
 // its sides move by at most m = delta (1 + A (B + 4 delta)) when no corner has moved more
 // than delta since the reference, with A and B from the reference geometry (len = |D1 x
@@ -210,13 +223,7 @@ void ContactPhase::pack_cycle(std::size_t f, const ContactNodes& nd, Item& it) c
 }
 
 void ContactPhase::unpack_motion(const FaceMotion& m, std::size_t j) {
-  for (int i = 0; i < 3; ++i) {
-    recv_box_[i][j] = m.lo[i];
-    recv_box_[3 + i][j] = m.hi[i];
-    recv_box_[6 + i][j] = m.normal[i];
-  }
-  recv_box_[9][j] = m.offset;
-  recv_box_[10][j] = m.warp;
+  put_box_and_plane(recv_box_, j, m);
 }
 
 void ContactPhase::complete_item(const FaceMotion& m, std::size_t j) {
@@ -927,13 +934,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     if (!lazy)
       for (std::size_t j = 0; j < nr; ++j) {
         const ContactFaceItem& it = face_in_[j];
-        for (int i = 0; i < 3; ++i) {
-          recv_box_[i][j] = it.lo[i];
-          recv_box_[3 + i][j] = it.hi[i];
-          recv_box_[6 + i][j] = it.normal[i];
-        }
-        recv_box_[9][j] = it.offset;
-        recv_box_[10][j] = it.warp;
+        put_box_and_plane(recv_box_, j, it);
         recv_box_[11][j] = it.depth;
       }
     for (int i = 0; i < 3; ++i) {
