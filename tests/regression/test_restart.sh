@@ -51,4 +51,17 @@ fi
 # The outputs of the restarted run are complete and readable.
 grep -q '"status": "completed"' killed/summary.json
 grep -q 'step_' killed/results.pvd
+# Each phase's seconds per rank: one entry for each of the restarted run's 3 or 4 ranks.
+for d in stopped killed; do
+  [ -f "$d/summary.json" ] || continue
+  /usr/bin/python3 - "$d/summary.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+by_rank = s["timers_by_rank"]
+assert set(by_rank) == set(s["timers"]), by_rank.keys()
+for phase, seconds in by_rank.items():
+    assert len(seconds) == s["ranks"], (phase, seconds)
+    assert max(seconds) == s["timers"][phase], (phase, seconds, s["timers"][phase])
+PY
+done
 echo "restart: identical state after stop/restart on 2 -> 3 and SIGTERM/restart on 2 -> 4 ranks"

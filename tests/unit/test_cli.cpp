@@ -125,8 +125,8 @@ TEST(Cli, RunWritesTheOutputs) {
   EXPECT_NE(pvd.str().find("step_000002.pvtu"), std::string::npos) << pvd.str();
   std::stringstream summary;
   summary << std::ifstream(dir + "/summary.json").rdbuf();
-  for (const char* key : {"\"grind_us\"", "\"timers\"", "\"imbalance\"", "\"balance_error\"",
-                          "\"status\": \"completed\""})
+  for (const char* key : {"\"grind_us\"", "\"timers\"", "\"timers_by_rank\"", "\"imbalance\"",
+                          "\"balance_error\"", "\"status\": \"completed\""})
     EXPECT_NE(summary.str().find(key), std::string::npos) << key;
 }
 

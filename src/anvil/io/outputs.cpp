@@ -404,6 +404,9 @@ void Outputs::write_summary(int status, const std::string& message) {
   std::vector<double> tmax(timers.begin(), timers.end());
   tmax[static_cast<int>(Phase::output)] += output_timer_.seconds(Phase::output);
   std::vector<double> tsum = tmax;
+  // Each rank's own seconds by phase (rank-major), to tell work from waits.
+  std::vector<double> by_rank(tmax.size() * static_cast<std::size_t>(comm.size()));
+  comm.allgather_bytes(tmax.data(), tmax.size() * sizeof(double), by_rank.data());
   comm.max(std::span<double>(tmax));
   comm.sum(std::span<double>(tsum));
   const Sample s = have_sample_ ? last_sample_ : sim_.sample();
@@ -445,6 +448,14 @@ void Outputs::write_summary(int status, const std::string& message) {
   json t, imb;
   for (std::size_t p = 0; p < tmax.size(); ++p) t[std::string(phase_names[p])] = tmax[p];
   j["timers"] = t;
+  json tr;
+  for (std::size_t p = 0; p < tmax.size(); ++p) {
+    json col = json::array();
+    for (int r = 0; r < comm.size(); ++r)
+      col.push_back(by_rank[static_cast<std::size_t>(r) * tmax.size() + p]);
+    tr[std::string(phase_names[p])] = col;
+  }
+  j["timers_by_rank"] = tr;
   auto ratio = [&](Phase p) {
     const double mean = tsum[static_cast<int>(p)] / comm.size();
     return mean > 0 ? tmax[static_cast<int>(p)] / mean : 1.0;
