@@ -326,6 +326,19 @@ shell_point_sums(double* const (&ps)[hex8::thick_shell_max_points][6], int e, in
 
 } // namespace
 
+int element_cost(const HourglassControl& hourglass, const ThickShell& thick_shell) {
+  if (thick_shell.enabled()) return 148 + 22 * thick_shell.points;
+  switch (hourglass.model) {
+  case HourglassControl::Model::viscous:
+    return 127;
+  case HourglassControl::Model::stiffness:
+    return 138;
+  case HourglassControl::Model::assumed_strain:
+    return 148;
+  }
+  return 148;
+}
+
 int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array<int, 8>> corners,
                    const double* const x[3], std::size_t base) {
   const int n = static_cast<int>(ids.size());

@@ -56,6 +56,12 @@ struct ThickShell {
   bool enabled() const { return points > 0; }
 };
 
+// Relative cost of one element in the FE phase, for balancing the static decomposition:
+// the kernel's time per element and cycle on the benchmark blocks of docs/performance.md
+// (J2, 47^3, ns): viscous 127, stiffness 138, assumed strain 148; the thick shell adds
+// about 22 per point through the thickness to the assumed-strain form (212 with 3).
+int element_cost(const HourglassControl& hourglass, const ThickShell& thick_shell);
+
 struct HexBlock {
   std::string name;                   // part name
   int part = 0;                       // part index in the deck

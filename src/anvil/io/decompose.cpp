@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "anvil/fe/hex_block.hpp"
 #include "anvil/io/files.hpp"
 #include "anvil/io/outputs.hpp"
 #include "anvil/parallel/graph_partition.hpp"
@@ -48,6 +49,12 @@ void write_decomposition(const Config& config, const std::string& outdir, const 
   j["nodes"] = sim.global_nodes();
   nlohmann::json fe;
   fe["elements"] = per_rank(comm, static_cast<double>(sim.fe().num_elements()));
+  // The work the partition balances: each element weighted by its formulation's cost.
+  double cost = 0;
+  for (std::size_t b = 0; b < sim.fe().blocks.size(); ++b)
+    cost += static_cast<double>(sim.fe().blocks[b].gid.size()) *
+            element_cost(config.parts[b].hourglass, config.parts[b].thick_shell);
+  fe["cost"] = per_rank(comm, cost);
   fe["owned_nodes"] = per_rank(comm, static_cast<double>(sim.fe().num_owned_nodes()));
   fe["held_nodes"] = per_rank(comm, static_cast<double>(sim.fe().node_gid.size()));
   double shared = 0;
@@ -56,7 +63,7 @@ void write_decomposition(const Config& config, const std::string& outdir, const 
   fe["neighbours"] = per_rank(comm, static_cast<double>(sim.fe().neighbors.size()));
   if (comm.rank() == 0) {
     const Mesh mesh = build_mesh(config);
-    fe["edge_cut"] = partition_cut(mesh, partition_elements(mesh, comm.size()));
+    fe["edge_cut"] = partition_cut(mesh, partition_model(mesh, config, comm.size()));
   }
   j["fe"] = fe;
   if (const ContactPhase* cp = sim.contact()) {

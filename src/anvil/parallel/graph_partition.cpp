@@ -9,7 +9,8 @@
 
 namespace anvil {
 
-std::vector<int> partition_elements(const Mesh& mesh, int parts) {
+std::vector<int> partition_elements(const Mesh& mesh, int parts,
+                                    std::span<const int> block_weight) {
   const auto ne = mesh.num_elements();
   std::vector<int> out(static_cast<std::size_t>(ne), 0);
   if (parts <= 1 || ne == 0) return out;
@@ -17,13 +18,17 @@ std::vector<int> partition_elements(const Mesh& mesh, int parts) {
     std::iota(out.begin(), out.end(), 0);
     return out;
   }
-  std::vector<idx_t> eptr(static_cast<std::size_t>(ne) + 1), eind;
+  if (!block_weight.empty() && block_weight.size() != mesh.blocks.size())
+    throw std::invalid_argument("partition_elements: one weight per block expected");
+  std::vector<idx_t> eptr(static_cast<std::size_t>(ne) + 1), eind, vwgt;
   eind.reserve(static_cast<std::size_t>(ne) * 8);
+  if (!block_weight.empty()) vwgt.reserve(static_cast<std::size_t>(ne));
   std::size_t e = 0;
-  for (const auto& b : mesh.blocks)
-    for (const auto& h : b.elements) {
+  for (std::size_t b = 0; b < mesh.blocks.size(); ++b)
+    for (const auto& h : mesh.blocks[b].elements) {
       eptr[e++] = static_cast<idx_t>(eind.size());
       for (auto n : h) eind.push_back(static_cast<idx_t>(n));
+      if (!block_weight.empty()) vwgt.push_back(static_cast<idx_t>(std::max(1, block_weight[b])));
     }
   eptr[e] = static_cast<idx_t>(eind.size());
   idx_t n_el = static_cast<idx_t>(ne), n_nodes = static_cast<idx_t>(mesh.num_nodes());
@@ -33,9 +38,9 @@ std::vector<int> partition_elements(const Mesh& mesh, int parts) {
   options[METIS_OPTION_NUMBERING] = 0;
   options[METIS_OPTION_SEED] = 12345;
   std::vector<idx_t> epart(static_cast<std::size_t>(ne)), npart(static_cast<std::size_t>(n_nodes));
-  const int rc =
-      METIS_PartMeshDual(&n_el, &n_nodes, eptr.data(), eind.data(), nullptr, nullptr, &ncommon,
-                         &nparts, nullptr, options, &objval, epart.data(), npart.data());
+  const int rc = METIS_PartMeshDual(&n_el, &n_nodes, eptr.data(), eind.data(),
+                                    vwgt.empty() ? nullptr : vwgt.data(), nullptr, &ncommon,
+                                    &nparts, nullptr, options, &objval, epart.data(), npart.data());
   if (rc != METIS_OK) throw std::runtime_error("METIS_PartMeshDual failed");
   for (std::size_t i = 0; i < out.size(); ++i) out[i] = static_cast<int>(epart[i]);
   return out;

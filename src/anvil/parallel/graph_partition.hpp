@@ -2,6 +2,7 @@
 // (elements adjacent through a face), as the paper used Chaco.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "anvil/mesh/mesh.hpp"
@@ -10,7 +11,10 @@ namespace anvil {
 
 // Owner part (0..parts-1) of every element in global element order. Deterministic for
 // given input (fixed seed). With more parts than elements, element i goes to part i.
-std::vector<int> partition_elements(const Mesh& mesh, int parts);
+// `block_weight` (empty, or one positive value per mesh block) weighs each element of a
+// block by its cost, so that the parts balance work instead of counts.
+std::vector<int> partition_elements(const Mesh& mesh, int parts,
+                                    std::span<const int> block_weight = {});
 
 // Number of face-adjacent element pairs whose parts differ (the edge cut).
 long long partition_cut(const Mesh& mesh, const std::vector<int>& part);

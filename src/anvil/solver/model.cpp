@@ -8,10 +8,12 @@
 
 #include <fmt/format.h>
 
+#include "anvil/fe/hex_block.hpp"
 #include "anvil/io/keyword.hpp"
 #include "anvil/mesh/generators.hpp"
 #include "anvil/mesh/read_exodus.hpp"
 #include "anvil/mesh/read_gmsh.hpp"
+#include "anvil/parallel/graph_partition.hpp"
 
 namespace anvil {
 
@@ -149,6 +151,14 @@ std::vector<std::int64_t> resolve_selection(const Mesh& mesh, const Config& conf
   }
   if (ids.empty()) throw InputError(sel.where, "the selection contains no nodes");
   return ids;
+}
+
+std::vector<int> partition_model(const Mesh& mesh, const Config& config, int parts) {
+  std::vector<int> weight;
+  weight.reserve(config.parts.size());
+  for (const auto& part : config.parts)
+    weight.push_back(element_cost(part.hourglass, part.thick_shell));
+  return partition_elements(mesh, parts, weight);
 }
 
 } // namespace anvil

@@ -18,4 +18,10 @@ Mesh build_mesh(const Config& config);
 std::vector<std::int64_t> resolve_selection(const Mesh& mesh, const Config& config,
                                             const Selection& sel);
 
+// The static FE decomposition of the model (DESIGN.md section 1): the owner rank of every
+// element in global element order, METIS k-way on the element dual graph with each
+// element weighted by its formulation's cost (element_cost), so that a thick-shell part
+// and a solid part share the ranks by work, not by count.
+std::vector<int> partition_model(const Mesh& mesh, const Config& config, int parts);
+
 } // namespace anvil

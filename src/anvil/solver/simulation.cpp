@@ -9,7 +9,6 @@
 #include "anvil/contact/rigid_wall.hpp"
 #include "anvil/core/simd.hpp"
 #include "anvil/io/checkpoint.hpp"
-#include "anvil/parallel/graph_partition.hpp"
 #include "anvil/solver/model.hpp"
 
 namespace anvil {
@@ -18,12 +17,13 @@ Simulation::~Simulation() = default;
 
 Simulation::Simulation(const Config& config, const Comm& comm) : config_(config), comm_(comm) {
   // The global mesh is built on every rank (generators and readers are deterministic);
-  // METIS runs on rank 0 and its answer is broadcast so that every rank agrees.
+  // METIS runs on rank 0 (partition_model) and its answer is broadcast so that every rank
+  // agrees.
   const Mesh mesh = build_mesh(config_);
   global_elements_ = mesh.num_elements();
   block_offsets_ = mesh.block_offsets();
   std::vector<int> owner;
-  if (comm_.rank() == 0) owner = partition_elements(mesh, comm_.size());
+  if (comm_.rank() == 0) owner = partition_model(mesh, config_, comm_.size());
   comm_.broadcast(owner, 0);
   fe_ = decompose_fe(mesh, owner, comm_.rank(), comm_.size());
   corner_exchange_ = std::make_unique<CornerExchange>(fe_, comm_);
