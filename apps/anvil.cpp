@@ -123,6 +123,12 @@ int main(int argc, char** argv) {
                   "(the paper's hexahedron, viscous hourglass control)")
       ->check(CLI::IsMember({"thick_shell", "one_point"}))
       ->capture_default_str();
+  std::string decomposition = "paper";
+  can->add_option("--decomposition", decomposition,
+                  "paper (METIS for the elements, contact RCB cutting the longest direction) or "
+                  "sectors (RCBs cutting along the can's axis, in both decompositions)")
+      ->check(CLI::IsMember({"paper", "sectors"}))
+      ->capture_default_str();
   can->add_flag("--print-deck", write_deck, "print the deck for this rank count and exit");
   can->add_flag("-q,--quiet", quiet, "no progress line");
 
@@ -162,6 +168,8 @@ int main(int argc, char** argv) {
       cc.ranks = comm.size();
       cc.wall = wall == "one_point" ? anvil::CanCrushOptions::Wall::one_point
                                     : anvil::CanCrushOptions::Wall::thick_shell;
+      cc.decomposition = decomposition == "sectors" ? anvil::CanCrushOptions::Decomposition::sectors
+                                                    : anvil::CanCrushOptions::Decomposition::paper;
       if (write_deck) {
         if (root) std::printf("%s", anvil::can_crush_deck(cc).c_str());
         return 0;

@@ -28,6 +28,7 @@ options:
   --ranks "P1 P2 ..."    explicit list of rank counts instead of the doubling series
   --cycles C             cycles per run (default 300; 0 would be a setup-only run)
   --elements-per-rank N  one-rank model size, passed to anvil (default: anvil's, 1875)
+  --decomposition D      paper (default) or sectors, passed to anvil (docs/benchmark.md)
   --full                 run each problem to 3.2 ms instead of --cycles (slow)
   --anvil PATH           anvil executable (default: build/apps/anvil next to tools/)
   --mpirun CMD           MPI launcher (default: mpirun)
@@ -58,6 +59,7 @@ max_ranks=8
 ranks_list=""
 cycles=300
 epr=""
+decomposition=""
 full=0
 timeout_s=""
 repeat=1
@@ -73,6 +75,7 @@ while [ $# -gt 0 ]; do
     --ranks) [ $# -ge 2 ] || die "$1 needs a value"; ranks_list=$2; shift 2 ;;
     --cycles) [ $# -ge 2 ] || die "$1 needs a value"; cycles=$2; shift 2 ;;
     --elements-per-rank) [ $# -ge 2 ] || die "$1 needs a value"; epr=$2; shift 2 ;;
+    --decomposition) [ $# -ge 2 ] || die "$1 needs a value"; decomposition=$2; shift 2 ;;
     --full) full=1; shift ;;
     --anvil) [ $# -ge 2 ] || die "$1 needs a value"; anvil=$2; shift 2 ;;
     --mpirun) [ $# -ge 2 ] || die "$1 needs a value"; mpirun_cmd=$2; shift 2 ;;
@@ -89,6 +92,7 @@ done
 [ -n "$outroot" ] || { usage >&2; die "OUTROOT is required"; }
 is_uint "$cycles" || die "--cycles expects a non-negative integer, got '$cycles'"
 [ -z "$epr" ] || is_uint "$epr" || die "--elements-per-rank expects an integer, got '$epr'"
+case "$decomposition" in ""|paper|sectors) ;; *) die "--decomposition expects paper or sectors, got '$decomposition'" ;; esac
 is_uint "$repeat" && [ "$repeat" -ge 1 ] || die "--repeat expects N >= 1, got '$repeat'"
 [ -z "$timeout_s" ] || is_uint "$timeout_s" || die "--timeout expects seconds, got '$timeout_s'"
 [ -x "$anvil" ] || die "$anvil: no executable (build it: cmake --build build -j2 --target anvil)"
@@ -140,6 +144,7 @@ cat >"$outroot/machine.json" <<EOF
   "ranks": $ranks_json,
   "cycles": $([ "$full" = 1 ] && echo null || echo "$cycles"),
   "elements_per_rank": ${epr:-1875},
+  "decomposition": "${decomposition:-paper}",
   "repeat": $repeat
 }
 EOF
@@ -162,6 +167,7 @@ run_one() {
   local args=(bench can-crush -o "$dir")
   [ "$full" = 1 ] || args+=(--cycles "$cycles")
   [ -z "$epr" ] || args+=(--elements-per-rank "$epr")
+  [ -z "$decomposition" ] || args+=(--decomposition "$decomposition")
   local launcher=("$mpirun_cmd" -np "$p" --oversubscribe)
   # shellcheck disable=SC2206  # the extra launcher arguments are meant to split on spaces
   launcher+=($mpi_args)
@@ -174,7 +180,8 @@ run_one() {
   echo "${launcher[*]} $anvil ${args[*]}" >"$dir/command.txt"
   # the deck of this rank count, for the record (mesh divisions)
   "${launcher[@]}" "$anvil" bench can-crush --print-deck \
-    ${epr:+--elements-per-rank "$epr"} >"$dir/deck.yaml" 2>/dev/null || rm -f "$dir/deck.yaml"
+    ${epr:+--elements-per-rank "$epr"} ${decomposition:+--decomposition "$decomposition"} \
+    >"$dir/deck.yaml" 2>/dev/null || rm -f "$dir/deck.yaml"
   /usr/bin/time -f '%e %U %S' -o "$dir/time.txt" "${launcher[@]}" "$anvil" "${args[@]}" \
     >"$dir/run.log" 2>&1
   status=$?

@@ -167,6 +167,21 @@ TEST(Determinism, CanCrushSameBitsOnAnyRankCount) {
   if (Comm::world().rank() == 0) EXPECT_GT(max_ep, 1e-4); // contact has deformed the rim
 }
 
+// The same with the sectors decomposition (the FE decomposition an RCB of the element
+// centres, every RCB cutting along the can's axis): another partition, the same bits.
+TEST(Determinism, CanCrushSectorsSameBitsOnAnyRankCount) {
+  CanCrushOptions o;
+  o.cycles = 600;
+  o.decomposition = CanCrushOptions::Decomposition::sectors;
+  const Config config = can_crush_config(o);
+  ASSERT_EQ(config.decomposition.fe, DecompositionConfig::Fe::rcb);
+  double max_ep = 0;
+  const std::int64_t differing = compare_with_serial(config, &max_ep);
+  EXPECT_EQ(differing, 0) << "values differing from the 1-rank run on " << Comm::world().size()
+                          << " ranks";
+  if (Comm::world().rank() == 0) EXPECT_GT(max_ep, 1e-4); // contact has deformed the rim
+}
+
 TEST(Determinism, SameBitsOnAnyRankCount) {
   const Config config = test::deck(deck_text);
   const Comm world = Comm::world();

@@ -293,6 +293,32 @@ TEST(Rcb, WeightedWithinOneWeight) {
     EXPECT_LE(std::abs(rcb.weight(q) - W / comm.size()), wmax) << "rank " << q;
 }
 
+// A direction scale stretches the coordinates only where a node chooses its cut: on the
+// 3 x 2 x 1 cloud, x shrunk by 10 is never cut below 16 ranks (the paper's rule alone cuts
+// it first); the splits stay exact.
+TEST(Rcb, DirectionScaleChoosesTheCuts) {
+  const Comm comm = world();
+  const std::int64_t n = 2000;
+  const auto all = uniform(n);
+  const Cloud c = share(all, comm, false);
+  Rcb plain(comm), stretched(comm, {0.1, 1, 1});
+  plain.partition(c.view());
+  stretched.partition(c.view());
+  const int P = comm.size();
+  if (P >= 2) { // the root's cut
+    const auto root = static_cast<std::size_t>(Rcb::split(0, P));
+    EXPECT_EQ(plain.cuts()[root].dim, 0);
+    EXPECT_EQ(stretched.cuts()[root].dim, 1);
+  }
+  for (int m = 1; m < P; ++m) EXPECT_NE(stretched.cuts()[static_cast<std::size_t>(m)].dim, 0);
+  for (int r = 0; r < P; ++r) {
+    EXPECT_GE(stretched.count(r), n / P);
+    EXPECT_LE(stretched.count(r), (n + P - 1) / P);
+  }
+  EXPECT_THROW(Rcb(comm, {1, 0, 1}), std::invalid_argument);
+  EXPECT_THROW(Rcb(comm, {1, 1, std::numeric_limits<double>::infinity()}), std::invalid_argument);
+}
+
 TEST(Rcb, DeterministicWhoeverHoldsThePoints) {
   const Comm comm = world();
   const auto all = uniform(2500);

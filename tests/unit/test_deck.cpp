@@ -105,6 +105,26 @@ TEST(Deck, ImpossibleValues) {
   expect_error("scale: 0.9", "scale: 1.5", {"deck.yaml:3", "time_step.scale"});
 }
 
+// decomposition: {fe: metis | rcb, scale: [sx, sy, sz]}: METIS and no stretch unless
+// given; an unknown method or a factor that is not positive names file, line and key.
+TEST(Deck, Decomposition) {
+  Config c = test::deck(good);
+  EXPECT_EQ(c.decomposition.fe, DecompositionConfig::Fe::metis);
+  EXPECT_DOUBLE_EQ(c.decomposition.scale.z, 1.0);
+  c = test::deck(std::string(good) + "decomposition: {fe: rcb, scale: [1, 1, 0.25]}\n");
+  EXPECT_EQ(c.decomposition.fe, DecompositionConfig::Fe::rcb);
+  EXPECT_DOUBLE_EQ(c.decomposition.scale.x, 1.0);
+  EXPECT_DOUBLE_EQ(c.decomposition.scale.z, 0.25);
+  const std::string last = "output: {fields_every: 1.0e-5, history_every: 1.0e-7}";
+  expect_error(last, last + "\ndecomposition: {fe: chaco}",
+               {"deck.yaml:22", "decomposition.fe", "chaco", "metis or rcb"});
+  expect_error(last, last + "\ndecomposition: {scale: [1, 0, 1]}",
+               {"deck.yaml:22", "decomposition.scale", "positive"});
+  expect_error(last, last + "\ndecomposition: {scale: [1, 1]}",
+               {"deck.yaml:22", "decomposition.scale"});
+  expect_error(last, last + "\ndecomposition: {method: rcb}", {"deck.yaml:22", "method"});
+}
+
 TEST(Deck, BrokenReferences) {
   expect_error("material: copper", "material: steel",
                {"deck.yaml:10", "parts.bar.material", "steel"});

@@ -40,8 +40,9 @@ inline V side_move(const V& delta, const V& a, const V& b) {
 ContactPhase::~ContactPhase() = default;
 
 ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const FeDecomposition& fe,
-                           const std::vector<HexBlock>& blocks, const Comm& comm)
-    : config_(config), fe_(fe), comm_(comm), blocks_(blocks), rcb_(comm) {
+                           const std::vector<HexBlock>& blocks, const Comm& comm,
+                           const Vec3& rcb_scale)
+    : config_(config), fe_(fe), comm_(comm), blocks_(blocks), rcb_(comm, rcb_scale) {
   global_nodes_ = mesh.num_nodes();
   std::vector<bool> selected(mesh.blocks.size(), config.parts.empty());
   for (const auto& name : config.parts)

@@ -69,9 +69,11 @@ struct ContactNodes {
 class ContactPhase {
 public:
   // Builds the surfaces of the deck's contact parts from the global mesh (every rank holds
-  // it at setup) and the element data of this rank's blocks. Collective.
+  // it at setup) and the element data of this rank's blocks. Collective. The contact RCB
+  // chooses its cut directions in coordinates stretched by rcb_scale (Rcb).
   ContactPhase(const ContactConfig& config, const Mesh& mesh, const FeDecomposition& fe,
-               const std::vector<HexBlock>& blocks, const Comm& comm);
+               const std::vector<HexBlock>& blocks, const Comm& comm,
+               const Vec3& rcb_scale = {1, 1, 1});
   ~ContactPhase();
 
   // Step 4 for the motion predicted over dt: moves nodes and faces to the contact

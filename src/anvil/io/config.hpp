@@ -148,6 +148,19 @@ struct ProbeConfig {
 // Which field files a run writes (DESIGN.md section 4, `output.format`).
 enum class OutputFormat { vtu, exodus, both };
 
+// How the model is divided among the ranks (docs/cycle.md, "The decompositions").
+struct DecompositionConfig {
+  // The static FE decomposition: METIS k-way on the element dual graph (the paper used
+  // Chaco), or a recursive coordinate bisection of the element centres, both weighing
+  // each element by its formulation's cost.
+  enum class Fe { metis, rcb };
+  Fe fe = Fe::metis;
+  // Every RCB (the FE one with fe: rcb, the contact and the SPH decompositions) chooses
+  // its cut directions in coordinates stretched by these factors (LS-DYNA's SX, SY, SZ
+  // of *CONTROL_MPP_DECOMPOSITION_TRANSFORMATION): [1, 1, 0.25] makes cuts across z rare.
+  Vec3 scale{1, 1, 1};
+};
+
 struct Config {
   std::string title;
   std::string deck_file;
@@ -169,6 +182,7 @@ struct Config {
   std::vector<ProbeConfig> probes;
   std::vector<ContactConfig> contact; // at most one
   std::vector<RigidWallConfig> rigid_walls;
+  DecompositionConfig decomposition;
   // What the reader accepted but could not take over exactly (an LS-DYNA keyword that
   // anvil ignores, a material option it approximates); the command line prints them.
   std::vector<std::string> warnings;

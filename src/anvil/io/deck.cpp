@@ -560,7 +560,7 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
   const auto entries =
       top.entries({"title", "termination", "time_step", "materials", "parts", "particles", "sph",
                    "node_sets", "initial_conditions", "boundary_conditions", "contact",
-                   "rigid_walls", "probes", "output", "checkpoint"});
+                   "rigid_walls", "probes", "output", "checkpoint", "decomposition"});
   (void)entries;
 
   if (top.has("title")) c.title = top.child("title").str();
@@ -648,6 +648,26 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
       c.sph.rebalance_threshold = s.child("rebalance_threshold").number();
       if (!(c.sph.rebalance_threshold >= 1))
         s.child("rebalance_threshold").fail("must be at least 1");
+    }
+  }
+
+  if (top.has("decomposition")) {
+    const Node d = top.child("decomposition");
+    d.check_keys({"fe", "scale"});
+    if (d.has("fe")) {
+      const std::string m = d.child("fe").str();
+      if (m == "metis")
+        c.decomposition.fe = DecompositionConfig::Fe::metis;
+      else if (m == "rcb")
+        c.decomposition.fe = DecompositionConfig::Fe::rcb;
+      else
+        d.child("fe").fail(fmt::format("unknown FE decomposition '{}' (metis or rcb)", m));
+    }
+    if (d.has("scale")) {
+      c.decomposition.scale = d.child("scale").vec3();
+      for (int i = 0; i < 3; ++i)
+        if (!(c.decomposition.scale[i] > 0 && std::isfinite(c.decomposition.scale[i])))
+          d.child("scale").fail("each factor must be positive (a stretch of x, y, z)");
     }
   }
 

@@ -61,9 +61,10 @@ void write_decomposition(const Config& config, const std::string& outdir, const 
   for (const auto& nb : sim.fe().neighbors) shared += static_cast<double>(nb.shared.size());
   fe["shared_node_copies"] = per_rank(comm, shared);
   fe["neighbours"] = per_rank(comm, static_cast<double>(sim.fe().neighbors.size()));
-  if (comm.rank() == 0) {
+  {
     const Mesh mesh = build_mesh(config);
-    fe["edge_cut"] = partition_cut(mesh, partition_model(mesh, config, comm.size()));
+    const std::vector<int> owner = partition_model(mesh, config, comm); // collective
+    if (comm.rank() == 0) fe["edge_cut"] = partition_cut(mesh, owner);
   }
   j["fe"] = fe;
   if (const ContactPhase* cp = sim.contact()) {

@@ -336,10 +336,14 @@ struct Rcb::Work {
   std::vector<std::int64_t> gmaxes;
 };
 
-Rcb::Rcb(const Comm& comm)
-    : comm_(&comm), rank_(comm.rank()), ranks_(comm.size()),
+Rcb::Rcb(const Comm& comm, const Vec3& direction_scale)
+    : comm_(&comm), direction_scale_(direction_scale), rank_(comm.rank()), ranks_(comm.size()),
       cuts_(static_cast<std::size_t>(comm.size())), count_(static_cast<std::size_t>(comm.size())),
-      weight_(static_cast<std::size_t>(comm.size())), work_(std::make_unique<Work>()) {}
+      weight_(static_cast<std::size_t>(comm.size())), work_(std::make_unique<Work>()) {
+  for (int d = 0; d < 3; ++d)
+    if (!(direction_scale[d] > 0 && std::isfinite(direction_scale[d])))
+      throw std::invalid_argument("Rcb: the direction scale factors must be positive");
+}
 Rcb::~Rcb() = default;
 Rcb::Rcb(Rcb&&) noexcept = default;
 Rcb& Rcb::operator=(Rcb&&) noexcept = default;
@@ -478,12 +482,14 @@ void Rcb::run(const RcbPoints& in, bool incremental) {
         s.spacing = c.spacing;
       } else {
         // The longest extent of the points' box keeps subdomains closest to cubes (the
-        // paper's rule); an empty node uses its geometric box instead.
+        // paper's rule), measured in the stretched coordinates; an empty node uses its
+        // geometric box instead.
         const Box3 ext =
             empty ? s.geom : Box3{{s.lo[0], s.lo[1], s.lo[2]}, {s.hi[0], s.hi[1], s.hi[2]}};
+        auto extent = [&](int d) { return (ext.hi[d] - ext.lo[d]) * direction_scale_[d]; };
         s.dim = 0;
         for (int d = 1; d < 3; ++d)
-          if (ext.hi[d] - ext.lo[d] > ext.hi[s.dim] - ext.lo[s.dim]) s.dim = d;
+          if (extent(d) > extent(s.dim)) s.dim = d;
       }
       s.phase = Phase::First;
       const double A = s.lo[s.dim], B = s.hi[s.dim];

@@ -70,17 +70,21 @@ class Rcb {
 public:
   // comm must outlive this object; every member function taking points is collective.
   // Before the first partition, every cut is the plane x = 0 (queries are valid).
-  explicit Rcb(const Comm& comm);
+  // direction_scale stretches the coordinates when a node chooses the direction to cut
+  // (the longest of its box's extents times these factors; all positive): a factor below
+  // 1 makes cuts across that direction rarer (LS-DYNA's decomposition transformation SX,
+  // SY, SZ). The cuts' places are those of the unstretched points.
+  explicit Rcb(const Comm& comm, const Vec3& direction_scale = {1, 1, 1});
   ~Rcb();
   Rcb(Rcb&&) noexcept;
   Rcb& operator=(Rcb&&) noexcept;
 
   // Partitions from scratch: at every node, the direction is the longest extent of the
-  // bounding box of the node's points, and the first probes of the cut divide that box
-  // evenly (its midpoint, the paper's first guess, among them).
-  // With unit weights every rank ends with floor(N/P) or ceil(N/P) points; with weights
-  // every rank's weight is within the largest single weight of W/P. The result depends
-  // only on the global set of (point, gid, weight) and P, not on which rank holds what.
+  // bounding box of the node's points (times direction_scale), and the first probes of the cut
+  // divide that box evenly (its midpoint, the paper's first guess, among them). With unit weights
+  // every rank ends with floor(N/P) or ceil(N/P) points; with weights every rank's weight is within
+  // the largest single weight of W/P. The result depends only on the global set of (point, gid,
+  // weight) and P, not on which rank holds what.
   void partition(const RcbPoints& points);
 
   // Repartitions reusing the previous cuts as first guesses and their directions (so a
@@ -120,6 +124,7 @@ private:
   void run(const RcbPoints& points, bool incremental);
 
   const Comm* comm_;
+  Vec3 direction_scale_;
   int rank_ = 0, ranks_ = 1;
   std::vector<int> dest_;           // owner rank of each local input point
   std::vector<RcbCut> cuts_;        // cut tree, see above (size P; [0] unused)

@@ -32,6 +32,9 @@ std::string can_crush_deck(const CanCrushOptions& o) {
   const char* wall = o.wall == CanCrushOptions::Wall::thick_shell
                          ? "thick_shell: {points: 3}"
                          : "hourglass: {model: viscous, coefficient: 0.1}";
+  const char* decomposition = o.decomposition == CanCrushOptions::Decomposition::sectors
+                                  ? "decomposition: {fe: rcb, scale: [1, 1, 0.25]}\n"
+                                  : "";
   return fmt::format(R"(title: Scaled can crush, {} ranks
 termination: {}
 time_step: {{scale: 0.9}}
@@ -55,9 +58,9 @@ contact:
 probes:
   - {{name: block, at: [0, 0, 0.1005]}}
 output: {{fields_every: 1.6e-3, history_every: 1.0e-5}}
-)",
+{})",
                      o.ranks, termination, can[0], can[1], can[2], wall, block[0], block[1],
-                     block[2]);
+                     block[2], decomposition);
 }
 
 Config can_crush_config(const CanCrushOptions& o) {

@@ -22,6 +22,13 @@ struct CanCrushOptions {
   // bends through hourglass modes).
   enum class Wall { thick_shell, one_point };
   Wall wall = Wall::thick_shell;
+  // The decompositions: the paper's (METIS for the elements, RCBs cutting the longest
+  // direction for contact), or sectors: every decomposition an RCB whose cuts run along
+  // the can's axis (z stretched by 1/4 when a cut direction is chosen), so that each rank
+  // holds a sector of the can and of the block in the FE and the contact decomposition
+  // alike, and the contact zone (a ring) is shared by every rank.
+  enum class Decomposition { paper, sectors };
+  Decomposition decomposition = Decomposition::paper;
 };
 
 // The deck text of the problem (YAML), for `anvil bench can-crush` and the tests.

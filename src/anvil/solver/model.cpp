@@ -14,6 +14,7 @@
 #include "anvil/mesh/read_exodus.hpp"
 #include "anvil/mesh/read_gmsh.hpp"
 #include "anvil/parallel/graph_partition.hpp"
+#include "anvil/parallel/rcb.hpp"
 
 namespace anvil {
 
@@ -153,12 +154,49 @@ std::vector<std::int64_t> resolve_selection(const Mesh& mesh, const Config& conf
   return ids;
 }
 
-std::vector<int> partition_model(const Mesh& mesh, const Config& config, int parts) {
+std::vector<int> partition_model(const Mesh& mesh, const Config& config, const Comm& comm) {
   std::vector<int> weight;
   weight.reserve(config.parts.size());
   for (const auto& part : config.parts)
     weight.push_back(element_cost(part.hourglass, part.thick_shell));
-  return partition_elements(mesh, parts, weight);
+  std::vector<int> owner;
+  if (config.decomposition.fe == DecompositionConfig::Fe::metis) {
+    if (comm.rank() == 0) owner = partition_elements(mesh, comm.size(), weight);
+    comm.broadcast(owner, 0);
+    return owner;
+  }
+  // RCB: rank r brings the elements [r ne / P, (r + 1) ne / P) in global order, each at
+  // its centre (the mean of its corners) with its global id and its block's weight. The
+  // partition depends only on the whole set, not on who brings what.
+  const std::int64_t ne = mesh.num_elements(), ranks = comm.size(), r = comm.rank();
+  const std::int64_t first = ne * r / ranks, last = ne * (r + 1) / ranks;
+  const auto n = static_cast<std::size_t>(last - first);
+  std::vector<double> x(n), y(n), z(n), w(n);
+  std::vector<std::int64_t> gid(n);
+  std::int64_t e = 0;
+  for (std::size_t b = 0; b < mesh.blocks.size(); ++b)
+    for (const auto& h : mesh.blocks[b].elements) {
+      if (e >= first && e < last) {
+        Vec3 c{0, 0, 0};
+        for (const auto node : h) c = c + mesh.nodes[static_cast<std::size_t>(node)];
+        const auto k = static_cast<std::size_t>(e - first);
+        x[k] = 0.125 * c.x;
+        y[k] = 0.125 * c.y;
+        z[k] = 0.125 * c.z;
+        gid[k] = e;
+        w[k] = weight[b];
+      }
+      ++e;
+    }
+  Rcb rcb(comm, config.decomposition.scale);
+  rcb.partition({x, y, z, gid, w});
+  // Every rank learns every owner: its own range filled, the others' -1, a maximum.
+  std::vector<std::int64_t> all(static_cast<std::size_t>(ne), -1);
+  const auto dest = rcb.destinations();
+  for (std::size_t k = 0; k < n; ++k) all[static_cast<std::size_t>(first) + k] = dest[k];
+  comm.max(std::span<std::int64_t>(all));
+  owner.assign(all.begin(), all.end());
+  return owner;
 }
 
 } // namespace anvil

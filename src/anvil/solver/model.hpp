@@ -7,6 +7,7 @@
 
 #include "anvil/io/config.hpp"
 #include "anvil/mesh/mesh.hpp"
+#include "anvil/parallel/comm.hpp"
 
 namespace anvil {
 
@@ -18,10 +19,12 @@ Mesh build_mesh(const Config& config);
 std::vector<std::int64_t> resolve_selection(const Mesh& mesh, const Config& config,
                                             const Selection& sel);
 
-// The static FE decomposition of the model (DESIGN.md section 1): the owner rank of every
-// element in global element order, METIS k-way on the element dual graph with each
-// element weighted by its formulation's cost (element_cost), so that a thick-shell part
-// and a solid part share the ranks by work, not by count.
-std::vector<int> partition_model(const Mesh& mesh, const Config& config, int parts);
+// The static FE decomposition of the model (DESIGN.md section 1; `decomposition` in the
+// deck): the owner rank of every element in global element order, the same on every
+// rank. METIS k-way on the element dual graph (run on rank 0, its answer broadcast), or
+// an RCB of the element centres in the deck's stretched coordinates; both weigh each
+// element by its formulation's cost (element_cost), so that a thick-shell part and a
+// solid part share the ranks by work, not by count. Collective.
+std::vector<int> partition_model(const Mesh& mesh, const Config& config, const Comm& comm);
 
 } // namespace anvil

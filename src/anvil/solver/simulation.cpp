@@ -17,14 +17,11 @@ Simulation::~Simulation() = default;
 
 Simulation::Simulation(const Config& config, const Comm& comm) : config_(config), comm_(comm) {
   // The global mesh is built on every rank (generators and readers are deterministic);
-  // METIS runs on rank 0 (partition_model) and its answer is broadcast so that every rank
-  // agrees.
+  // every rank gets the same owner of every element (partition_model).
   const Mesh mesh = build_mesh(config_);
   global_elements_ = mesh.num_elements();
   block_offsets_ = mesh.block_offsets();
-  std::vector<int> owner;
-  if (comm_.rank() == 0) owner = partition_model(mesh, config_, comm_.size());
-  comm_.broadcast(owner, 0);
+  const std::vector<int> owner = partition_model(mesh, config_, comm_);
   fe_ = decompose_fe(mesh, owner, comm_.rank(), comm_.size());
   corner_exchange_ = std::make_unique<CornerExchange>(fe_, comm_);
   // Nodes that no element uses (mid-side nodes of imported quadratic elements, stray
@@ -94,7 +91,8 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
 
   wall_impulse_.assign(config_.rigid_walls.size(), 0.0);
   if (!config_.contact.empty()) {
-    contact_ = std::make_unique<ContactPhase>(config_.contact[0], mesh, fe_, blocks_, comm_);
+    contact_ = std::make_unique<ContactPhase>(config_.contact[0], mesh, fe_, blocks_, comm_,
+                                              config_.decomposition.scale);
     for (auto& f : contact_force_) f.assign(nn, 0.0);
   }
   if (!config_.particles.empty()) {

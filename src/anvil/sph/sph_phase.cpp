@@ -19,7 +19,8 @@ double seconds_since(PhaseTimers::clock::time_point t0) {
 
 SphPhase::SphPhase(const Config& config, const std::function<const Material*(int)>& material,
                    const Comm& comm)
-    : comm_(comm), rcb_(comm), threshold_(config.sph.rebalance_threshold) {
+    : comm_(comm), rcb_(comm, config.decomposition.scale),
+      threshold_(config.sph.rebalance_threshold) {
   const auto& psets = config.particles;
   for (std::size_t s = 0; s < psets.size(); ++s) {
     const auto& ps = psets[s];
