@@ -98,7 +98,10 @@ def describe(series):
         machine = f"; {cores(series.nproc)}"
         if m.get("cpu_model"):
             machine += f" ({m['cpu_model']})"
-    return f"{size} elements per rank, {cyc}{machine}"
+    decomposition = ""
+    if m.get("decomposition", "paper") != "paper":
+        decomposition = f", {m['decomposition']} decomposition"
+    return f"{size} elements per rank, {cyc}{decomposition}{machine}"
 
 
 def cores(n):
