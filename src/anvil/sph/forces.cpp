@@ -518,15 +518,40 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
   bool any_corrected = false;
   for (const auto& st : sets) any_corrected = any_corrected || st.corrected;
   if (any_corrected) w.binv.resize(9 * n);
+  // Pass 1's records, and their copy into the first two groups of pass 2's (x, h; v and
+  // a volume that c replaces after the material update).
+  using R2 = NeighbourRead2;
+  static_assert(sizeof(NeighbourRead1) == 8 * sizeof(double) && R2::v == R2::x + 4);
   w.read1.resize(p.n_all);
-  for (std::size_t i = 0; i < p.n_all; ++i) {
-    NeighbourRead1& r = w.read1[i];
-    for (int a = 0; a < 3; ++a) {
-      r.x[a] = p.x[a][i];
-      r.v[a] = p.v[a][i];
+  w.read2.resize(p.n_all);
+  std::size_t k0 = 0;
+  for (; k0 + width <= p.n_all; k0 += width) { // `width` records per 4 x 4 transpose
+    auto ld = [&](const double* a) { return simd::load(a + k0); };
+    double *q1[width], *q2[width];
+    for (int l = 0; l < width; ++l) {
+      q1[l] = reinterpret_cast<double*>(&w.read1[k0 + static_cast<std::size_t>(l)]);
+      q2[l] = w.read2[k0 + static_cast<std::size_t>(l)].a;
     }
-    r.h = p.h[i];
-    r.volume = p.mass[i] / p.rho[i];
+    const vdouble xh[4] = {ld(p.x[0]), ld(p.x[1]), ld(p.x[2]), ld(p.h)};
+    const vdouble vv[4] = {ld(p.v[0]), ld(p.v[1]), ld(p.v[2]), ld(p.mass) / ld(p.rho)};
+    simd::scatter4(q1, xh);
+    simd::scatter4(q2, xh);
+    for (int l = 0; l < width; ++l) {
+      q1[l] += 4;
+      q2[l] += R2::v;
+    }
+    simd::scatter4(q1, vv);
+    simd::scatter4(q2, vv);
+  }
+  for (std::size_t i = k0; i < p.n_all; ++i) {
+    NeighbourRead1& r = w.read1[i];
+    double* r2 = w.read2[i].a;
+    for (int a = 0; a < 3; ++a) {
+      r2[R2::x + a] = r.x[a] = p.x[a][i];
+      r2[R2::v + a] = r.v[a] = p.v[a][i];
+    }
+    r2[R2::h] = r.h = p.h[i];
+    r2[R2::c] = r.volume = p.mass[i] / p.rho[i];
   }
   filter_neighbours(w.read1.data()->x, sizeof(NeighbourRead1) / sizeof(double), candidates, w.nl);
   w.dwr.resize(static_cast<std::size_t>(w.nl.start.back()));
@@ -581,6 +606,8 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
   // particles at a time where none normalises its gradient or has an artificial stress
   // (P = sigma, R = 0: the same operations per particle), else one at a time. Where no
   // set does, pass 2 reads neither R nor S6-S8 (the shear again): they are not written.
+  // P's first six components, the new density, the mass and the wave speed go straight
+  // into pass 2's records (the exchange sends them from there).
   const bool all_plain = !any_corrected && !any_epsilon;
   auto plain = [&](std::size_t i) {
     const SetParams& st = sets[static_cast<std::size_t>(p.set[i])];
@@ -601,10 +628,16 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
       simd::store(simd::load(p.energy + i) +
                       0.5 * (simd::load(w.power_old.data() + i) + power) * dt / rho,
                   p.energy + i);
-      for (int k = 0; k < 6; ++k) simd::store(s[k], p.S[k] + i);
+      double* q[width];
+      for (int l = 0; l < width; ++l) q[l] = w.read2[i + static_cast<std::size_t>(l)].a + R2::S;
+      simd::scatter4(q, {s[0], s[1], s[2], s[3]});
+      for (auto& ql : q) ql += R2::S45 - R2::S;
+      simd::scatter4(q, {s[4], s[5], rho, simd::load(p.mass + i)});
+      for (int l = 0; l < width; ++l)
+        q[l][R2::c - R2::S45] = p.wave_speed[i + static_cast<std::size_t>(l)];
       if (!all_plain) {
         for (int k = 0; k < 6; ++k) simd::store(0.0, p.R[k] + i);
-        for (int k = 6; k < 9; ++k) simd::store(s[k - 3], p.S[k] + i);
+        for (int k = 0; k < 3; ++k) simd::store(s[k + 3], p.S678[k] + i);
       }
       i += width;
       continue;
@@ -616,6 +649,7 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
                          2 * (s[3] * w.d[3][i] + s[4] * w.d[4][i] + s[5] * w.d[5][i]);
     const double rho = p.rho[i];
     p.energy[i] += 0.5 * (w.power_old[i] + power) * dt / rho;
+    double* r = w.read2[i].a;
     if (si.corrected) {
       // P = sigma B^-T: P_ab = sigma_ac Bi_bc (pass 2's stress for this particle).
       const double* bi = &w.binv[9 * i];
@@ -626,13 +660,15 @@ void sph_kinematics(const SphView& p, std::span<const SetParams> sets, KernelTyp
           P[a][b] = sg[a][0] * bi[3 * b] + sg[a][1] * bi[3 * b + 1] + sg[a][2] * bi[3 * b + 2];
       const double pk[9] = {P[0][0], P[1][1], P[2][2], P[0][1], P[1][2],
                             P[0][2], P[1][0], P[2][1], P[2][0]};
-      for (int k = 0; k < 9; ++k) p.S[k][i] = pk[k];
+      for (int k = 0; k < 6; ++k) r[R2::S + k] = pk[k];
+      for (int k = 0; k < 3; ++k) p.S678[k][i] = pk[k + 6];
     } else {
-      for (int k = 0; k < 6; ++k) p.S[k][i] = s[k];
-      p.S[6][i] = s[3];
-      p.S[7][i] = s[4];
-      p.S[8][i] = s[5];
+      for (int k = 0; k < 6; ++k) r[R2::S + k] = s[k];
+      for (int k = 0; k < 3; ++k) p.S678[k][i] = s[k + 3];
     }
+    r[R2::c] = p.wave_speed[i];
+    r[R2::rho] = rho;
+    r[R2::mass] = p.mass[i];
     double R[6] = {0, 0, 0, 0, 0, 0};
     if (si.epsilon > 0) artificial_stress(s, si.epsilon, R);
     for (int k = 0; k < 6; ++k) p.R[k][i] = R[k];
@@ -877,13 +913,13 @@ void smoothing_lengths(std::span<const SetParams> sets, const int* set, const do
 
 void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType kernel,
                 SphWorkspace& w, SphResult& res) {
-  using R2 = NeighbourRead2;
   using R2r = NeighbourRead2Rest;
   bool any_corrected = false, any_epsilon = false;
   for (const auto& st : sets) {
     any_corrected = any_corrected || st.corrected;
     any_epsilon = any_epsilon || st.epsilon > 0;
   }
+  // The records hold what the common path reads (pass 1 and the exchange filled them).
   // The rest records are read only by a normalised gradient, an artificial stress (its
   // groups S6-S8 and has_r, R0-R3, R4, R5) and sets of different viscosity (alpha, beta):
   // without those they are not written (forces_pairs reads them under the same conditions).
@@ -892,38 +928,25 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
   });
   const bool stress_rest = any_corrected || any_epsilon;
   const bool any_rest = stress_rest || !same_visc;
-  w.read2.resize(p.n_all);
   w.read2r.resize(p.n_all);
   w.low2.resize(p.n_all); // zeros as pass 1's (sph_kinematics)
   if (!w.low2_zero) std::fill(w.low2.begin(), w.low2.end(), LowerSums2{});
   w.low2_zero = false;
   // `width` records at a time: four fields of every record per 4 x 4 transpose.
   std::size_t i0 = 0;
-  for (; i0 + width <= p.n_all; i0 += width) {
-    double *q[width], *qr[width];
-    for (int l = 0; l < width; ++l) {
-      q[l] = w.read2[i0 + static_cast<std::size_t>(l)].a;
-      qr[l] = w.read2r[i0 + static_cast<std::size_t>(l)].a;
-    }
-    auto put_in = [&](double* const* base, int offset, const vdouble& a, const vdouble& b,
-                      const vdouble& c, const vdouble& d) {
+  for (; any_rest && i0 + width <= p.n_all; i0 += width) {
+    double* qr[width];
+    for (int l = 0; l < width; ++l) qr[l] = w.read2r[i0 + static_cast<std::size_t>(l)].a;
+    auto put_r = [&](int offset, const vdouble& a, const vdouble& b, const vdouble& c,
+                     const vdouble& d) {
       double* qo[width];
-      for (int l = 0; l < width; ++l) qo[l] = base[l] + offset;
+      for (int l = 0; l < width; ++l) qo[l] = qr[l] + offset;
       simd::scatter4(qo, {a, b, c, d});
     };
-    auto put = [&](int offset, const vdouble& a, const vdouble& b, const vdouble& c,
-                   const vdouble& d) { put_in(q, offset, a, b, c, d); };
-    auto put_r = [&](int offset, const vdouble& a, const vdouble& b, const vdouble& c,
-                     const vdouble& d) { put_in(qr, offset, a, b, c, d); };
     auto ld = [&](const double* a) { return simd::load(a + i0); };
     auto per_set = [&](auto field) {
       return vdouble([&](auto l) { return field(sets[static_cast<std::size_t>(p.set[i0 + l])]); });
     };
-    put(R2::x, ld(p.x[0]), ld(p.x[1]), ld(p.x[2]), ld(p.h));
-    put(R2::v, ld(p.v[0]), ld(p.v[1]), ld(p.v[2]), ld(p.wave_speed));
-    put(R2::S, ld(p.S[0]), ld(p.S[1]), ld(p.S[2]), ld(p.S[3]));
-    put(R2::S45, ld(p.S[4]), ld(p.S[5]), ld(p.rho), ld(p.mass));
-    if (!any_rest) continue;
     vdouble R4 = 0.0, R5 = 0.0; // R is zero without an artificial stress
     if (stress_rest) {
       vdouble R[4];
@@ -934,24 +957,13 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
           R[0] != 0.0 || R[1] != 0.0 || R[2] != 0.0 || R[3] != 0.0 || R4 != 0.0 || R5 != 0.0;
       vdouble has_r = 0.0;
       stdx::where(any, has_r) = 1.0;
-      put_r(R2r::S6, ld(p.S[6]), ld(p.S[7]), ld(p.S[8]), has_r);
+      put_r(R2r::S6, ld(p.S678[0]), ld(p.S678[1]), ld(p.S678[2]), has_r);
       put_r(R2r::R, R[0], R[1], R[2], R[3]);
     }
     put_r(R2r::R45, R4, R5, per_set([](const SetParams& st) { return st.alpha; }),
           per_set([](const SetParams& st) { return st.beta; }));
   }
-  for (std::size_t i = i0; i < p.n_all; ++i) {
-    double* r = w.read2[i].a;
-    for (int a = 0; a < 3; ++a) {
-      r[R2::x + a] = p.x[a][i];
-      r[R2::v + a] = p.v[a][i];
-    }
-    r[R2::h] = p.h[i];
-    r[R2::c] = p.wave_speed[i];
-    r[R2::rho] = p.rho[i];
-    r[R2::mass] = p.mass[i];
-    for (int c = 0; c < 6; ++c) r[R2::S + c] = p.S[c][i];
-    if (!any_rest) continue;
+  for (std::size_t i = i0; any_rest && i < p.n_all; ++i) {
     double* rr = w.read2r[i].a;
     const SetParams& si = sets[static_cast<std::size_t>(p.set[i])];
     double R[6] = {0, 0, 0, 0, 0, 0};
@@ -961,7 +973,7 @@ void sph_forces(const SphView& p, std::span<const SetParams> sets, KernelType ke
         R[c] = p.R[c][i];
         any |= R[c] != 0.0;
       }
-      for (int c = 6; c < 9; ++c) rr[R2r::S6 + c - 6] = p.S[c][i];
+      for (int c = 0; c < 3; ++c) rr[R2r::S6 + c] = p.S678[c][i];
       rr[R2r::has_r] = any ? 1.0 : 0.0;
       for (int c = 0; c < 4; ++c) rr[R2r::R + c] = R[c];
     }

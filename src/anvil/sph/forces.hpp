@@ -86,14 +86,16 @@ struct SphView {
   double* energy = nullptr; // specific internal energy, J/kg
   double* plastic_strain = nullptr;
   double* temperature = nullptr;
-  // all: written by pass 1 for own particles, read by pass 2 for all
+  // own: written by pass 1 (and into pass 2's records, NeighbourRead2)
   double* wave_speed = nullptr;
-  // The stress the momentum equation pairs, P = sigma B^-T (a copy the ghosts receive;
-  // xx yy zz xy yz xz yx zy zx, row index first), Pa: sigma itself (the last three
-  // repeat the shear) unless the set normalises its gradient.
-  double* S[9] = {};
+  // The stress the momentum equation pairs, P = sigma B^-T (xx yy zz xy yz xz yx zy zx,
+  // row index first), Pa: sigma itself (the last three repeat the shear) unless the set
+  // normalises its gradient. Pass 1 writes its first six components into pass 2's
+  // records (SphWorkspace::read2) and the last three here; all: the ghost part from the
+  // exchange.
+  double* S678[3] = {};
   double* R[6] = {}; // artificial stress, Pa
-  // (S6-S8 and R are written only where some set normalises its gradient or has an
+  // (S678 and R are written only where some set normalises its gradient or has an
   // artificial stress: pass 2 reads them only then.)
   // own, out of pass 2
   double* force[3] = {};         // N
@@ -108,8 +110,8 @@ struct SphResult {
 
 // What one pass reads of a neighbour, packed per particle in groups of four doubles
 // (simd::gather4 loads a group of `width` neighbours and transposes it: vector loads
-// instead of lane-by-lane gathers): built for own and ghost particles at the start of a
-// pass.
+// instead of lane-by-lane gathers), for own and ghost particles. Pass 1's record, built
+// at its start:
 struct alignas(64) NeighbourRead1 {
   double x[3], h;
   double v[3], volume; // m / rho
@@ -119,10 +121,17 @@ struct alignas(64) NeighbourRead1 {
 // 32^3 particles the records of the +2 lattice planes a sweep of rows reads no longer fit
 // in a 1 MB L2 cache). NeighbourRead2: x, h; v, c; S0-S3; S4, S5, rho, m: every value a
 // pair needs without a normalised gradient or an artificial stress (a neighbour's 1/rho
-// is divided in the loop, the row particle's once per row).
+// is divided in the loop, the row particle's once per row). Filled where its values are
+// made instead of copied from the arrays at the start of pass 2: x, h and v at pass 1's
+// start (a copy of NeighbourRead1's two groups, whose volume c replaces), the new
+// stress, rho, m and c after pass 1's material update for own particles, and by the
+// ghost exchange for the ghosts (SphPhase). (One record for both passes, pass 1
+// reading the first 64 bytes of 128, was 4% slower at 32^3: pass 1 and the filter read
+// twice the memory.)
 // NeighbourRead2Rest (96 bytes, whole 32-byte groups): a normalised gradient reads the
 // first group (S6-S8), the artificial stress the first (has_r), second and third, sets of
-// different viscosity the third (alpha, beta); written only where one of them is there.
+// different viscosity the third (alpha, beta); packed by pass 2 only where one of them is
+// there.
 // The row particle takes its own alpha, beta from its set.
 struct alignas(64) NeighbourRead2 {
   static constexpr int x = 0, h = 3, v = 4, c = 7, S = 8, S45 = 12, rho = 14, mass = 15;

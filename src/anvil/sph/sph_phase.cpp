@@ -202,21 +202,30 @@ void SphPhase::exchange_ghosts_in() {
 }
 
 void SphPhase::exchange_ghosts_out() {
+  using Rec = NeighbourRead2;
   const std::size_t n = p_.stress[0].size(); // own particles (not extended)
   out_send_.resize(ghost_src_.size());
   for (std::size_t k = 0; k < ghost_src_.size(); ++k) {
     const auto i = static_cast<std::size_t>(ghost_src_[k]);
+    const double* r = work_.read2[i].a; // pass 1 wrote S0-S5, rho and c there
     GhostOut& g = out_send_[k];
-    for (int c = 0; c < 9; ++c) g.S[c] = S_[c][i];
+    for (int c = 0; c < 6; ++c) g.S[c] = r[Rec::S + c];
+    for (int c = 0; c < 3; ++c) g.S[6 + c] = S678_[c][i];
     for (int c = 0; c < 6; ++c) g.R[c] = R_[c][i];
-    g.rho = p_.rho[i];
-    g.c = p_.wave_speed[i];
+    g.rho = r[Rec::rho];
+    g.c = r[Rec::c];
   }
   ghost_plan_.forward(out_send_, out_recv_);
   for (std::size_t k = 0; k < out_recv_.size(); ++k) {
     const GhostOut& g = out_recv_[k];
     const std::size_t i = n + k;
-    for (int c = 0; c < 9; ++c) S_[c][i] = g.S[c];
+    // Into the ghost's record (pass 1 wrote its x, h, v and volume) and the rest's arrays.
+    double* r = work_.read2[i].a;
+    for (int c = 0; c < 6; ++c) r[Rec::S + c] = g.S[c];
+    r[Rec::rho] = g.rho;
+    r[Rec::mass] = p_.mass[i];
+    r[Rec::c] = g.c;
+    for (int c = 0; c < 3; ++c) S678_[c][i] = g.S[6 + c];
     for (int c = 0; c < 6; ++c) R_[c][i] = g.R[c];
     p_.rho[i] = g.rho;
     p_.wave_speed[i] = g.c;
@@ -333,7 +342,7 @@ void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
   }
 
   const std::size_t na = p_.gid.size();
-  for (auto& a : S_) a.resize(na);
+  for (auto& a : S678_) a.resize(na);
   for (auto& a : R_) a.resize(na);
   for (auto& a : p_.f) a.resize(n);
   energy_rate_.resize(n);
@@ -354,7 +363,7 @@ void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
     view.stress[c] = p_.stress[c].data();
     view.R[c] = R_[c].data();
   }
-  for (int c = 0; c < 9; ++c) view.S[c] = S_[c].data();
+  for (int c = 0; c < 3; ++c) view.S678[c] = S678_[c].data();
   view.energy = p_.energy.data();
   view.plastic_strain = p_.plastic_strain.data();
   view.temperature = p_.temperature.data();

@@ -100,7 +100,8 @@ private:
   // particles (extends the neighbour-read arrays). Collective.
   void exchange_ghosts_in();
   // Sends what pass 2 reads (stress, artificial stress, new rho, wave speed) along the
-  // same plan into the ghost part of S_, R_, rho and wave_speed. Collective.
+  // same plan into the ghosts' records (work_.read2: P's first six components, rho, mass,
+  // c) and the ghost part of S678_, R_, rho and wave_speed. Collective.
   void exchange_ghosts_out();
   // Sizes the arrays that neighbours read to n entries (own + ghosts, or own only);
   // capacity is kept.
@@ -142,7 +143,7 @@ private:
   };
   std::vector<GhostIn> in_send_, in_recv_;
   std::vector<GhostOut> out_send_, out_recv_;
-  std::vector<double> S_[9], R_[6], energy_rate_;
+  std::vector<double> S678_[3], R_[6], energy_rate_;
   std::vector<int> ranks_, dest_, perm_;
   std::vector<double> tmp_d_;
   std::vector<std::int64_t> tmp_l_;
