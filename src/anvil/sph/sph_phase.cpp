@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "anvil/core/simd.hpp"
 #include "anvil/sph/lattice.hpp"
 
 namespace anvil::sph {
@@ -243,20 +244,44 @@ void SphPhase::forces(double dt_prev, PhaseTimers& timers) {
   {
     ScopedPhase t(timers, Phase::sph);
     const Box3 box = rcb_.box(me);
+    // simd::width particles at a time, then the rest one at a time: the same test and
+    // maxima (a maximum is exact in any order; a NaN is skipped by both forms, and fails
+    // Box3::contains as it fails the lanes' comparisons).
+    using simd::vdouble;
+    constexpr std::size_t w = simd::width;
+    const bool moved = lists_valid_ && x_build_[0].size() == n;
+    vdouble out_v = 0.0, hmax_v = 0.0, d2max_v = 0.0;
+    std::size_t i0 = 0;
+    for (; i0 + w <= n; i0 += w) {
+      const vdouble x = simd::load(p_.x[0].data() + i0), y = simd::load(p_.x[1].data() + i0),
+                    z = simd::load(p_.x[2].data() + i0), h = simd::load(p_.h.data() + i0);
+      const auto in = x >= box.lo.x && x <= box.hi.x && y >= box.lo.y && y <= box.hi.y &&
+                      z >= box.lo.z && z <= box.hi.z;
+      simd::stdx::where(!in, out_v) = 1.0;
+      simd::stdx::where(hmax_v < h, hmax_v) = h;
+      if (!moved) continue;
+      const vdouble dx = x - simd::load(x_build_[0].data() + i0),
+                    dy = y - simd::load(x_build_[1].data() + i0),
+                    dz = z - simd::load(x_build_[2].data() + i0);
+      const vdouble d2 = dx * dx + dy * dy + dz * dz;
+      simd::stdx::where(d2max_v < d2, d2max_v) = d2;
+    }
     double escaped = 0, hmax = 0, d2max = 0;
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t l = 0; l < w; ++l) {
+      escaped = std::max(escaped, static_cast<double>(out_v[l]));
+      hmax = std::max(hmax, static_cast<double>(hmax_v[l]));
+      d2max = std::max(d2max, static_cast<double>(d2max_v[l]));
+    }
+    for (std::size_t i = i0; i < n; ++i) {
       const Vec3 x{p_.x[0][i], p_.x[1][i], p_.x[2][i]};
       escaped = box.contains(x) ? escaped : 1.0;
       hmax = std::max(hmax, p_.h[i]);
+      if (!moved) continue;
+      const double dx = p_.x[0][i] - x_build_[0][i], dy = p_.x[1][i] - x_build_[1][i],
+                   dz = p_.x[2][i] - x_build_[2][i];
+      d2max = std::max(d2max, dx * dx + dy * dy + dz * dz);
     }
-    if (lists_valid_ && x_build_[0].size() == n)
-      for (std::size_t i = 0; i < n; ++i) {
-        const double dx = p_.x[0][i] - x_build_[0][i], dy = p_.x[1][i] - x_build_[1][i],
-                     dz = p_.x[2][i] - x_build_[2][i];
-        d2max = std::max(d2max, dx * dx + dy * dy + dz * dz);
-      }
-    else
-      d2max = std::numeric_limits<double>::infinity();
+    if (!moved) d2max = std::numeric_limits<double>::infinity();
     double red[4] = {static_cast<double>(n), escaped, hmax, d2max};
     comm_.max(std::span<double>(red, 4));
     const double mean = static_cast<double>(global_count_) / comm_.size();
