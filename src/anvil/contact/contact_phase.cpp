@@ -313,15 +313,21 @@ double ContactPhase::build_deviation(std::size_t f) const {
 // still valid, and (2) every face whose capture box holds a node is held where the node is.
 // (1): each receiver tells each item's sender how far it may still move (its lists' 0.45
 // skin less its deviation from the build, as set_lazy_reference() does on one rank). (2):
-// at the cycle its destinations were computed, node n was in the box of its rank r (at
-// x0), and face f went to every rank that its capture box B0, enlarged by g, touches.
-// While n has moved at most 0.45 g from x0 and each side of f's box at most 0.45 g from
-// B0, a box B that holds n now had x0 within 0.9 g of B0, so B0 enlarged by g overlapped
-// r's box around x0 (Rcb::overlapping reports r), and f is on r. The budget of each item
-// is the smaller of the two. Each cycle checks every node exactly and bounds every face's
-// box (shared_bound_holds); a face whose bound fails is checked exactly, and if within its
-// budget gets a new reference (rebase_faces). Any failure makes the next cycle full on
-// every rank (detect()).
+// at the cycle its destinations were computed, node n was in the box of its rank r, and
+// face f went to every rank that its capture box B0, enlarged by g, touches (so B0 is at
+// least g from the box of every other rank, in the largest coordinate). Kept: every node
+// within 0.45 g of its rank's box, and every face's box B more than 0.45 g from the box
+// of every rank it did not go to. Then a box B that holds n is within 0.45 g of r's box,
+// and f is on r. A node's ghosting budget is therefore 0.45 g plus how deep inside r's
+// box its reference position is (negative outside; ghost_budget()); a face's, how far its
+// box may move before it comes within 0.5 g of another rank's box: at least 0.45 g less
+// its moves since B0 (B0 is g from them), and, where it went to one rank only, its box's
+// depth inside that rank's box less 0.5 g (every other box is outside that one); where it
+// went to every rank, unlimited. The budget of each item is the smaller of the two. Each
+// cycle checks the nodes against their budgets (each when drift_ says it could fail) and
+// bounds every face's box (shared_bound_holds); a face whose bound fails is checked
+// exactly, and if within its budget gets a new reference (rebase_faces). Any failure
+// makes the next cycle full on every rank (detect()).
 void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live, bool recomputed) {
   const std::size_t nf = my_face_gid_.size(), nn = my_nodes_.size();
   const std::size_t nfp = static_cast<std::size_t>(simd::padded_size(static_cast<int>(nf)));
@@ -330,17 +336,30 @@ void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live
   const double inf = std::numeric_limits<double>::infinity();
   const double h = 0.45 * w.skin, gh = 0.45 * ghost_margin_;
   // The ghosting: full budgets where the destinations were just computed, else what is
-  // left of them (the references are those of the last full cycle or rebase).
+  // left of them (the references are those of the last full cycle or rebase); the faces'
+  // budgets from their depth inside their rank's box are added in set_face_reference().
+  // A node's from its position in its rank's box, now.
+  sn_ghost_.resize(nn);
+  for (std::size_t k = 0; k < nn; ++k) {
+    const auto p = static_cast<std::size_t>(node_point_[k]);
+    sn_ghost_[k] = gh + depth_in_box(xs_[0][p], xs_[1][p], xs_[2][p], xs_[0][p], xs_[1][p],
+                                     xs_[2][p], node_dest_[k]);
+  }
   if (recomputed) {
-    sn_ghost_.assign(nn, gh);
     sf_ghost_.assign(nfp, gh);
-  } else {
-    for (std::size_t k = 0; k < nn; ++k) {
-      const auto p = static_cast<std::size_t>(node_point_[k]);
-      double e = 0;
-      for (int i = 0; i < 3; ++i) e = std::max(e, std::abs(xs_[i][p] - sn_x_[i][k]));
-      sn_ghost_[k] -= e;
+    // Per face: its one rank, -2 where it went to every rank, else -1.
+    sf_dest_.assign(nf, -1);
+    for (std::size_t c0 = 0; c0 < face_src_.size();) {
+      std::size_t c1 = c0 + 1;
+      while (c1 < face_src_.size() && face_src_[c1] == face_src_[c0]) ++c1;
+      const auto f = static_cast<std::size_t>(face_src_[c0]);
+      if (c1 - c0 == 1)
+        sf_dest_[f] = face_dest_[c0];
+      else if (c1 - c0 == static_cast<std::size_t>(comm_.size()))
+        sf_dest_[f] = -2;
+      c0 = c1;
     }
+  } else {
     for (std::size_t f = 0; f < nf; ++f) {
       double e = 0;
       for (int s = 0; s < 6; ++s)
@@ -395,13 +414,14 @@ void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live
   keep_recv_.resize(nr);
   for (std::size_t j = 0; j < nr; ++j) keep_recv_[j] = static_cast<char>(fb_recv_[j].keep);
   keep_send_.resize(fb_send_.size());
-  sf_budget_.assign(nfp, inf); // dead faces and the padding never fail
+  sf_list_.assign(nfp, inf); // dead faces and the padding never fail
+  sf_budget_.assign(nfp, inf);
   sub_faces_.clear();
   for (std::size_t c = 0; c < fb_send_.size(); ++c) { // copies in ascending face order
     const int f = face_src_[c];
     keep_send_[c] = static_cast<char>(fb_send_[c].keep);
-    auto& budget = sf_budget_[static_cast<std::size_t>(f)];
-    budget = std::min(budget, std::min(fb_send_[c].budget, sf_ghost_[static_cast<std::size_t>(f)]));
+    auto& budget = sf_list_[static_cast<std::size_t>(f)];
+    budget = std::min(budget, fb_send_[c].budget);
     if (keep_send_[c] != 0 && (sub_faces_.empty() || sub_faces_.back() != f))
       sub_faces_.push_back(f);
   }
@@ -445,17 +465,35 @@ void ContactPhase::set_bound_reference(std::size_t f) {
 }
 
 void ContactPhase::set_face_reference(std::size_t f) {
-  set_bound_reference(f);
-  if (f >= my_face_gid_.size()) return; // padding
+  if (f >= my_face_gid_.size() || !alive(f)) { // (sf_budget_[f] is infinite)
+    set_bound_reference(f);
+    if (f < my_face_gid_.size())
+      for (int i = 0; i < 3; ++i) {
+        sf_box_[i][f] = cap_.lo[i][f];
+        sf_box_[3 + i][f] = cap_.hi[i][f];
+      }
+    return;
+  }
   for (int i = 0; i < 3; ++i) {
     sf_box_[i][f] = cap_.lo[i][f];
     sf_box_[3 + i][f] = cap_.hi[i][f];
   }
-  if (!alive(f)) return;
-  // The centre moves no more than the corners, at most 0.45 g while the bound holds: only
-  // a face whose centre is nearer its rank's box side can change rank.
+  // The ghosting budget from the box's depth inside its one rank's box (set_shared_reference()).
+  const int d = sf_dest_[f];
+  if (d == -2) {
+    sf_ghost_[f] = std::numeric_limits<double>::infinity();
+  } else if (d >= 0) {
+    const double depth = depth_in_box(cap_.lo[0][f], cap_.lo[1][f], cap_.lo[2][f], cap_.hi[0][f],
+                                      cap_.hi[1][f], cap_.hi[2][f], d);
+    sf_ghost_[f] = std::max(sf_ghost_[f], depth - 0.5 * ghost_margin_);
+  }
+  double budget = std::min(sf_list_[f], sf_ghost_[f]);
+  // The centre moves no more than the bound allows the box sides (face_motion()): a face
+  // whose centre is 0.5 g or more inside its rank's box keeps its rank while its budget is
+  // within 0.9 of that depth; only the others (near_) can change rank.
   const double c[3] = {cap_.centre[0][f], cap_.centre[1][f], cap_.centre[2][f]};
   update_face_rank(f, c);
+  const double depth = depth_in_box(c[0], c[1], c[2], c[0], c[1], c[2], my_face_rank_[f]);
   const Box3& b = rank_box_[static_cast<std::size_t>(my_face_rank_[f])];
   bool far = true;
   for (int i = 0; i < 3; ++i)
@@ -464,6 +502,18 @@ void ContactPhase::set_face_reference(std::size_t f) {
     sf_near_[f] = 1;
     near_.push_back(static_cast<int>(f));
   }
+  if (sf_near_[f] == 0) budget = std::min(budget, 0.9 * depth);
+  sf_budget_[f] = budget;
+  set_bound_reference(f);
+}
+
+// How deep the box [lo, hi] (a point where lo = hi) lies inside rank r's box: the least
+// distance of a side from the rank box's side beyond it, negative where it sticks out.
+double ContactPhase::depth_in_box(double lo0, double lo1, double lo2, double hi0, double hi1,
+                                  double hi2, int r) const {
+  const Box3& b = rank_box_[static_cast<std::size_t>(r)];
+  return std::min(
+      {lo0 - b.lo[0], lo1 - b.lo[1], lo2 - b.lo[2], b.hi[0] - hi0, b.hi[1] - hi1, b.hi[2] - hi2});
 }
 
 // Face f's motion since its reference: delta, the largest distance of a corner from where
@@ -556,18 +606,22 @@ void ContactPhase::find_failing_faces() {
 bool ContactPhase::rebase_faces() {
   compute_captures(corners(), fail_, cap_);
   unsigned bad = 0; // also when anything is not a number
-  for (int f : fail_)
+  // Against the lists' and the ghosting's budgets (sf_budget_ may be less: the limit that
+  // keeps the face's rank, which its new reference looks at again).
+  for (int f : fail_) {
+    const double budget = std::min(sf_list_[f], sf_ghost_[f]);
     for (int s = 0; s < 6; ++s) {
       const double b = s < 3 ? cap_.lo[s][f] : cap_.hi[s - 3][f];
-      bad |= static_cast<unsigned>(!(std::abs(b - sf_box_[s][f]) <= sf_budget_[f]));
+      bad |= static_cast<unsigned>(!(std::abs(b - sf_box_[s][f]) <= budget));
     }
+  }
   if (bad != 0) return false;
   for (int fi : fail_) {
     const auto f = static_cast<std::size_t>(fi);
     double e = 0;
     for (int s = 0; s < 6; ++s)
       e = std::max(e, std::abs((s < 3 ? cap_.lo[s][f] : cap_.hi[s - 3][f]) - sf_box_[s][f]));
-    sf_budget_[f] -= e;
+    sf_list_[f] -= e;
     sf_ghost_[f] -= e;
     set_face_reference(f);
   }

@@ -199,6 +199,8 @@ private:
   std::vector<double> sf_due_;
   std::vector<double> sf_budget_, sf_ghost_; // per face (padded): how far its box sides may
                                              // move from there, and for the ghosting, m
+  std::vector<double> sf_list_;              // per face (padded): for the receivers' lists, m
+  std::vector<int> sf_dest_;                 // per face: its one rank, -2 for every rank, else -1
   std::vector<char> sf_near_;                // per face: listed in near_
   std::vector<int> near_;      // alive faces whose centre may leave its rank's box (contact_rank)
   std::vector<int> fail_;      // faces whose bound failed this cycle
@@ -286,6 +288,9 @@ private:
   bool rebase_faces();
   // Face f's reference: this cycle's corners and exact box (cap_), and its rank.
   void set_face_reference(std::size_t f);
+  // How deep the box [lo, hi] lies inside rank r's box (rank_box_), m; negative outside.
+  double depth_in_box(double lo0, double lo1, double lo2, double hi0, double hi1, double hi2,
+                      int r) const;
   // Its bound's part (corners and coefficients, when it is next looked at), given its
   // budget.
   void set_bound_reference(std::size_t f);
