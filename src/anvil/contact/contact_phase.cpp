@@ -389,11 +389,13 @@ void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live
     keep_send_[k] = static_cast<char>(fb_send_[k].keep);
   node_sub_.build_subset(node_plan_, keep_send_, keep_recv_);
   sn_budget_.resize(nn);
+  sn_due_.assign(static_cast<std::size_t>(simd::padded_size(static_cast<int>(nn))), inf);
   for (int i = 0; i < 3; ++i) sn_x_[i].resize(nn);
   for (std::size_t k = 0; k < nn; ++k) {
     const auto p = static_cast<std::size_t>(node_point_[k]);
     for (int i = 0; i < 3; ++i) sn_x_[i][k] = xs_[i][p];
     sn_budget_[k] = std::min(fb_send_[k].budget, sn_ghost_[k]);
+    sn_due_[k] = drift_ + 0.999999 * sn_budget_[k];
   }
 
   // Faces: the same per copy (the faces in some list), each face's budget the least of
@@ -571,14 +573,23 @@ double ContactPhase::drift_allowed(std::size_t f, const FaceMotionBound& m) cons
   return std::max(s1, s2);
 }
 
-// The nodes against their budgets, and the faces by their bounds (find_failing_faces()).
+// The nodes against their budgets, each when its move could have reached it (sn_due_: a
+// node moves no more than the growth of drift_), and the faces by their bounds
+// (find_failing_faces()).
 bool ContactPhase::shared_bound_holds() {
   unsigned bad = 0; // also when anything is not a number
-  for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
-    const auto p = static_cast<std::size_t>(node_point_[k]);
-    const double e = std::max({std::abs(xs_[0][p] - sn_x_[0][k]), std::abs(xs_[1][p] - sn_x_[1][k]),
-                               std::abs(xs_[2][p] - sn_x_[2][k])});
-    bad |= static_cast<unsigned>(!(e <= sn_budget_[k]));
+  const std::size_t nn = sn_due_.size();
+  for (std::size_t k0 = 0; k0 < nn; k0 += simd::width) {
+    if (all_of(simd::load(sn_due_.data() + k0) >= drift_)) continue; // (a NaN is looked at)
+    for (std::size_t k = k0; k < k0 + simd::width; ++k) {
+      if (sn_due_[k] >= drift_) continue; // (the padding never is)
+      const auto p = static_cast<std::size_t>(node_point_[k]);
+      const double e =
+          std::max({std::abs(xs_[0][p] - sn_x_[0][k]), std::abs(xs_[1][p] - sn_x_[1][k]),
+                    std::abs(xs_[2][p] - sn_x_[2][k])});
+      bad |= static_cast<unsigned>(!(e <= sn_budget_[k]));
+      sn_due_[k] = drift_ + 0.999999 * (sn_budget_[k] - e);
+    }
   }
   find_failing_faces();
   return bad == 0;

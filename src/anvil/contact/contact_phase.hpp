@@ -184,11 +184,13 @@ private:
   std::vector<double> sn_x_[3];              // per owned contact node: x* at its reference
   std::vector<double> sn_budget_, sn_ghost_; // per node: how far it may move from there
                                              // (largest coordinate), and for the ghosting
-  struct alignas(64) FaceRef {               // per face (padded), at its reference:
-    double x[4][3];                          // its corners' x*
-    double a, b;                             // the bound's coefficients
-    double largest; // the largest corner move its budget allows (first bound)
-    int corner[4];  // its corners' points (corner_)
+  std::vector<double> sn_due_; // per node (padded): the drift_ at which it may first have
+                               // moved its budget (shared_bound_holds() looks at it then)
+  struct alignas(64) FaceRef { // per face (padded), at its reference:
+    double x[4][3];            // its corners' x*
+    double a, b;               // the bound's coefficients
+    double largest;            // the largest corner move its budget allows (first bound)
+    int corner[4];             // its corners' points (corner_)
   };
   std::vector<FaceRef> sf_ref_;   // what a look at a face reads, together
   std::vector<double> sf_box_[6]; // per face: capture box then (lo, then hi)
