@@ -141,6 +141,49 @@ TEST(Migration, ForwardPackedMatchesForward) {
   EXPECT_TRUE(same_bits(a.data(), b.data(), a.size() * sizeof(Vec3)));
 }
 
+// forward_packed() with a stay() callback: the items for other ranks arrive as forward()
+// delivers them, each item that stays is reported once, with its received position, and
+// its place in the output is left as it was.
+TEST(Migration, ForwardPackedReportsTheItemsThatStay) {
+  const Comm comm = Comm::world();
+  const int P = comm.size();
+  const std::size_t n = 800 + 17 * static_cast<std::size_t>(comm.rank());
+  std::vector<int> dest(n);
+  std::vector<Vec3> in(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint64_t h = mix(static_cast<std::uint64_t>(comm.rank()) * 70001 + i);
+    dest[i] = static_cast<int>(h % static_cast<std::uint64_t>(P));
+    in[i] = {bits_as_double(mix(h)), bits_as_double(mix(h + 1)), bits_as_double(mix(h + 2))};
+  }
+  Migration plan;
+  plan.build(comm, dest);
+  std::vector<Vec3> a;
+  plan.forward(in, a);
+  const Vec3 untouched{-1.0, -2.0, -3.0};
+  std::vector<Vec3> b(a.size(), untouched);
+  std::vector<int> stayed(n, 0);
+  plan.forward_packed(
+      b,
+      [&](std::size_t i, Vec3& item) {
+        EXPECT_NE(dest[i], comm.rank()) << "packs only items for other ranks";
+        item = in[i];
+      },
+      [&](std::size_t i, std::size_t j) {
+        ASSERT_LT(j, a.size());
+        EXPECT_EQ(dest[i], comm.rank());
+        EXPECT_TRUE(same_bits(&a[j], &in[i], sizeof(Vec3))) << "forward() puts it at j";
+        ++stayed[i];
+      });
+  const std::size_t off = plan.recv_offset(comm.rank()), cnt = plan.recv_count(comm.rank());
+  for (std::size_t j = 0; j < a.size(); ++j) {
+    if (j >= off && j < off + cnt)
+      EXPECT_TRUE(same_bits(&b[j], &untouched, sizeof(Vec3)));
+    else
+      EXPECT_TRUE(same_bits(&b[j], &a[j], sizeof(Vec3)));
+  }
+  for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(stayed[i], dest[i] == comm.rank() ? 1 : 0);
+}
+
 // A subset plan (build_subset) moves exactly the items the receivers marked, sent back to
 // their senders along reverse(): each arrives with the bits forward() gives it, and
 // base_position() says where forward() put it. Marking everything gives forward()'s

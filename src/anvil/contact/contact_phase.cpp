@@ -22,6 +22,17 @@ void put_box_and_plane(std::vector<double> (&box)[12], std::size_t j, const Face
   box[9][j] = f.offset;
   box[10][j] = f.warp;
 }
+// The same from face f of this rank's captures.
+void put_box_and_plane(std::vector<double> (&box)[12], std::size_t j, const FaceCaptures& c,
+                       std::size_t f) {
+  for (int i = 0; i < 3; ++i) {
+    box[i][j] = c.lo[i][f];
+    box[3 + i][j] = c.hi[i][f];
+    box[6 + i][j] = c.normal[i][f];
+  }
+  box[9][j] = c.offset[f];
+  box[10][j] = c.warp[f];
+}
 
 // The bound of a face's capture box (derived above set_lazy_reference()):
 // its sides move by at most m = delta (1 + A (B + 4 delta)) when no corner has moved more
@@ -896,17 +907,33 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     }
     if (lazy) {
       // Only the items some receiver's lists read, and of a face only what changes.
+      // Those that stay on this rank are written where the search reads them, not packed
+      // and copied (a face's box and plane from cap_; its item, if queued, below).
       compute_captures(corners(), sub_faces_, cap_, true);
-      node_sub_.forward_packed(node_sub_in_,
-                               [&](std::size_t k, ContactNodeItem& it) { pack_node(k, nd, it); });
       std::vector<ContactNodeItem>& held = node_plan_.stays() ? node_out_ : node_in_;
+      node_sub_.forward_packed(
+          node_sub_in_, [&](std::size_t k, ContactNodeItem& it) { pack_node(k, nd, it); },
+          [&](std::size_t k, std::size_t j) {
+            pack_node(k, nd, held[node_sub_.base_position(j)]);
+          });
+      const int me = comm_.rank();
       for (std::size_t j = 0; j < node_sub_in_.size(); ++j)
-        held[node_sub_.base_position(j)] = node_sub_in_[j];
+        if (j - node_sub_.recv_offset(me) >= node_sub_.recv_count(me)) // (from another rank)
+          held[node_sub_.base_position(j)] = node_sub_in_[j];
       if (!in_place_) { // (in place: the items the search reads are packed below)
-        face_sub_.forward_packed(face_sub_in_, [&](std::size_t k, FaceMotion& m) {
-          pack_cycle(static_cast<std::size_t>(face_src_[k]), nd, m);
-        });
+        face_sub_.forward_packed(
+            face_sub_in_,
+            [&](std::size_t k, FaceMotion& m) {
+              pack_cycle(static_cast<std::size_t>(face_src_[k]), nd, m);
+            },
+            [&](std::size_t k, std::size_t j) {
+              const std::size_t b = face_sub_.base_position(j);
+              const int f = face_src_[k];
+              put_box_and_plane(recv_box_, b, cap_, static_cast<std::size_t>(f));
+              motion_[b] = -1 - f; // its item from face f, if queued (complete_item())
+            });
         for (std::size_t j = 0; j < face_sub_in_.size(); ++j) {
+          if (j - face_sub_.recv_offset(me) < face_sub_.recv_count(me)) continue; // stayed
           const std::size_t b = face_sub_.base_position(j);
           unpack_motion(face_sub_in_[j], b);
           motion_[b] = static_cast<int>(j);
@@ -1027,7 +1054,10 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
         const auto j = static_cast<std::size_t>(f);
         if (unpacked_[j] != stats_.cycles) {
           unpacked_[j] = stats_.cycles;
-          complete_item(face_sub_in_[static_cast<std::size_t>(motion_[j])], j);
+          if (motion_[j] < 0) // a face of this rank: its fields straight from it
+            pack_cycle(static_cast<std::size_t>(-1 - motion_[j]), nd, face_in_[j]);
+          else
+            complete_item(face_sub_in_[static_cast<std::size_t>(motion_[j])], j);
         }
       }
     }

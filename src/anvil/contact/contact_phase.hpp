@@ -222,7 +222,8 @@ private:
   Migration node_sub_, face_sub_; // the kept part of node_plan_, face_plan_
   std::vector<ContactNodeItem> node_sub_in_;
   std::vector<FaceMotion> face_sub_in_;
-  std::vector<int> motion_;            // per received face: its index in face_sub_in_
+  std::vector<int> motion_; // per received face: its index in face_sub_in_, or -1 - f for
+                            // face f of this rank (its motion not packed)
   std::vector<std::int64_t> unpacked_; // per received face: the cycle its item was completed
   // FaceBoxes of face_in_: lo x, y, z, hi x, y, z, normal x, y, z, offset, warp, depth.
   std::vector<double> recv_box_[12];

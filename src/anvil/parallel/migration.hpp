@@ -118,6 +118,38 @@ public:
     out.resize(recv_count());
     forward_packed(std::span<T>(out), std::forward<Pack>(pack));
   }
+  // Like forward_packed(), but the items that stay on this rank are not written: stay(i, j)
+  // is called instead for each, with its local index i and its received position j (its
+  // place in out, which stays untouched there), so that the caller can use the item where
+  // it is. pack() writes only the items for other ranks. Collective.
+  template <class T, class Pack, class Stay>
+  void forward_packed(std::span<T> out, Pack&& pack, Stay&& stay) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    if (out.size() != recv_count())
+      throw std::invalid_argument("Migration::forward_packed: out does not match the plan");
+    const std::size_t need = order_.size() * sizeof(T);
+    if (buffer_.size() < need) buffer_.resize(need);
+    T* buf = reinterpret_cast<T*>(buffer_.data());
+    post_receives(out.data(), sizeof(T));
+    for (int q : peers_) {
+      const auto qz = static_cast<std::size_t>(q);
+      if (scount_[qz] == 0) continue;
+      const std::int64_t* idx = order_.data() + sdispl_[qz];
+      T* dst = buf + sdispl_[qz];
+      for (std::int64_t k = 0; k < scount_[qz]; ++k) pack(static_cast<std::size_t>(idx[k]), dst[k]);
+      send_group(q, dst, sizeof(T));
+    }
+    const auto me = static_cast<std::size_t>(rank_);
+    const std::int64_t* idx = order_.data() + sdispl_[me];
+    for (std::int64_t k = 0; k < scount_[me]; ++k)
+      stay(static_cast<std::size_t>(idx[k]), static_cast<std::size_t>(rdispl_[me] + k));
+    requests_.wait();
+  }
+  template <class T, class Pack, class Stay>
+  void forward_packed(std::vector<T>& out, Pack&& pack, Stay&& stay) {
+    out.resize(recv_count());
+    forward_packed(std::span<T>(out), std::forward<Pack>(pack), std::forward<Stay>(stay));
+  }
 
   // Moves one field back: in has recv_count() items in the received layout, out gets
   // send_count() items at the original positions. Collective.
