@@ -141,6 +141,48 @@ TEST(Migration, ForwardPackedMatchesForward) {
   EXPECT_TRUE(same_bits(a.data(), b.data(), a.size() * sizeof(Vec3)));
 }
 
+// build() with the receive counts given (here from an all-gather of every rank's count())
+// makes the plan build() makes: the same layout and bits.
+TEST(Migration, BuildWithGivenCountsMatchesBuild) {
+  const Comm comm = Comm::world();
+  const int P = comm.size();
+  const auto Pz = static_cast<std::size_t>(P);
+  const std::size_t n = 600 + 31 * static_cast<std::size_t>(comm.rank());
+  std::vector<int> dest(n);
+  std::vector<Vec3> in(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint64_t h = mix(static_cast<std::uint64_t>(comm.rank()) * 4001 + i);
+    dest[i] = static_cast<int>(h % static_cast<std::uint64_t>(P));
+    in[i] = {bits_as_double(mix(h)), bits_as_double(mix(h + 1)), bits_as_double(mix(h + 2))};
+  }
+  std::vector<std::int64_t> mine(Pz), all(Pz * Pz), recv(Pz);
+  Migration::count(P, dest, mine);
+  comm.allgather_bytes(mine.data(), Pz * sizeof(std::int64_t), all.data());
+  for (std::size_t q = 0; q < Pz; ++q)
+    recv[q] = all[q * Pz + static_cast<std::size_t>(comm.rank())];
+  Migration a_plan, b_plan;
+  a_plan.build(comm, dest);
+  b_plan.build(comm, dest, recv);
+  ASSERT_EQ(a_plan.recv_count(), b_plan.recv_count());
+  EXPECT_EQ(a_plan.stays(), b_plan.stays());
+  std::vector<Vec3> a, b;
+  a_plan.forward(in, a);
+  b_plan.forward(in, b);
+  EXPECT_TRUE(same_bits(a.data(), b.data(), a.size() * sizeof(Vec3)));
+  std::vector<Vec3> back;
+  b_plan.reverse(b, back);
+  EXPECT_TRUE(same_bits(back.data(), in.data(), in.size() * sizeof(Vec3)));
+  // A bad destination: count() marks it, and the given counts make the build throw.
+  std::vector<int> bad(dest);
+  if (comm.rank() == 0 && !bad.empty()) bad[0] = P;
+  Migration::count(P, bad, mine);
+  comm.allgather_bytes(mine.data(), Pz * sizeof(std::int64_t), all.data());
+  for (std::size_t q = 0; q < Pz; ++q)
+    recv[q] = all[q * Pz + static_cast<std::size_t>(comm.rank())];
+  Migration c_plan;
+  EXPECT_THROW(c_plan.build(comm, bad, recv), std::invalid_argument);
+}
+
 // forward_packed() with a stay() callback: the items for other ranks arrive as forward()
 // delivers them, each item that stays is reported once, with its received position, and
 // its place in the output is left as it was.

@@ -150,7 +150,13 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
   packed_.assign(nf_all, -1);
   last_face_.assign(fe.node_gid.size(), -1);
   allowance_.assign(fe.node_gid.size(), 0.0);
-  gathered_.assign(4 * static_cast<std::size_t>(comm.size()), 0.0);
+  {
+    const auto P = static_cast<std::size_t>(comm.size());
+    mine_.assign(4 + P, 0.0);
+    gathered_.assign((4 + P) * P, 0.0);
+    force_counts_.assign(P, 0);
+    force_recv_.assign(P, 0);
+  }
   exchange_ = std::make_unique<NodeExchange>(fe, comm);
   // Several ranks: the ghosting margin g (set_shared_reference), the skin the candidate
   // lists use (SearchOptions::skin of the median capture-box extent) for the initial
@@ -1097,13 +1103,22 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
     }
     // Load of this rank: nodes searched plus faces held. One collective (an all-gather of
     // four values per rank, reduced here in rank order) for the balance test, the pair
-    // count and the deepest penetrations, which need both sums and maxima.
-    const double mine[4] = {static_cast<double>(search_nodes_->size() + search_faces_->size()),
-                            static_cast<double>(pairs_.size()), deepest, resisted};
-    comm_.allgather_bytes(mine, sizeof mine, gathered_.data());
+    // count and the deepest penetrations, which need both sums and maxima; and of the
+    // force items' counts per destination rank, for the force plan (no all-to-all).
+    const auto P = static_cast<std::size_t>(comm_.size());
+    mine_[0] = static_cast<double>(search_nodes_->size() + search_faces_->size());
+    mine_[1] = static_cast<double>(pairs_.size());
+    mine_[2] = deepest;
+    mine_[3] = resisted;
+    Migration::count(comm_.size(), force_dest_, force_counts_);
+    for (std::size_t q = 0; q < P; ++q) mine_[4 + q] = static_cast<double>(force_counts_[q]);
+    comm_.allgather_bytes(mine_.data(), mine_.size() * sizeof(double), gathered_.data());
+    for (std::size_t q = 0; q < P; ++q)
+      force_recv_[q] = static_cast<std::int64_t>(
+          gathered_[(4 + P) * q + 4 + static_cast<std::size_t>(comm_.rank())]);
     double load_max = 0, load_sum = 0, pair_sum = 0, deep_max = 0, resisted_max = 0;
     for (int r = 0; r < comm_.size(); ++r) {
-      const double* g = gathered_.data() + 4 * static_cast<std::size_t>(r);
+      const double* g = gathered_.data() + (4 + P) * static_cast<std::size_t>(r);
       load_max = std::max(load_max, g[0]);
       load_sum += g[0];
       pair_sum += g[1];
@@ -1121,7 +1136,7 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
 
   {
     ScopedPhase t(timers, Phase::transfer);
-    force_plan_.build(comm_, force_dest_);
+    force_plan_.build(comm_, force_dest_, force_recv_);
     if (!force_plan_.stays()) force_plan_.forward(force_out_, force_in_);
     stats_.bytes_sent +=
         static_cast<double>(force_plan_.sent_elsewhere() * sizeof(ContactForceItem));

@@ -137,7 +137,9 @@ private:
   std::vector<double> allowance_;       // per local node: penetration allowed without force
   std::vector<int> history_set_;        // local nodes whose history forces() set last cycle
   bool history_set_all_ = false;        // set_history() may have set any
-  std::vector<double> gathered_;        // forces(): four values per rank, all-gathered
+  std::vector<double> mine_, gathered_; // forces(): four values and the force items' counts
+                                        // per destination, of this rank and all-gathered
+  std::vector<std::int64_t> force_counts_, force_recv_; // force items to, from each rank
   std::vector<std::int64_t> my_face_gid_;
   std::vector<std::array<int, 4>> my_face_nodes_;    // local node indices
   std::vector<std::array<int, 4>> my_face_opposite_; // the element's other four nodes

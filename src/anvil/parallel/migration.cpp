@@ -1,5 +1,6 @@
 #include "anvil/parallel/migration.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <string>
 
@@ -65,8 +66,40 @@ void Migration::build(const Comm& comm, std::span<const int> dest) {
   // rank throw (a negative count cannot occur otherwise).
   if (bad) scount_.assign(Pz, -1);
   comm.alltoall_bytes(scount_.data(), sizeof(std::int64_t), rcount_.data());
+  finish_build(dest, bad != 0);
+}
+
+void Migration::count(int ranks, std::span<const int> dest, std::span<std::int64_t> counts) {
+  std::fill(counts.begin(), counts.end(), 0);
+  for (int d : dest) {
+    if (d < 0 || d >= ranks) {
+      std::fill(counts.begin(), counts.end(), -1);
+      return;
+    }
+    ++counts[static_cast<std::size_t>(d)];
+  }
+}
+
+void Migration::build(const Comm& comm, std::span<const int> dest,
+                      std::span<const std::int64_t> recv_counts) {
+  comm_ = &comm;
+  rank_ = comm.rank();
+  position_.clear();
+  const auto Pz = static_cast<std::size_t>(comm.size());
+  scount_.resize(Pz);
+  count(comm.size(), dest, scount_);
+  const bool bad = !scount_.empty() && scount_[0] < 0;
+  rcount_.assign(recv_counts.begin(), recv_counts.end());
+  sdispl_.assign(Pz + 1, 0);
+  rdispl_.assign(Pz + 1, 0);
+  finish_build(dest, bad);
+}
+
+void Migration::finish_build(std::span<const int> dest, bool bad) {
+  const auto Pz = rcount_.size();
+  const int P = static_cast<int>(Pz);
   // Every rank receives the -1 of a rank with a bad destination: no reduction is needed.
-  bool any_bad = bad != 0;
+  bool any_bad = bad;
   for (std::int64_t c : rcount_) any_bad |= c < 0;
   if (any_bad)
     throw std::invalid_argument("Migration::build: destination rank out of range on some rank");

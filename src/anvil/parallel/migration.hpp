@@ -7,9 +7,9 @@
 // index on the source (so the layout is deterministic and independent of timing).
 // reverse() returns each item to its original rank and original position.
 //
-// Communication. build() exchanges one count per rank pair (MPI all-to-all of counts),
-// then every move sends one message per field to each rank that has items for it and to
-// no other (sparse). Items that stay on this rank are copied, not sent.
+// Communication. build() exchanges one count per rank pair (MPI all-to-all of counts;
+// or the caller passes them), then every move sends one message per field to each rank that has
+// items for it and to no other (sparse). Items that stay on this rank are copied, not sent.
 //
 // Subsets. build_subset() makes, without communication, a plan that moves only the items
 // marked on both sides of a built plan (for example what the receivers still need, the
@@ -39,6 +39,15 @@ public:
   // Builds the plan: local item i goes to rank dest[i] (0 <= dest[i] < comm.size()).
   // Collective over comm, which must outlive the plan's use.
   void build(const Comm& comm, std::span<const int> dest);
+  // The same without communication, for a caller that already has the counts: recv_counts[q]
+  // is the number of items rank q sends here (rank q's count() for this rank), for example
+  // from a collective it makes anyway. A -1 there (count() of a bad destination) makes
+  // this rank throw, as build() does everywhere.
+  void build(const Comm& comm, std::span<const int> dest,
+             std::span<const std::int64_t> recv_counts);
+  // counts[q] = items of dest going to rank q (ranks entries); every entry -1 when some
+  // destination is out of range.
+  static void count(int ranks, std::span<const int> dest, std::span<std::int64_t> counts);
   // Builds this plan as the part of `base` that moves only some items: local item i of
   // base when send_keep[i] != 0, arriving at base's received position j when
   // recv_keep[j] != 0. Sender and receiver must mark the same items (for example, the
@@ -173,6 +182,9 @@ private:
   // the send of rank q's group, packed at data.
   void post_receives(void* out, std::size_t size);
   void send_group(int q, const void* data, std::size_t size);
+  // build()'s part after the counts (scount_, rcount_): the error check, displacements,
+  // order and peers.
+  void finish_build(std::span<const int> dest, bool bad);
 
   const Comm* comm_ = nullptr;
   int rank_ = 0;
