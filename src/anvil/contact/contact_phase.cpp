@@ -575,18 +575,19 @@ bool ContactPhase::within_budget(std::size_t f, const FaceMotionBound& m) const 
 
 // How much further drift_ may grow before both of face f's bounds could fail, from its
 // motion now: in that time no corner moves more than s, so delta grows at most s, T moves
-// at most s and r grows at most 2 s. The larger of the largest s with
-// 1.001 m(delta + s) <= budget and of the largest s with 1.001 (t + s + m(r + 2 s)) <=
-// budget (with D = r + 2 s the root of 4 A D^2 + (1.5 + A B) D = budget / 1.001 - t + r /
-// 2); infinite for an infinite budget.
+// at most s and r grows at most 1.5 s (a corner's offset from T, u_a - T = 3/4 u_a - 1/4
+// of the other three corners' moves, changes by at most 3/4 s + 3/4 s). The larger of
+// the largest s with 1.001 m(delta + s) <= budget and of the largest s with
+// 1.001 (t + s + m(r + 1.5 s)) <= budget (with D = r + 1.5 s the root of
+// 4 A D^2 + (5/3 + A B) D = budget / 1.001 - t + 2/3 r); infinite for an infinite budget.
 double ContactPhase::drift_allowed(std::size_t f, const FaceMotionBound& m) const {
   const FaceRef& r = sf_ref_[f];
   const double a = r.a, b = r.b, beta = sf_budget_[f] / 1.001;
   if (!(beta < std::numeric_limits<double>::infinity())) return beta;
   const double s1 = r.largest - m.delta;
-  const double c = beta - m.t + 0.5 * m.r;
-  const double p2 = 1.5 + a * b;
-  const double s2 = 0.5 * (2 * c / (p2 + std::sqrt(p2 * p2 + 16 * a * c)) - m.r);
+  const double c = beta - m.t + (2.0 / 3.0) * m.r;
+  const double p2 = 5.0 / 3.0 + a * b;
+  const double s2 = (2.0 / 3.0) * (2 * c / (p2 + std::sqrt(p2 * p2 + 16 * a * c)) - m.r);
   return std::max(s1, s2);
 }
 
