@@ -863,6 +863,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
   }
 
   bool lazy = false;            // several ranks: every rank's bound holds
+  bool motions_only = false;    // several ranks, full cycle, plans kept: faces sent as motions
   bool extra_somewhere = false; // some rank has extra nodes this cycle
   {
     ScopedPhase t(timers, Phase::transfer);
@@ -965,8 +966,33 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
         search_nodes_ = &node_in_;
       }
       in_place_ = node_plan_.stays() && face_plan_.stays() && one_copy_each_;
+      // With the plans as they were (nobody's destinations changed), the received items'
+      // constant fields are in place: every face sends only what changes, and the items
+      // that stay give their boxes and planes straight from cap_ (as on a lazy cycle; the
+      // items of the queued faces are completed below).
+      motions_only = !alone && worst == 1 && !in_place_ && face_in_full_ &&
+                     motion_.size() == face_in_.size() && unpacked_.size() == face_in_.size();
+      if (worst == 2) face_in_full_ = false;
       if (in_place_) {
         search_faces_ = &face_local_;
+      } else if (motions_only) {
+        const int me = comm_.rank();
+        face_plan_.forward_packed(
+            face_sub_in_,
+            [&](std::size_t k, FaceMotion& m) {
+              pack_cycle(static_cast<std::size_t>(face_src_[k]), nd, m);
+            },
+            [&](std::size_t k, std::size_t j) {
+              const int f = face_src_[k];
+              put_box_and_plane(recv_box_, j, cap_, static_cast<std::size_t>(f));
+              motion_[j] = -1 - f;
+            });
+        for (std::size_t j = 0; j < face_sub_in_.size(); ++j) {
+          if (j - face_plan_.recv_offset(me) < face_plan_.recv_count(me)) continue; // stayed
+          unpack_motion(face_sub_in_[j], j);
+          motion_[j] = static_cast<int>(j);
+        }
+        search_faces_ = &face_in_;
       } else {
         if (lazy_cycle) compute_captures(corners(), cap_); // (cannot happen: one rank stays)
         // Each copy is packed straight into the send buffer of its rank, or into face_in_
@@ -975,11 +1001,13 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
           pack_copy(static_cast<std::size_t>(face_src_[k]), nd, it);
         });
         search_faces_ = &face_in_;
+        face_in_full_ = true;
       }
       // Only what goes to another rank: items kept here are no traffic.
       stats_.bytes_sent +=
           static_cast<double>(node_plan_.sent_elsewhere() * sizeof(ContactNodeItem) +
-                              face_plan_.sent_elsewhere() * sizeof(ContactFaceItem));
+                              face_plan_.sent_elsewhere() *
+                                  (motions_only ? sizeof(FaceMotion) : sizeof(ContactFaceItem)));
     }
   }
 
@@ -1031,7 +1059,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     // cycle has updated those of the items the lists read; the depths do not change).
     const std::size_t nr = face_in_.size();
     for (auto& v : recv_box_) v.resize(nr);
-    if (!lazy)
+    if (!lazy && !motions_only)
       for (std::size_t j = 0; j < nr; ++j) {
         const ContactFaceItem& it = face_in_[j];
         put_box_and_plane(recv_box_, j, it);
@@ -1053,7 +1081,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       ScopedPhase t(timers, Phase::contact_search);
       queue_candidates(*search_nodes_, boxes, search_);
     }
-    if (lazy) {
+    if (lazy || motions_only) {
       // The received motions of the faces queued for the detailed check into their items
       // (the others' items are not read this cycle).
       ScopedPhase t(timers, Phase::transfer);

@@ -244,6 +244,7 @@ private:
   // The destinations the plans were built for (reused while nobody's have changed).
   std::vector<int> node_dest_built_, face_dest_built_, face_src_built_;
   bool plans_built_ = false;
+  bool face_in_full_ = false; // face_in_ holds the items of face_plan_ (constant fields too)
   // What the search and the forces read: the received items, or the local ones in place
   // where every item stays on this rank.
   const std::vector<ContactNodeItem>* search_nodes_ = &node_in_;
