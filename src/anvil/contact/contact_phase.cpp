@@ -293,6 +293,7 @@ void ContactPhase::set_lazy_reference() {
   const double h = 0.45 * w.skin;
   sf_ref_.resize(nfp);
   sf_due_.assign(nfp, 0.0); // (the padding is looked at once, and never fails)
+  sf_due_rel_.assign(nfp, 0.0);
   sf_budget_.assign(nfp, std::numeric_limits<double>::infinity());
   fail_.reserve(nfp);
   for (std::size_t f = 0; f < nf; ++f) sf_budget_[f] = h - build_deviation(f);
@@ -458,6 +459,7 @@ void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live
   sf_ref_.resize(nfp);
   for (auto& v : sf_box_) v.resize(nf);
   sf_due_.resize(nfp);
+  sf_due_rel_.resize(nfp);
   sf_near_.assign(nf, 0);
   near_.clear();
   for (std::size_t f = 0; f < nfp; ++f) set_face_reference(f);
@@ -480,7 +482,7 @@ void ContactPhase::set_bound_reference(std::size_t f) {
   r.largest = beta < std::numeric_limits<double>::infinity()
                   ? 2 * beta / (p + std::sqrt(p * p + 16 * r.a * beta))
                   : beta;
-  sf_due_[f] = drift_ + 0.999999 * drift_allowed(f, {0, 0, 0}); // no motion at the reference
+  set_due(f, {0, 0, 0}); // no motion at the reference
 }
 
 void ContactPhase::set_face_reference(std::size_t f) {
@@ -591,6 +593,34 @@ double ContactPhase::drift_allowed(std::size_t f, const FaceMotionBound& m) cons
   return std::max(s1, s2);
 }
 
+// Face f's due drifts from its motion m now: its bound cannot fail while drift_ grows by at
+// most Ad and rel_drift_ by at most Br. Either drift_allowed() with rel_drift_ free (the
+// offsets' growth bounded by 1.5 times drift_'s), or, from the second bound's slack S now
+// (budget / 1.001 - t - m(r)), half of it to the translation (Ad = S / 2: t grows at most
+// by drift_'s growth) and half to the offsets (r grows at most 1.5 times rel_drift_'s:
+// Br = (D - r) / 1.5 with m(D) = m(r) + S / 2, D the root of 4 A D^2 + (1 + A B) D =
+// m(r) + S / 2). Which of the two: the second where it lasts a quarter longer if
+// rel_drift_ keeps growing at its recent rate against drift_'s (only when the face is
+// looked at depends on the choice, not what the look finds).
+void ContactPhase::set_due(std::size_t f, const FaceMotionBound& m) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const double one = drift_allowed(f, m);
+  sf_due_[f] = drift_ + 0.999999 * one;
+  sf_due_rel_[f] = inf;
+  const FaceRef& r = sf_ref_[f];
+  const double a = r.a, b = r.b, beta = sf_budget_[f] / 1.001;
+  if (!(beta < inf) || !(drift_ > 0)) return;
+  const double mr = side_move(m.r, a, b);
+  const double half = 0.5 * (beta - m.t - mr);
+  if (!(half > one)) return; // (also a NaN)
+  const double q = 1 + a * b, c = mr + half;
+  const double br = (2 * c / (q + std::sqrt(q * q + 16 * a * c)) - m.r) / 1.5;
+  const double rate = rel_rate_ / drift_rate_; // rel_drift_'s recent growth per drift_'s
+  if (!(std::min(half, rate > 0 ? br / rate : inf) > 1.25 * one)) return;
+  sf_due_[f] = drift_ + 0.999999 * half;
+  sf_due_rel_[f] = rel_drift_ + 0.999999 * br;
+}
+
 // The nodes against their budgets, each when its move could have reached it (sn_due_: a
 // node moves no more than the growth of drift_), and the faces by their bounds
 // (find_failing_faces()).
@@ -615,19 +645,23 @@ bool ContactPhase::shared_bound_holds() {
 
 void ContactPhase::find_failing_faces() {
   fail_.clear();
-  // No corner moves more than the growth of drift_ in the meantime: a face is looked at
-  // again only when its bound could fail (sf_due_, drift_allowed()), and the others pass.
+  // No corner moves more than the growth of drift_ in the meantime, and no corner's offset
+  // from the mean move more than 1.5 times the growth of rel_drift_: a face is looked at
+  // again only when its bound could fail (sf_due_, sf_due_rel_, set_due()), and the
+  // others pass.
   const std::size_t nfp = sf_budget_.size();
   for (std::size_t f = 0; f < nfp; f += simd::width) {
-    if (all_of(simd::load(sf_due_.data() + f) >= drift_)) continue; // (a NaN is looked at)
+    if (all_of((simd::load(sf_due_.data() + f) >= drift_) &
+               (simd::load(sf_due_rel_.data() + f) >= rel_drift_)))
+      continue; // (a NaN is looked at)
     for (int l = 0; l < simd::width; ++l) {
       const std::size_t g = f + static_cast<std::size_t>(l);
-      if (sf_due_[g] >= drift_) continue;
+      if (sf_due_[g] >= drift_ && sf_due_rel_[g] >= rel_drift_) continue;
       const FaceMotionBound m = face_motion(g);
       if (!within_budget(g, m))
         fail_.push_back(static_cast<int>(g));
       else
-        sf_due_[g] = drift_ + 0.999999 * drift_allowed(g, m);
+        set_due(g, m);
     }
   }
 }
@@ -765,17 +799,25 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     // The points' predicted positions, and the largest move of a point since last cycle,
     // summed into drift_ (several ranks: shared_bound_holds()). (A NaN is not carried: the
     // element phase stops the run on non-finite values.)
+    // Also the largest move of a point less the mean move of last cycle (w0, w1, w2; any
+    // common vector W serves, see find_failing_faces()), summed into rel_drift_.
     const std::size_t np = surf_local_.size();
-    double step2 = 0;
+    double step2 = 0, rel2 = 0, s0 = 0, s1 = 0, s2 = 0;
+    const double w0 = w_step_[0], w1 = w_step_[1], w2 = w_step_[2];
     if (np == fe_.node_gid.size()) { // every local node is a surface point (point k: node k)
       const double *x0 = nd.x[0], *x1 = nd.x[1], *x2 = nd.x[2];
       const double *v0 = nd.v[0], *v1 = nd.v[1], *v2 = nd.v[2];
       double *y0 = xs_[0].data(), *y1 = xs_[1].data(), *y2 = xs_[2].data();
-#pragma omp simd reduction(max : step2)
+#pragma omp simd reduction(max : step2, rel2) reduction(+ : s0, s1, s2)
       for (std::size_t k = 0; k < np; ++k) {
         const double a0 = x0[k] + dt * v0[k], a1 = x1[k] + dt * v1[k], a2 = x2[k] + dt * v2[k];
         const double d0 = a0 - y0[k], d1 = a1 - y1[k], d2 = a2 - y2[k];
         step2 = std::max(step2, d0 * d0 + d1 * d1 + d2 * d2);
+        const double e0 = d0 - w0, e1 = d1 - w1, e2 = d2 - w2;
+        rel2 = std::max(rel2, e0 * e0 + e1 * e1 + e2 * e2);
+        s0 += d0;
+        s1 += d1;
+        s2 += d2;
         y0[k] = a0;
         y1[k] = a1;
         y2[k] = a2;
@@ -783,17 +825,30 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     } else {
       for (std::size_t k = 0; k < np; ++k) {
         const auto l = static_cast<std::size_t>(surf_local_[k]);
-        double d2 = 0;
+        double d[3];
         for (int i = 0; i < 3; ++i) {
           const double y = nd.x[i][l] + dt * nd.v[i][l];
-          const double d = y - xs_[i][k];
-          d2 += d * d;
+          d[i] = y - xs_[i][k];
           xs_[i][k] = y;
         }
-        step2 = std::max(step2, d2);
+        const double e0 = d[0] - w0, e1 = d[1] - w1, e2 = d[2] - w2;
+        step2 = std::max(step2, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        rel2 = std::max(rel2, e0 * e0 + e1 * e1 + e2 * e2);
+        s0 += d[0];
+        s1 += d[1];
+        s2 += d[2];
       }
     }
     drift_ += std::sqrt(step2);
+    rel_drift_ += std::sqrt(std::min(step2, rel2));
+    // Their recent growths (over some 64 cycles), for set_due()'s choice.
+    drift_rate_ += (std::sqrt(step2) - drift_rate_) / 64;
+    rel_rate_ += (std::sqrt(std::min(step2, rel2)) - rel_rate_) / 64;
+    if (np > 0) {
+      w_step_[0] = s0 / static_cast<double>(np);
+      w_step_[1] = s1 / static_cast<double>(np);
+      w_step_[2] = s2 / static_cast<double>(np);
+    }
     // The faces alive: counted again only when some element has eroded since.
     std::int64_t eroded = 0;
     for (const auto& b : blocks_) eroded += b.eroded;

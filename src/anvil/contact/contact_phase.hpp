@@ -201,6 +201,15 @@ private:
   // moved too far for its budget (find_failing_faces() looks at it again then).
   double drift_ = 0;
   std::vector<double> sf_due_;
+  // rel_drift_: the same sum of the largest move of a point less a common vector W (the
+  // mean move of the previous cycle), or of its move where that is less, m: no corner's
+  // offset from its face's mean move grows by more than 1.5 times its growth (u_a - T =
+  // 3/4 (u_a - W) - 1/4 of the other three corners' moves less W). sf_due_rel_: per face
+  // (padded), the rel_drift_ at which it may first fail (infinite when sf_due_ alone says).
+  double rel_drift_ = 0;
+  double w_step_[3] = {0, 0, 0};
+  double drift_rate_ = 0, rel_rate_ = 0; // their recent growths per cycle, m
+  std::vector<double> sf_due_rel_;
   std::vector<double> sf_budget_, sf_ghost_; // per face (padded): how far its box sides may
                                              // move from there, and for the ghosting, m
   std::vector<double> sf_list_;              // per face (padded): for the receivers' lists, m
@@ -289,6 +298,8 @@ private:
   bool within_budget(std::size_t f, const FaceMotionBound& m) const;
   // How much drift_ may grow before f's bound could fail, from its motion m now.
   double drift_allowed(std::size_t f, const FaceMotionBound& m) const;
+  // Sets sf_due_[f] and sf_due_rel_[f] from its motion m now.
+  void set_due(std::size_t f, const FaceMotionBound& m);
   // The faces of fail_ checked exactly: true when each is within its budget; each then
   // gets this cycle as its reference, its budgets less what it used.
   bool rebase_faces();
