@@ -101,26 +101,7 @@ public:
   // twice when it stays: into the input, then into out). Collective.
   template <class T, class Pack>
   void forward_packed(std::span<T> out, Pack&& pack) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    if (out.size() != recv_count())
-      throw std::invalid_argument("Migration::forward_packed: out does not match the plan");
-    const std::size_t need = order_.size() * sizeof(T);
-    if (buffer_.size() < need) buffer_.resize(need);
-    T* buf = reinterpret_cast<T*>(buffer_.data());
-    auto pack_group = [&](int q, T* dst) {
-      const auto qz = static_cast<std::size_t>(q);
-      const std::int64_t* idx = order_.data() + sdispl_[qz];
-      for (std::int64_t k = 0; k < scount_[qz]; ++k) pack(static_cast<std::size_t>(idx[k]), dst[k]);
-    };
-    post_receives(out.data(), sizeof(T));
-    for (int q : peers_) {
-      const auto qz = static_cast<std::size_t>(q);
-      if (scount_[qz] == 0) continue;
-      pack_group(q, buf + sdispl_[qz]);
-      send_group(q, buf + sdispl_[qz], sizeof(T));
-    }
-    pack_group(rank_, out.data() + rdispl_[static_cast<std::size_t>(rank_)]);
-    requests_.wait();
+    forward_packed(out, pack, [&](std::size_t i, std::size_t j) { pack(i, out[j]); });
   }
   template <class T, class Pack>
   void forward_packed(std::vector<T>& out, Pack&& pack) {
