@@ -1,4 +1,7 @@
-// simd::cube_root (the smoothing length's h0 (rho0 / rho)^(1/3)) against exact references.
+// simd::cube_root (the smoothing length's h0 (rho0 / rho)^(1/3)) against exact references,
+// and the data-movement helpers of simd.hpp (the hand-written AVX and AVX-512 transposes)
+// against their definitions written as plain loops: the same values in the same places,
+// and for the sums the same bits as adding lane after lane (exact comparisons).
 // Tolerances: within 1 ulp of the exact cube root for every input (the computed root and
 // its neighbours are cubed in exact integer arithmetic); perfect cubes and 2^(3k) exact;
 // within 4 ulps of std::cbrt (glibc's cbrt is itself up to 3 ulps from the correctly
@@ -190,6 +193,134 @@ TEST(SimdCubeRoot, PerfectCubesAndSpecialValues) {
   EXPECT_FALSE(std::signbit(cube_root(0.0)));
   EXPECT_TRUE(std::signbit(cube_root(-0.0)));
   EXPECT_EQ(cube_root(-27.0), -3.0);
+}
+
+// Values that are distinct and tell lane and index apart: v(l, a) = 100 l + a + 0.25.
+double tag(int l, int a) {
+  return 100.0 * l + a + 0.25;
+}
+
+vdouble tagged(int a) {
+  return vdouble([&](auto l) { return tag(static_cast<int>(l), a); });
+}
+
+TEST(SimdMoves, LoadStoreAndPairs) {
+  alignas(64) double buf[2 * 8 * 16] = {};
+  for (int k = 0; k < 2 * 8 * 16; ++k) buf[k] = 0.5 * k;
+  const vdouble v = anvil::simd::load(buf + 3); // unaligned
+  for (int l = 0; l < width; ++l) EXPECT_EQ(v[l], buf[3 + l]);
+  double out[16] = {};
+  anvil::simd::store(v, out + 1);
+  for (int l = 0; l < width; ++l) EXPECT_EQ(out[1 + l], buf[3 + l]);
+  std::ptrdiff_t off[8] = {7, 0, 31, 12, 5, 40, 2, 19};
+  vdouble first, second;
+  anvil::simd::gather_pairs(buf, off, first, second);
+  for (int l = 0; l < width; ++l) {
+    EXPECT_EQ(first[l], buf[off[l]]) << l;
+    EXPECT_EQ(second[l], buf[off[l] + 1]) << l;
+  }
+}
+
+TEST(SimdMoves, StoreTransposed) {
+  vdouble v[8];
+  for (int a = 0; a < 8; ++a) v[a] = tagged(a);
+  alignas(64) double plain[8 * 8] = {}, streamed[8 * 8] = {};
+  anvil::simd::store_transposed(v, plain);
+  anvil::simd::store_transposed<true>(v, streamed);
+  anvil::simd::stream_fence();
+  for (int l = 0; l < width; ++l)
+    for (int a = 0; a < 8; ++a) {
+      EXPECT_EQ(plain[8 * l + a], tag(l, a)) << l << " " << a;
+      EXPECT_EQ(streamed[8 * l + a], tag(l, a)) << l << " " << a;
+    }
+}
+
+TEST(SimdMoves, GatherScatterFour) {
+  alignas(32) double rec[10][4];
+  for (int r = 0; r < 10; ++r)
+    for (int a = 0; a < 4; ++a) rec[r][a] = 10.0 * r + a;
+  const int idx[8] = {3, 9, 0, 4, 7, 1, 8, 2};
+  vdouble g[4];
+  anvil::simd::gather4(&rec[0][0], 4, idx, g);
+  for (int l = 0; l < width; ++l)
+    for (int a = 0; a < 4; ++a) EXPECT_EQ(g[a][l], rec[idx[l]][a]) << l << " " << a;
+
+  const vdouble v[4] = {tagged(0), tagged(1), tagged(2), tagged(3)};
+  double* q[8];
+  for (int l = 0; l < width; ++l) q[l] = rec[idx[l]];
+  anvil::simd::scatter4(q, v);
+  for (int l = 0; l < width; ++l)
+    for (int a = 0; a < 4; ++a) EXPECT_EQ(rec[idx[l]][a], tag(l, a));
+
+  // Added lane after lane, also where lanes name the same record.
+  alignas(32) double acc[2][4] = {{1e16, 1, 2, 3}, {4, 5, 6, 7}};
+  double ref[2][4];
+  std::copy(&acc[0][0], &acc[0][0] + 8, &ref[0][0]);
+  for (int l = 0; l < width; ++l) q[l] = acc[l % 3 == 1 ? 1 : 0];
+  anvil::simd::scatter_add4(q, v);
+  for (int l = 0; l < width; ++l)
+    for (int a = 0; a < 4; ++a) ref[l % 3 == 1 ? 1 : 0][a] += tag(l, a);
+  for (int r = 0; r < 2; ++r)
+    for (int a = 0; a < 4; ++a) EXPECT_EQ(acc[r][a], ref[r][a]) << r << " " << a;
+
+  alignas(32) double col[3][4] = {{1, 2, 3, 4}, {5, 6, 7, 8}, {9, 10, 11, 12}};
+  const double f[3][4] = {{0.5, 1.5, 2.5, 3.5}, {4.5, 5.5, 6.5, 7.5}, {8.5, 9.5, 10.5, 11.5}};
+  double* const qc[4] = {col[0], col[2], col[0], col[1]};
+  double refc[3][4];
+  std::copy(&col[0][0], &col[0][0] + 12, &refc[0][0]);
+  const int which[4] = {0, 2, 0, 1};
+  for (int k = 0; k < 4; ++k) {
+    for (int c = 0; c < 3; ++c) refc[which[k]][c] += f[c][k];
+    refc[which[k]][3] += 0.0;
+  }
+  anvil::simd::add_columns4(qc, f[0], f[1], f[2]);
+  for (int r = 0; r < 3; ++r)
+    for (int a = 0; a < 4; ++a) EXPECT_EQ(col[r][a], refc[r][a]) << r << " " << a;
+}
+
+TEST(SimdMoves, LaneSumsInLaneOrder) {
+  // Values whose sum depends on the order: a large value first, small ones after.
+  const vdouble v[4] = {
+      vdouble([](auto l) { return l == 0 ? 1e16 : 1.0 + 0.1 * static_cast<double>(l); }), tagged(1),
+      vdouble([](auto l) { return l % 2 ? -1e-17 : 3e-1; }), tagged(3)};
+  double out[4];
+  anvil::simd::lane_sums4(v, out);
+  for (int a = 0; a < 4; ++a) {
+    double s = v[a][0];
+    for (int l = 1; l < width; ++l) s += v[a][l];
+    EXPECT_EQ(out[a], s) << a;
+  }
+}
+
+TEST(SimdMoves, MaxNegativeLanesCompress) {
+  alignas(32) double rec[8][4] = {};
+  double* q[8];
+  for (int l = 0; l < 8; ++l) {
+    rec[l][0] = l % 2 ? 1e9 : -1e9;
+    q[l] = rec[l];
+  }
+  const vdouble v = tagged(0);
+  anvil::simd::scatter_max(q, v);
+  for (int l = 0; l < width; ++l) EXPECT_EQ(rec[l][0], l % 2 ? 1e9 : tag(l, 0)) << l;
+
+  const vdouble s([](auto l) { return l % 3 == 0 ? -1.0 : (l == 1 ? -0.0 : 2.0); });
+  unsigned want = 0;
+  for (int l = 0; l < width; ++l)
+    if (std::signbit(static_cast<double>(s[l]))) want |= 1u << l;
+  EXPECT_EQ(anvil::simd::negative_lanes(s), want);
+
+  const int idx[8] = {11, 12, 13, 14, 15, 16, 17, 18};
+  for (unsigned bits = 0; bits < (1u << width); ++bits) {
+    int dst[8] = {};
+    const int c = anvil::simd::compress_store(bits, idx, dst);
+    int k = 0;
+    for (int l = 0; l < width; ++l)
+      if (bits >> l & 1u) {
+        ASSERT_LT(k, c);
+        EXPECT_EQ(dst[k++], idx[l]) << bits;
+      }
+    EXPECT_EQ(c, k) << bits;
+  }
 }
 
 } // namespace

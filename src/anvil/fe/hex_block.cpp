@@ -90,22 +90,22 @@ void pack_nodes(const NodalView& n, int lo, int hi, double* __restrict p) {
   const double* __restrict v2 = n.v[2];
   int k = lo;
 #if defined(__AVX__)
-  if constexpr (width == 4) // four nodes at a time: six loads, six unpacks, twelve stores
-    for (; k + 4 <= hi; k += 4) {
-      double* q = p + node_stride * static_cast<std::size_t>(k);
-      const __m256d x[3] = {_mm256_loadu_pd(x0 + k), _mm256_loadu_pd(x1 + k),
-                            _mm256_loadu_pd(x2 + k)};
-      const __m256d v[3] = {_mm256_loadu_pd(v0 + k), _mm256_loadu_pd(v1 + k),
-                            _mm256_loadu_pd(v2 + k)};
-      for (int i = 0; i < 3; ++i) {
-        const __m256d lo_pairs = _mm256_unpacklo_pd(x[i], v[i]); // nodes 0 and 2
-        const __m256d hi_pairs = _mm256_unpackhi_pd(x[i], v[i]); // nodes 1 and 3
-        _mm_storeu_pd(q + 2 * i, _mm256_castpd256_pd128(lo_pairs));
-        _mm_storeu_pd(q + node_stride + 2 * i, _mm256_castpd256_pd128(hi_pairs));
-        _mm_storeu_pd(q + 2 * node_stride + 2 * i, _mm256_extractf128_pd(lo_pairs, 1));
-        _mm_storeu_pd(q + 3 * node_stride + 2 * i, _mm256_extractf128_pd(hi_pairs, 1));
-      }
+  // four nodes at a time: six loads, six unpacks, twelve stores
+  for (; k + 4 <= hi; k += 4) {
+    double* q = p + node_stride * static_cast<std::size_t>(k);
+    const __m256d x[3] = {_mm256_loadu_pd(x0 + k), _mm256_loadu_pd(x1 + k),
+                          _mm256_loadu_pd(x2 + k)};
+    const __m256d v[3] = {_mm256_loadu_pd(v0 + k), _mm256_loadu_pd(v1 + k),
+                          _mm256_loadu_pd(v2 + k)};
+    for (int i = 0; i < 3; ++i) {
+      const __m256d lo_pairs = _mm256_unpacklo_pd(x[i], v[i]); // nodes 0 and 2
+      const __m256d hi_pairs = _mm256_unpackhi_pd(x[i], v[i]); // nodes 1 and 3
+      _mm_storeu_pd(q + 2 * i, _mm256_castpd256_pd128(lo_pairs));
+      _mm_storeu_pd(q + node_stride + 2 * i, _mm256_castpd256_pd128(hi_pairs));
+      _mm_storeu_pd(q + 2 * node_stride + 2 * i, _mm256_extractf128_pd(lo_pairs, 1));
+      _mm_storeu_pd(q + 3 * node_stride + 2 * i, _mm256_extractf128_pd(hi_pairs, 1));
     }
+  }
 #endif
   for (; k < hi; ++k) {
     double* q = p + node_stride * static_cast<std::size_t>(k);
@@ -411,16 +411,16 @@ void HexWorkspace::end_nodal_forces(double* const f[3]) {
   double* q = sums_.data();
   int k = 0;
 #if defined(__AVX__)
-  if constexpr (width == 4) // four nodes at a time: four loads, the transpose, three stores
-    for (; k + 4 <= nn; k += 4) {
-      double* r = q + 4 * static_cast<std::size_t>(k);
-      const vdouble rows[4] = {vdouble(_mm256_load_pd(r)), vdouble(_mm256_load_pd(r + 4)),
-                               vdouble(_mm256_load_pd(r + 8)), vdouble(_mm256_load_pd(r + 12))};
-      __m256d c[4];
-      simd::transpose4(rows, c);
-      for (int i = 0; i < 3; ++i) _mm256_storeu_pd(f[i] + k, c[i]);
-      for (int j = 0; j < 4; ++j) _mm256_store_pd(r + 4 * j, _mm256_setzero_pd());
-    }
+  // four nodes at a time: four loads, the transpose, three stores
+  for (; k + 4 <= nn; k += 4) {
+    double* r = q + 4 * static_cast<std::size_t>(k);
+    const __m256d rows[4] = {_mm256_load_pd(r), _mm256_load_pd(r + 4), _mm256_load_pd(r + 8),
+                             _mm256_load_pd(r + 12)};
+    __m256d c[4];
+    simd::transpose4x4(rows, c);
+    for (int i = 0; i < 3; ++i) _mm256_storeu_pd(f[i] + k, c[i]);
+    for (int j = 0; j < 4; ++j) _mm256_store_pd(r + 4 * j, _mm256_setzero_pd());
+  }
 #endif
   for (; k < nn; ++k) {
     double* r = q + 4 * static_cast<std::size_t>(k);
@@ -471,13 +471,14 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
   // Nodal assembly (HexWorkspace::begin_nodal_forces), or null.
   double* const sums = work.assembled_nodes_ >= 0 ? work.sums_.data() : nullptr;
   const std::uint8_t* rows = b.corner_rows.data();
-  // Non-temporal corner stores need 32-byte aligned rows (every row is if the arrays are),
-  // and pay only where the rows are read after the kernel: the nodal assembly reads the
-  // rows it asks for back at once, and a streamed row read back comes from memory (the
-  // 2-rank can crush spent 10% longer in the kernel).
+  // Non-temporal corner stores need rows aligned to a vector (32 or 64 bytes; every row is if the
+  // arrays are), and pay only where the rows are read after the kernel: the nodal assembly reads
+  // the rows it asks for back at once, and a streamed row read back comes from memory (the 2-rank
+  // can crush spent 10% longer in the kernel).
   bool stream = sums == nullptr;
   for (double* f : corners.f)
-    stream = stream && reinterpret_cast<std::uintptr_t>(f + b.corner_base) % 32 == 0;
+    stream = stream &&
+             reinterpret_cast<std::uintptr_t>(f + b.corner_base) % (sizeof(double) * width) == 0;
   // Positions and velocities of the block's nodes, packed per node.
   const std::size_t packed_size = node_stride * static_cast<std::size_t>(b.node_end);
   if (work.nodes_.size() < packed_size) work.nodes_.resize(packed_size); // first calls only
