@@ -734,7 +734,7 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
     constexpr int rest = sizeof(R2) / sizeof(double);
     constexpr int alpha_i = rest + 3, beta_i = alpha_i + 1, inv_rho = beta_i + 1;
     constexpr int visc_a = inv_rho + 1, visc_b = visc_a + 1;
-    alignas(32) vdouble pb[visc_b + 1];
+    vdouble pb[visc_b + 1];
     for (int k = R2::x; k <= R2::rho; ++k) pb[k] = pi[k];
     if constexpr (Corr)
       for (int k = R2r::S6; k < R2r::S6 + 3; ++k) pb[rest + k] = pir[k];
