@@ -128,7 +128,7 @@ inline vdouble gather(const double* p, const Index* idx) {
 // four 128-bit loads and two unpacks instead of eight scalar loads and inserts.
 inline void gather_pairs(const double* p, const std::ptrdiff_t* off, vdouble& first,
                          vdouble& second) {
-#if defined(__AVX__)
+#if defined(ANVIL_SIMD_AVX) || defined(ANVIL_SIMD_AVX512)
   // Two lanes' pairs in one 256-bit register: f_i s_i f_j s_j.
   auto pairs = [&](int i, int j) {
     return _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(p + off[i])),
@@ -139,16 +139,15 @@ inline void gather_pairs(const double* p, const std::ptrdiff_t* off, vdouble& fi
   const __m256d a = pairs(0, 2), b = pairs(1, 3);
   first = vdouble(_mm256_unpacklo_pd(a, b));
   second = vdouble(_mm256_unpackhi_pd(a, b));
-  return;
 #elif defined(ANVIL_SIMD_AVX512)
   const __m512d a = _mm512_insertf64x4(_mm512_castpd256_pd512(pairs(0, 2)), pairs(4, 6), 1);
   const __m512d b = _mm512_insertf64x4(_mm512_castpd256_pd512(pairs(1, 3)), pairs(5, 7), 1);
   first = vdouble(_mm512_unpacklo_pd(a, b));
   second = vdouble(_mm512_unpackhi_pd(a, b));
-  return;
-#endif
+#else
   first = vdouble([&](auto l) { return p[off[l]]; });
   second = vdouble([&](auto l) { return p[off[l] + 1]; });
+#endif
 }
 
 // A compiler barrier: values stored to memory before it are read back from memory after
