@@ -165,6 +165,11 @@ CornerExchange::CornerExchange(const FeDecomposition& d, const Comm& comm) : d_(
 }
 
 void CornerExchange::exchange(std::initializer_list<double*> list) {
+  start(list);
+  finish(list);
+}
+
+void CornerExchange::start(std::initializer_list<double*> list) {
   if (d_.neighbors.empty()) return;
   const std::size_t k = list.size();
   double* const* arrays = list.begin();
@@ -181,7 +186,13 @@ void CornerExchange::exchange(std::initializer_list<double*> list) {
     comm_.isend(std::span<const double>(s, nb.send_slots.size() * k), nb.rank, 11, req);
     off += nb.send_slots.size() * k;
   }
-  req.wait();
+}
+
+void CornerExchange::finish(std::initializer_list<double*> list) {
+  if (d_.neighbors.empty()) return;
+  const std::size_t k = list.size();
+  double* const* arrays = list.begin();
+  requests_.wait();
   for (std::size_t j = 0; j < d_.remote_slots; ++j)
     for (std::size_t c = 0; c < k; ++c) arrays[c][d_.local_slots + j] = recv_[j * k + c];
 }

@@ -75,6 +75,12 @@ public:
   // arrays come as a braced list (an initializer_list lives on the stack: the cycle
   // allocates nothing for it).
   void exchange(std::initializer_list<double*> arrays);
+  // The same in two halves, so that the caller can do other work (a collective, say)
+  // while the messages travel: start() sends this rank's slots and posts the receives;
+  // finish() waits and fills the remote slots. Both take the same arrays, which must not
+  // change in between.
+  void start(std::initializer_list<double*> arrays);
+  void finish(std::initializer_list<double*> arrays);
 
 private:
   const FeDecomposition& d_;

@@ -278,12 +278,18 @@ void Simulation::fe_forces() {
     // The reductions are timed with the exchange, not with the element work: a rank that
     // waits here for a slower one would otherwise hide the imbalance of `fe`.
     ScopedPhase t(timers_, Phase::halo);
+    // The corner forces travel while the reduction runs (the exchange is completed before
+    // anything below can stop the run, so no message is left outstanding).
+    const std::initializer_list<double*> corners = {
+        corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()};
+    corner_exchange_->start(corners);
     // One reduction per cycle carries the stable step and the failure flags.
     const double none = std::numeric_limits<double>::infinity();
     double red[4] = {r.dt_stable, r.inverted_gid >= 0 ? static_cast<double>(r.inverted_gid) : none,
                      r.nonfinite_gid >= 0 ? static_cast<double>(r.nonfinite_gid) : none,
                      stop_local_ ? 0.0 : 1.0};
     comm_.min(std::span<double>(red, 4));
+    corner_exchange_->finish(corners);
     stop_ = red[3] == 0.0; // a stop asked on any rank stops every rank after this cycle
     if (red[1] != none)
       throw PhysicsError(describe_element(static_cast<std::int64_t>(red[1])), clock_.time,
@@ -295,8 +301,6 @@ void Simulation::fe_forces() {
     dt_stable_local_ = r.dt_stable;
     stable_gid_local_ = r.stable_gid;
     dt_stable_ = red[0];
-    corner_exchange_->exchange(
-        {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()});
   }
   {
     ScopedPhase t(timers_, Phase::fe);
