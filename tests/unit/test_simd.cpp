@@ -323,4 +323,23 @@ TEST(SimdMoves, MaxNegativeLanesCompress) {
   }
 }
 
+TEST(SimdMoves, OutsideLanes) {
+  // Per lane: below, at the low side, inside, at the high side, above, a NaN point, a NaN
+  // low side, a NaN high side (a NaN never counts as outside).
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double x[8] = {-2, -1, 0, 1, 2, nan, -5, 5};
+  const double lo[8] = {-1, -1, -1, -1, -1, -1, nan, -1};
+  const double hi[8] = {1, 1, 1, 1, 1, 1, 1, nan};
+  const bool out[8] = {true, false, false, false, true, false, false, false};
+  for (int shift = 0; shift + width <= 8; shift += width) {
+    unsigned want = 0;
+    for (int l = 0; l < width; ++l) want |= out[shift + l] ? 1u << l : 0u;
+    EXPECT_EQ(anvil::simd::outside_lanes(anvil::simd::load(x + shift),
+                                         anvil::simd::load(lo + shift),
+                                         anvil::simd::load(hi + shift)),
+              want)
+        << shift;
+  }
+}
+
 } // namespace

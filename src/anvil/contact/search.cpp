@@ -127,68 +127,114 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
     if (cells <= limit) break;
     cell *= std::cbrt(cells / limit) * 1.01;
   }
+  // The cell of a coordinate: any monotone map will do (a face is binned in every cell
+  // from its box's low side's to its high side's, so a node in the box is in one of them).
+  const double inv_cell = 1 / cell;
   auto index = [&](int i, double v) {
-    return std::clamp(static_cast<int>(std::floor((v - lo[i]) / cell)), 0, dims[i] - 1);
+    return std::clamp(static_cast<int>(std::floor((v - lo[i]) * inv_cell)), 0, dims[i] - 1);
   };
   const std::size_t ncell = static_cast<std::size_t>(dims[0]) * dims[1] * dims[2];
   w.cell_start.assign(ncell + 1, 0);
-  // Two passes (count, fill) over the cells each enlarged box covers, clipped to the grid;
-  // faces entirely outside the nodes' box are skipped.
-  auto for_cells = [&](std::size_t f, auto&& fn) {
-    double b[6];
+  // The range of cells each enlarged box covers, clipped to the grid (i0, i1, j0, j1, k0,
+  // k1; empty for a face entirely outside the nodes' box), and the count of each cell.
+  w.face_cells.resize(6 * nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    int* r = w.face_cells.data() + 6 * f;
+    bool outside = false;
     for (int i = 0; i < 3; ++i) {
-      b[i] = boxes.lo[i][f] - w.skin;
-      b[3 + i] = boxes.hi[i][f] + w.skin;
-      if (b[3 + i] < lo[i] || b[i] > hi[i]) return;
+      const double b0 = boxes.lo[i][f] - w.skin, b1 = boxes.hi[i][f] + w.skin;
+      outside |= b1 < lo[i] || b0 > hi[i];
+      r[2 * i] = index(i, b0);
+      r[2 * i + 1] = index(i, b1);
     }
-    const int i0 = index(0, b[0]), i1 = index(0, b[3]), j0 = index(1, b[1]), j1 = index(1, b[4]);
-    const int k0 = index(2, b[2]), k1 = index(2, b[5]);
-    for (int k = k0; k <= k1; ++k)
-      for (int j = j0; j <= j1; ++j)
-        for (int i = i0; i <= i1; ++i)
-          fn((static_cast<std::size_t>(k) * dims[1] + j) * dims[0] + i, b);
-  };
-  for (std::size_t f = 0; f < nf; ++f)
-    for_cells(f, [&](std::size_t c, const double*) { ++w.cell_start[c + 1]; });
+    if (outside) r[1] = r[0] - 1;
+    for (int k = r[4]; k <= r[5]; ++k)
+      for (int j = r[2]; j <= r[3]; ++j)
+        for (int i = r[0]; i <= r[1]; ++i)
+          ++w.cell_start[(static_cast<std::size_t>(k) * dims[1] + j) * dims[0] + i + 1];
+  }
   for (std::size_t c = 0; c < ncell; ++c) w.cell_start[c + 1] += w.cell_start[c];
-  w.entries.resize(static_cast<std::size_t>(w.cell_start[ncell]));
+  // The faces into their cells (ascending in each: the pass runs over the faces in order),
+  // then, entry after entry, their enlarged boxes (one vector of padding past the last
+  // entry: a scan loads whole vectors).
+  const auto used = static_cast<std::size_t>(w.cell_start[ncell]);
+  const std::size_t ne = used + simd::width;
+  w.entry_face.resize(ne);
+  for (auto& v : w.entry_box) v.resize(ne);
   w.cursor.assign(w.cell_start.begin(), w.cell_start.end() - 1);
-  for (std::size_t f = 0; f < nf; ++f)
-    for_cells(f, [&](std::size_t c, const double* b) {
-      // Each entry carries its face's box, so the scan of a cell is one contiguous stream.
-      auto& en = w.entries[static_cast<std::size_t>(w.cursor[c]++)];
-      for (int i = 0; i < 3; ++i) {
-        en.lo[i] = b[i];
-        en.hi[i] = b[3 + i];
-      }
-      en.face = static_cast<int>(f);
-    });
+  for (std::size_t f = 0; f < nf; ++f) {
+    const int* r = w.face_cells.data() + 6 * f;
+    for (int k = r[4]; k <= r[5]; ++k)
+      for (int j = r[2]; j <= r[3]; ++j)
+        for (int i = r[0]; i <= r[1]; ++i)
+          w.entry_face[static_cast<std::size_t>(
+              w.cursor[(static_cast<std::size_t>(k) * dims[1] + j) * dims[0] + i]++)] =
+              static_cast<int>(f);
+  }
+  for (int i = 0; i < 3; ++i) {
+    const double* l = boxes.lo[i].data();
+    const double* h = boxes.hi[i].data();
+    double* el = w.entry_box[i].data();
+    double* eh = w.entry_box[3 + i].data();
+    for (std::size_t e = 0; e < used; ++e) {
+      const auto f = static_cast<std::size_t>(w.entry_face[e]);
+      el[e] = l[f] - w.skin;
+      eh[e] = h[f] + w.skin;
+    }
+  }
+  // Each face's nodes and opposite nodes side by side: the test of a candidate below
+  // reads 64 bytes of a compact array, not the item.
+  w.face_ids.resize(8 * nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    std::copy(faces[f].node, faces[f].node + 4, w.face_ids.begin() + 8 * f);
+    std::copy(faces[f].opposite, faces[f].opposite + 4, w.face_ids.begin() + 8 * f + 4);
+  }
 
   // The lists: for each node with at least one candidate (the active nodes), the faces of
   // its cell whose enlarged box holds it, in ascending face index (the fill pass runs
   // over the faces in order), first the candidates, then its own faces; faces of elements
   // it belongs to are left out. A node with no candidate cannot pair before the next build.
+  // The entries of the cell are tested a vector at a time and those that hold the node
+  // compressed, in order, into `cand`.
   w.active.clear();
   w.list_start.clear();
   w.own_start.clear();
   w.list.clear();
+  int longest_cell = 0;
+  for (std::size_t c = 0; c < ncell; ++c)
+    longest_cell = std::max(longest_cell, w.cell_start[c + 1] - w.cell_start[c]);
+  w.cand.resize(static_cast<std::size_t>(longest_cell) + simd::width);
+  const double* const eb[6] = {w.entry_box[0].data(), w.entry_box[1].data(), w.entry_box[2].data(),
+                               w.entry_box[3].data(), w.entry_box[4].data(), w.entry_box[5].data()};
   for (std::size_t n = 0; n < nodes.size(); ++n) {
     const auto& nd = nodes[n];
     const std::size_t c =
         (static_cast<std::size_t>(index(2, nd.x[2])) * dims[1] + index(1, nd.x[1])) * dims[0] +
         index(0, nd.x[0]);
+    const int b = w.cell_start[c], e = w.cell_start[c + 1];
+    const simd::vdouble x0 = nd.x[0], x1 = nd.x[1], x2 = nd.x[2];
+    int m = 0;
+    for (int k = b; k < e; k += simd::width) {
+      const auto kz = static_cast<std::size_t>(k);
+      unsigned out = simd::outside_lanes(x0, simd::load(eb[0] + kz), simd::load(eb[3] + kz)) |
+                     simd::outside_lanes(x1, simd::load(eb[1] + kz), simd::load(eb[4] + kz)) |
+                     simd::outside_lanes(x2, simd::load(eb[2] + kz), simd::load(eb[5] + kz));
+      unsigned in = ~out & ((1u << simd::width) - 1u);
+      if (e - k < simd::width) in &= (1u << (e - k)) - 1u; // (past the cell's end)
+      m += simd::compress_store(in, w.entry_face.data() + kz, w.cand.data() + m);
+    }
     const std::size_t first = w.list.size();
     w.own.clear();
-    for (int k = w.cell_start[c]; k < w.cell_start[c + 1]; ++k) {
-      const auto& en = w.entries[static_cast<std::size_t>(k)];
-      const bool outside = (nd.x[0] < en.lo[0]) | (nd.x[0] > en.hi[0]) | (nd.x[1] < en.lo[1]) |
-                           (nd.x[1] > en.hi[1]) | (nd.x[2] < en.lo[2]) | (nd.x[2] > en.hi[2]);
-      if (outside) continue;
-      const auto& fc = faces[static_cast<std::size_t>(en.face)];
-      if (std::find(fc.node, fc.node + 4, nd.gid) != fc.node + 4)
-        w.own.push_back(en.face);
-      else if (std::find(fc.opposite, fc.opposite + 4, nd.gid) == fc.opposite + 4)
-        w.list.push_back(en.face);
+    for (int i = 0; i < m; ++i) {
+      const int f = w.cand[static_cast<std::size_t>(i)];
+      const std::int64_t* ids = w.face_ids.data() + 8 * static_cast<std::size_t>(f);
+      const std::int64_t g = nd.gid;
+      const bool own = (ids[0] == g) | (ids[1] == g) | (ids[2] == g) | (ids[3] == g);
+      const bool opposite = (ids[4] == g) | (ids[5] == g) | (ids[6] == g) | (ids[7] == g);
+      if (own)
+        w.own.push_back(f);
+      else if (!opposite)
+        w.list.push_back(f);
     }
     if (w.list.size() == first) continue;
     w.active.push_back(static_cast<int>(n));

@@ -104,14 +104,16 @@ struct FaceBoxes {
 
 // Scratch space and candidate lists kept between cycles (no allocation in steady state).
 struct SearchWorkspace {
-  struct CellEntry {
-    double lo[3], hi[3]; // the face's capture box, enlarged by the skin
-    int face;
-  };
+  // Faces binned by cell, entries of a cell contiguous (cell_start, + end), in columns so
+  // that a node's scan tests a vector of entries at a time: each entry's face and its
+  // capture box enlarged by the skin (lo x, y, z, hi x, y, z), padded by a vector.
   std::vector<int> cell_start, cursor; // per cell: first entry; fill cursors
-  std::vector<CellEntry> entries;      // faces binned by cell
-  std::vector<double> extent;          // largest side of each capture box
-  std::vector<int> own, cand;          // a node's own faces and its candidates (scratch)
+  std::vector<int> face_cells;         // 6 per face: the range of cells its box covers
+  std::vector<int> entry_face;
+  std::vector<double> entry_box[6];
+  std::vector<std::int64_t> face_ids; // 8 per face: its nodes, then its opposite nodes
+  std::vector<double> extent;         // largest side of each capture box
+  std::vector<int> own, cand;         // a node's own faces and its candidates (scratch)
   // The detailed checks of a cycle, projected together (project_on_quads): per active
   // node its range of queries (+ end), each query's face and the feet found.
   std::vector<int> query_start, query_face;

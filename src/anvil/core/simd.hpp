@@ -372,6 +372,25 @@ inline unsigned negative_lanes(const vdouble& v) {
 #endif
 }
 
+// Bit l set when x[l] < lo[l] or x[l] > hi[l]: x outside [lo, hi] in that lane (never
+// where a NaN is compared, so a box with a NaN side holds every point).
+inline unsigned outside_lanes(const vdouble& x, const vdouble& lo, const vdouble& hi) {
+#if defined(ANVIL_SIMD_AVX)
+  const __m256d a = static_cast<__m256d>(x);
+  return static_cast<unsigned>(
+      _mm256_movemask_pd(_mm256_or_pd(_mm256_cmp_pd(a, static_cast<__m256d>(lo), _CMP_LT_OQ),
+                                      _mm256_cmp_pd(a, static_cast<__m256d>(hi), _CMP_GT_OQ))));
+#elif defined(ANVIL_SIMD_AVX512)
+  const __m512d a = static_cast<__m512d>(x);
+  return static_cast<unsigned>(_mm512_cmp_pd_mask(a, static_cast<__m512d>(lo), _CMP_LT_OQ) |
+                               _mm512_cmp_pd_mask(a, static_cast<__m512d>(hi), _CMP_GT_OQ));
+#else
+  unsigned bits = 0;
+  for (int l = 0; l < width; ++l) bits |= (x[l] < lo[l] || x[l] > hi[l]) ? 1u << l : 0u;
+  return bits;
+#endif
+}
+
 // Appends the entries idx[l] whose bit l is set to dst, in lane order, and returns how
 // many (dst must have room for `width` entries: all are written).
 inline int compress_store(unsigned bits, const int* idx, int* dst) {
