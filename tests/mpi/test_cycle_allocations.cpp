@@ -14,7 +14,8 @@
 // contact opens and closes every period: the counted cycles hold cycles with and without
 // pairs, with sizes that the warm-up has already seen. The warm-up is 400 cycles: on 4
 // ranks the last growth is at cycle 285. The warm-up holds full contact cycles (on one
-// rank only the first; on several, plan rebuilds too); the counted cycles are lazy: each
+// rank only the first; plan rebuilds in the counted cycles are the next test's); the
+// counted cycles are lazy: each
 // face's bound follows its own reference (translations exactly), and these blocks
 // oscillate well inside the lists' skin, so neither the lists nor the destinations need
 // rebuilding in steady state.
@@ -77,7 +78,6 @@ probes:
   const std::int64_t counted_lazy = end.lazy_cycles - start.lazy_cycles;
   EXPECT_GT(counted_lazy, 0) << "the counted cycles include lazy ones";
   EXPECT_LT(start.lazy_cycles, 400) << "the warm-up full ones";
-  if (world.size() > 1) EXPECT_GT(start.plan_builds, 1) << "and plan rebuilds";
 }
 
 // The full contact cycle allocates nothing either. The test above counts lazy cycles only:
