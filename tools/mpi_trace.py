@@ -14,9 +14,14 @@ sequences of calls the mean time of each call and of the work before it.
 import argparse
 import collections
 import glob
+import os
 import subprocess
+import sys
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from anvil_results import ResultsError, run_main  # noqa: E402
 
 KINDS = {1: "allreduce", 2: "allgather", 3: "waitall", 4: "sendrecv", 5: "recv",
          6: "alltoall", 7: "isend"}
@@ -27,8 +32,11 @@ RECORD = np.dtype([("t0", "f8"), ("t1", "f8"), ("site", "u8"), ("kind", "i4"),
 def site_names(binary, sites):
     """Function names of return addresses (offsets in the binary), shortened."""
     sites = sorted(sites)
-    out = subprocess.run(["addr2line", "-f", "-C", "-e", binary] + [hex(s) for s in sites],
-                         capture_output=True, text=True, check=True).stdout.split("\n")
+    try:
+        out = subprocess.run(["addr2line", "-f", "-C", "-e", binary] + [hex(s) for s in sites],
+                             capture_output=True, text=True, check=True).stdout.split("\n")
+    except (OSError, subprocess.CalledProcessError) as e:
+        raise ResultsError(f"{binary}: cannot read its symbols ({e})") from None
     names = {}
     for i, s in enumerate(sites):
         name = out[2 * i].split("(")[0].replace("anvil::", "")
@@ -37,7 +45,12 @@ def site_names(binary, sites):
 
 
 def report(binary, path, groups, start):
-    d = np.fromfile(path, dtype=RECORD)
+    try:
+        d = np.fromfile(path, dtype=RECORD)
+    except (OSError, ValueError) as e:
+        raise ResultsError(f"{path}: cannot read ({e})") from None
+    if len(d) == 0 or not np.isin(d["kind"], list(KINDS)).all():
+        raise ResultsError(f"{path}: not a record of tools/mpi_trace.cpp")
     sends = d[d["kind"] == 7]
     d = d[d["kind"] != 7]
     names = site_names(binary, set(d["site"].tolist()))
@@ -56,6 +69,8 @@ def report(binary, path, groups, start):
     # Cycles: from one per-cycle step reduction to the next.
     red = d["kind"] == 1
     counts = collections.Counter(d["site"][red].tolist())
+    if not counts:
+        raise ResultsError(f"{path}: no MPI_Allreduce to split the run into cycles")
     marker = max(counts, key=lambda s: (not start or names[s] == start, counts[s]))
     starts = np.where(red & (d["site"] == marker))[0]
     calls = np.diff(starts)
@@ -91,9 +106,13 @@ def main():
     p.add_argument("--start", help="the function whose MPI_Allreduce starts a cycle (for anvil "
                    "Comm::min, the step reduction; default: the commonest reduction's)")
     a = p.parse_args()
-    for path in sorted(glob.glob(a.prefix + ".*.bin"), key=lambda s: int(s.split(".")[-2])):
+    paths = glob.glob(a.prefix + ".*.bin")
+    if not paths:
+        raise ResultsError(f"{a.prefix}.*.bin: no such files")
+    for path in sorted(paths, key=lambda s: int(s.split(".")[-2]) if s.split(".")[-2].isdigit()
+                       else -1):
         report(a.binary, path, a.groups, a.start)
 
 
 if __name__ == "__main__":
-    main()
+    run_main(main, "mpi_trace.py")

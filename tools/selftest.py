@@ -426,6 +426,28 @@ def check_tools(outdir, tmp):
         run_tool(bad, 2)
 
 
+def check_mpi_trace(tmp):
+    """mpi_trace.py on synthetic records: 3 cycles of (reduction, wait, wait), a message
+    each; cycle and call counts, and exit status 2 on missing or foreign files."""
+    import numpy as np
+    rec = np.dtype([("t0", "f8"), ("t1", "f8"), ("site", "u8"), ("kind", "i4"),
+                    ("bytes", "i4")])
+    rows, t = [], 0.0
+    for _ in range(4):
+        for site, kind, size in ((0x10, 1, 0), (0x20, 7, 4096), (0x30, 3, 0), (0x30, 3, 0)):
+            rows.append((t, t + 1e-6, site, kind, size))
+            t += 1e-5
+    np.array(rows, dtype=rec).tofile(f"{tmp}/tr.0.bin")
+    r = run_tool(["mpi_trace.py", sys.executable, f"{tmp}/tr"], 0)
+    assert "12 calls" in r.stdout and "cycles: 3" in r.stdout, r.stdout
+    assert "3 cycles of 3 calls" in r.stdout, r.stdout
+    assert "4096 / 4096" in r.stdout, r.stdout
+    run_tool(["mpi_trace.py", sys.executable, f"{tmp}/none"], 2)
+    with open(f"{tmp}/junk.0.bin", "wb") as f:
+        f.write(b"\x07" * 64)
+    run_tool(["mpi_trace.py", sys.executable, f"{tmp}/junk"], 2)
+
+
 def main():
     """Build the synthetic run, run all checks, return the exit status."""
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -444,6 +466,7 @@ def main():
         c.run("plot_figure2 / plot_parallel_evidence on a synthetic series",
               check_series_tools, tmp)
         c.run("plot_figure3 on the synthetic run", check_figure3, outdir, tmp)
+        c.run("mpi_trace on synthetic records", check_mpi_trace, tmp)
     finally:
         if args.keep:
             print(f"kept {tmp}")
