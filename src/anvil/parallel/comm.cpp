@@ -41,11 +41,12 @@ MpiSession::MpiSession(int* argc, char*** argv) {
   if (!initialised) {
     // Open MPI's shared-memory transport sends a message longer than its eager limit (4 KiB
     // by default) by rendezvous: the sender's wait ends only after the receiver has matched
-    // the message, pulled it and answered, one more round trip between the ranks. Every
-    // message of a lazy contact cycle and the corner exchange of a 1875-element rank is
-    // 0.2-11 KB, the largest of a full one 34 KB (docs/performance.md, "Messages"): with 32 KiB,
-    // the transport's own fragment size (btl_vader_max_send_size), most go eagerly. A value the
-    // user gave (mpirun --mca, or the environment) stands; other MPIs ignore the variable.
+    // the message, pulled it and answered, one more round trip between the ranks. The
+    // messages of a lazy contact cycle and the corner exchange of a 1875-element rank are
+    // 0.2-11 KB (34 KB with the paper's decompositions; a full contact cycle's up to 92 KB;
+    // docs/performance.md, "Messages"): at 32 KiB, the transport's own fragment size
+    // (btl_vader_max_send_size), the common ones go eagerly. A value the user gave (mpirun
+    // --mca, or the environment) stands; other MPI libraries ignore the variable.
     setenv("OMPI_MCA_btl_vader_eager_limit", "32768", 0);
     MPI_Init(argc, argv);
   }
