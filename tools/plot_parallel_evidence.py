@@ -142,7 +142,7 @@ def plot(series, rows, title):
                     xytext=(4, 6), fontsize=7.5)
     ax.set_ylim(0, np.nanmax([r["bytes"] for r in rows]) / 1e3 * 1.2)
     ax.set_ylabel("kB sent per rank per cycle")
-    ax.set_title("(b) contact transfer volume (FE <-> contact, incl. to self)", fontsize=10)
+    ax.set_title("(b) contact transfers: bytes sent to other ranks", fontsize=10)
     ax.legend(fontsize=8, loc="lower right")
 
     ax = axes[2]
