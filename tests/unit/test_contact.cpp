@@ -220,7 +220,7 @@ struct Scene {
     for (int a = 0; a < 4; ++a) {
       f.node[a] = first_node + a;
       f.opposite[a] = first_node + 4 + a;
-      f.owner[a] = 0;
+      f.holders[a] = 0;
       f.x[a][0] = xs[a][0];
       f.x[a][1] = xs[a][1];
       f.x[a][2] = z;
@@ -323,7 +323,8 @@ TEST(Contact, DetailedCheckRules) {
 }
 
 // Penalty forces of a pair sum to zero (momentum conserved to round-off) with and without
-// friction; the normal force is k times the penetration beyond the allowance.
+// friction; the normal force is k times the penetration beyond the allowance; a node held
+// by several ranks gets the same item addressed to each of them.
 TEST(Contact, PenaltyForcesConserveMomentum) {
   Scene s;
   s.face(1, 0, 0, 100);
@@ -332,10 +333,11 @@ TEST(Contact, PenaltyForcesConserveMomentum) {
   s.run();
   ASSERT_EQ(s.pairs.size(), 1u);
   s.pairs[0].allowance = 0.01;
+  const int one_start[] = {0, 1}, one_rank[] = {0}; // group 0: rank 0 alone
   for (double mu : {0.0, 0.3}) {
     std::vector<ContactForceItem> items;
     std::vector<int> dest;
-    penalty_forces(s.nodes, s.faces, s.pairs, {mu, 1e-6}, items, dest);
+    penalty_forces(s.nodes, s.faces, s.pairs, {mu, 1e-6}, {one_start, one_rank}, items, dest);
     ASSERT_EQ(items.size(), 5u);
     double sum[3] = {0, 0, 0};
     for (const auto& it : items)
@@ -347,6 +349,24 @@ TEST(Contact, PenaltyForcesConserveMomentum) {
     else
       EXPECT_EQ(items[0].f[0], 0.0);
   }
+  // A node held by two ranks gets the same item at each: group 1 = ranks 1 and 3.
+  const int start[] = {0, 1, 3}, ranks[] = {0, 1, 3};
+  s.faces[0].holders[2] = 1;
+  std::vector<ContactForceItem> items;
+  std::vector<int> dest;
+  penalty_forces(s.nodes, s.faces, s.pairs, {0.0, 1e-6}, {start, ranks}, items, dest);
+  ASSERT_EQ(items.size(), 6u);
+  ASSERT_EQ(dest.size(), 6u);
+  int copies = 0;
+  for (std::size_t j = 0; j < items.size(); ++j)
+    if (items[j].target == s.faces[0].node[2]) {
+      EXPECT_EQ(dest[j], copies == 0 ? 1 : 3);
+      EXPECT_EQ(items[j].f[2], items[j - static_cast<std::size_t>(copies)].f[2]);
+      ++copies;
+    } else {
+      EXPECT_EQ(dest[j], 0);
+    }
+  EXPECT_EQ(copies, 2);
 }
 
 } // namespace

@@ -70,7 +70,7 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
     if (l >= 0) force_nodes_.push_back(l);
   }
   std::sort(force_nodes_.begin(), force_nodes_.end());
-  history_set_.reserve(my_nodes_.size()); // a node is the slave of one pair at most
+  history_set_.reserve(force_nodes_.size()); // a node is the slave of one pair at most
   // Faces of owned elements, with the penalty stiffness k = scale K A^2 / V and the
   // contact depth fraction V / A of their element, from the initial geometry.
   const auto offsets = mesh.block_offsets();
@@ -112,7 +112,7 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
   for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
     node_out_[k] = {};
     node_out_[k].gid = fe.node_gid[static_cast<std::size_t>(my_nodes_[k])];
-    node_out_[k].owner = comm.rank();
+    node_out_[k].holders = fe.node_holders[static_cast<std::size_t>(my_nodes_[k])];
   }
   face_local_.resize(my_face_gid_.size());
   for (std::size_t f = 0; f < face_local_.size(); ++f) {
@@ -122,7 +122,7 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
     for (int a = 0; a < 4; ++a) {
       const auto l = static_cast<std::size_t>(my_face_nodes_[f][a]);
       it.node[a] = fe.node_gid[l];
-      it.owner[a] = fe.node_owner[l];
+      it.holders[a] = fe.node_holders[l];
       it.opposite[a] = fe.node_gid[static_cast<std::size_t>(my_face_opposite_[f][a])];
     }
     it.stiffness = my_face_stiffness_[f];
@@ -157,7 +157,6 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
     force_counts_.assign(P, 0);
     force_recv_.assign(P, 0);
   }
-  exchange_ = std::make_unique<NodeExchange>(fe, comm);
   // Several ranks: the ghosting margin g (set_shared_reference), the skin the candidate
   // lists use (SearchOptions::skin of the median capture-box extent) for the initial
   // geometry, the least over the ranks so that every rank uses the same.
@@ -197,7 +196,7 @@ void ContactPhase::pack_copy(std::size_t f, const ContactNodes& nd, ContactFaceI
   for (int a = 0; a < 4; ++a) {
     it.node[a] = c.node[a];
     it.opposite[a] = c.opposite[a];
-    it.owner[a] = c.owner[a];
+    it.holders[a] = c.holders[a];
   }
   it.stiffness = c.stiffness;
   it.depth = c.depth;
@@ -230,7 +229,7 @@ void ContactPhase::pack_cycle(std::size_t f, const ContactNodes& nd, Item& it) c
   const auto l = static_cast<std::size_t>(my_nodes_[k]);
   const auto p = static_cast<std::size_t>(node_point_[k]);
   it.gid = node_out_[k].gid;
-  it.owner = node_out_[k].owner;
+  it.holders = node_out_[k].holders;
   for (int i = 0; i < 3; ++i) {
     it.x[i] = xs_[i][p];
     it.v[i] = nd.v[i][l];
@@ -1166,8 +1165,9 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
 
 void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers) {
   const std::size_t nn = fe_.node_gid.size();
-  // Only contact nodes receive forces (the owners' sums below, their copies through the
-  // exchange); every other entry stays at the zero the caller keeps there.
+  // Only contact nodes receive forces (below: every rank that holds a node sums its items,
+  // the same items in the same order); every other entry stays at the zero the caller
+  // keeps there.
   if (force_nodes_.size() == nn) { // (every node is on the surface: a thin wall)
     for (int i = 0; i < 3; ++i) std::fill(nd.force[i], nd.force[i] + nn, 0.0);
   } else {
@@ -1178,8 +1178,8 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
     ScopedPhase t(timers, Phase::contact_force);
     force_out_.clear();
     force_dest_.clear();
-    penalty_forces(*search_nodes_, *search_faces_, pairs_, {config_.friction, dt}, force_out_,
-                   force_dest_);
+    penalty_forces(*search_nodes_, *search_faces_, pairs_, {config_.friction, dt},
+                   {fe_.holder_start, fe_.holder_ranks}, force_out_, force_dest_);
     double deepest = 0, resisted = 0;
     for (const auto& p : pairs_) {
       deepest = std::max(deepest, -p.gap);
@@ -1228,10 +1228,11 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
 
   {
     ScopedPhase t(timers, Phase::contact_force);
-    // Owners add the contributions to each node in ascending (node, pair node): the sum
-    // no longer depends on where the pairs were found. The items are grouped by receiving
-    // node (a counting sort on its local index; extra nodes after the mesh's), and each
-    // group, a handful of items, is put in pair-node order by insertion: the order of
+    // Every rank that holds a node adds the contributions to it in ascending (node, pair
+    // node): the sum depends neither on where the pairs were found nor on which copy of
+    // the node it is (each copy gets the same items; no exchange of sums afterwards). The items are
+    // grouped by receiving node (a counting sort on its local index; extra nodes after the mesh's),
+    // and each group, a handful of items, is put in pair-node order by insertion: the order of
     // std::sort by (node, pair node) within every node, in linear time.
     const std::vector<ContactForceItem>& items = force_plan_.stays() ? force_out_ : force_in_;
     const std::size_t ni = items.size(), nk = nn + extra_.size();
@@ -1248,7 +1249,7 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
                                                           std::int64_t x) { return a.gid < x; }) -
                                       extra_.begin()));
       } else {
-        item_key_[j] = node_index_.find(g); // an owned node: always found
+        item_key_[j] = node_index_.find(g); // a node this rank holds: always found
       }
     }
     key_start_.assign(nk + 1, 0);
@@ -1295,10 +1296,6 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
       }
       j0 = j1;
     }
-  }
-  {
-    ScopedPhase t(timers, Phase::transfer);
-    exchange_->from_owners({nd.force[0], nd.force[1], nd.force[2]});
   }
 }
 

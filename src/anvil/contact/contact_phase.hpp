@@ -264,7 +264,6 @@ private:
   std::vector<int> force_dest_;
   SearchWorkspace search_;
   Migration node_plan_, face_plan_, force_plan_;
-  std::unique_ptr<NodeExchange> exchange_;
   ContactStats stats_;
 
   // Writes this cycle's corners (predicted positions, velocities, masses), plane and

@@ -9,7 +9,15 @@ namespace anvil {
 void penalty_forces(const std::vector<ContactNodeItem>& nodes,
                     const std::vector<ContactFaceItem>& faces,
                     const std::vector<ContactPair>& pairs, const PenaltyOptions& opt,
-                    std::vector<ContactForceItem>& items, std::vector<int>& dest) {
+                    const HolderGroups& holders, std::vector<ContactForceItem>& items,
+                    std::vector<int>& dest) {
+  auto send = [&](const ContactForceItem& item, int group) {
+    const auto g = static_cast<std::size_t>(group);
+    for (int j = holders.start[g]; j < holders.start[g + 1]; ++j) {
+      items.push_back(item);
+      dest.push_back(holders.ranks[static_cast<std::size_t>(j)]);
+    }
+  };
   for (const auto& p : pairs) {
     const auto& n = nodes[static_cast<std::size_t>(p.node)];
     const auto& f = faces[static_cast<std::size_t>(p.face)];
@@ -31,12 +39,9 @@ void penalty_forces(const std::vector<ContactNodeItem>& nodes,
         F -= (ft / speed) * vt;
       }
     }
-    items.push_back({n.gid, n.gid, f.gid, p.allowance, {F.x, F.y, F.z}});
-    dest.push_back(n.owner);
-    for (int a = 0; a < 4; ++a) {
-      items.push_back({f.node[a], n.gid, -1, 0.0, {-N[a] * F.x, -N[a] * F.y, -N[a] * F.z}});
-      dest.push_back(f.owner[a]);
-    }
+    send({n.gid, n.gid, f.gid, p.allowance, {F.x, F.y, F.z}}, n.holders);
+    for (int a = 0; a < 4; ++a)
+      send({f.node[a], n.gid, -1, 0.0, {-N[a] * F.x, -N[a] * F.y, -N[a] * F.z}}, f.holders[a]);
   }
 }
 

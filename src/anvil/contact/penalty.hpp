@@ -3,19 +3,20 @@
 // -N_a F (N_a the face's shape functions at the foot), so momentum is conserved to
 // round-off between deformable bodies; optional Coulomb friction opposes the relative
 // tangential velocity, limited by mu |F| and by the force that would stop the sliding in
-// one step. MPI-free: forces leave as items addressed to the nodes' FE owners.
+// one step. MPI-free: forces leave as items addressed to every FE rank that holds the node.
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "anvil/contact/search.hpp"
 
 namespace anvil {
 
-// One contribution to a node's contact force. The receiving FE owner sums the items of a
-// node in ascending `slave` (then as given), which makes the sum independent of the
-// decomposition (DESIGN.md section 3).
+// One contribution to a node's contact force. Each FE rank that holds the node receives
+// the items of a node and sums them in ascending `slave` (then as given): every copy gets
+// the same bits, independent of the decomposition (DESIGN.md section 3).
 struct ContactForceItem {
   std::int64_t target; // node receiving the force (global id)
   std::int64_t slave;  // the pair's node, the key of the summation order
@@ -29,11 +30,18 @@ struct PenaltyOptions {
   double dt = 0;       // the step over which the force acts (for the sticking limit)
 };
 
-// Appends one item per node touched by each pair to `items`, and its destination (the FE
-// owner of the target node) to `dest`.
+// The holder groups of the items' `holders` fields: group g's ranks are
+// ranks[start[g], start[g + 1]) (FeDecomposition::holder_start, holder_ranks).
+struct HolderGroups {
+  std::span<const int> start, ranks;
+};
+
+// Appends, per node touched by each pair, one item for each FE rank that holds the node
+// to `items`, and that rank to `dest`.
 void penalty_forces(const std::vector<ContactNodeItem>& nodes,
                     const std::vector<ContactFaceItem>& faces,
                     const std::vector<ContactPair>& pairs, const PenaltyOptions& options,
-                    std::vector<ContactForceItem>& items, std::vector<int>& dest);
+                    const HolderGroups& holders, std::vector<ContactForceItem>& items,
+                    std::vector<int>& dest);
 
 } // namespace anvil

@@ -24,7 +24,7 @@ namespace anvil {
 // A contact node in the contact decomposition (trivially copyable: moved by Migration).
 struct ContactNodeItem {
   std::int64_t gid;       // global node id
-  int owner;              // FE rank that owns the node
+  int holders;            // FE ranks that hold the node (FeDecomposition's holder group)
   double x[3];            // predicted position x* = x(n) + dt v(n+1/2)
   double v[3];            // predicted velocity v(n+1/2)
   double mass;            // lumped nodal mass
@@ -37,7 +37,7 @@ struct ContactFaceItem {
   std::int64_t gid;         // global face id (ExteriorFaces order)
   std::int64_t node[4];     // global node ids, counter-clockwise seen from outside
   std::int64_t opposite[4]; // the element's other four nodes (never in contact with the face)
-  int owner[4];             // FE owner rank of each node
+  int holders[4];           // FE ranks that hold each node (holder groups)
   double x[4][3];           // predicted node positions
   double v[4][3];           // predicted node velocities
   double mass[4];           // nodal masses

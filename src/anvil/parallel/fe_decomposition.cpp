@@ -1,6 +1,7 @@
 #include "anvil/parallel/fe_decomposition.hpp"
 
 #include <algorithm>
+#include <map>
 #include <stdexcept>
 
 #include "anvil/core/simd.hpp"
@@ -56,13 +57,39 @@ FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, in
     for (auto p = ptr[n]; p < ptr[n + 1]; ++p) m = std::min(m, owner[corner[p] / 8]);
     return m;
   };
-  for (std::int64_t n = 0; n < nn; ++n)
+  // The holder groups: first one per rank (a node only it holds), then each set of two or
+  // more ranks that hold a node, in ascending id of the first node they hold together.
+  // Every rank lists every node, so every rank builds the same table.
+  d.holder_start.assign(1, 0);
+  d.holder_ranks.clear();
+  for (int r = 0; r < ranks; ++r) {
+    d.holder_ranks.push_back(r);
+    d.holder_start.push_back(r + 1);
+  }
+  std::map<std::vector<int>, int> group_of; // (set-up only)
+  std::vector<int> set;
+  for (std::int64_t n = 0; n < nn; ++n) {
+    set.clear();
+    for (auto p = ptr[n]; p < ptr[n + 1]; ++p) set.push_back(owner[corner[p] / 8]);
+    std::sort(set.begin(), set.end());
+    set.erase(std::unique(set.begin(), set.end()), set.end());
+    int group = set.empty() ? -1 : set[0];
+    if (set.size() > 1) {
+      const auto [it, added] = group_of.emplace(set, static_cast<int>(d.holder_start.size()) - 1);
+      if (added) {
+        d.holder_ranks.insert(d.holder_ranks.end(), set.begin(), set.end());
+        d.holder_start.push_back(static_cast<int>(d.holder_ranks.size()));
+      }
+      group = it->second;
+    }
     if (touches(n, rank)) {
       g2l[n] = static_cast<int>(d.node_gid.size());
       d.node_gid.push_back(n);
       d.node_owned.push_back(min_rank(n) == rank ? 1 : 0);
       d.node_owner.push_back(min_rank(n));
+      d.node_holders.push_back(group);
     }
+  }
 
   // Owned elements per block and their corner slots.
   std::vector<std::int64_t> local_index(static_cast<std::size_t>(ne), -1); // within block
@@ -195,47 +222,6 @@ void CornerExchange::finish(std::initializer_list<double*> list) {
   requests_.wait();
   for (std::size_t j = 0; j < d_.remote_slots; ++j)
     for (std::size_t c = 0; c < k; ++c) arrays[c][d_.local_slots + j] = recv_[j * k + c];
-}
-
-NodeExchange::NodeExchange(const FeDecomposition& d, const Comm& comm) : d_(d), comm_(comm) {
-  std::size_t n = 0;
-  for (const auto& nb : d.neighbors) n += nb.shared.size();
-  send_.resize(3 * n);
-  recv_.resize(3 * n);
-}
-
-void NodeExchange::from_owners(std::initializer_list<double*> list) {
-  if (d_.neighbors.empty()) return;
-  const std::size_t k = list.size();
-  double* const* arrays = list.begin();
-  Requests& req = requests_;
-  // Per neighbour: we send the shared nodes we own, receive those it owns, both in
-  // ascending gid, so the two sides agree on the layout without telling each other.
-  std::size_t off = 0;
-  for (const auto& nb : d_.neighbors) {
-    std::size_t nr = 0;
-    for (int i : nb.shared) nr += d_.node_owner[i] == nb.rank;
-    comm_.irecv(std::span<double>(recv_.data() + off, nr * k), nb.rank, 12, req);
-    off += nb.shared.size() * k;
-  }
-  off = 0;
-  for (const auto& nb : d_.neighbors) {
-    std::size_t ns = 0;
-    for (int i : nb.shared)
-      if (d_.node_owner[i] == d_.rank)
-        for (std::size_t c = 0; c < k; ++c) send_[off + ns++] = arrays[c][i];
-    comm_.isend(std::span<const double>(send_.data() + off, ns), nb.rank, 12, req);
-    off += nb.shared.size() * k;
-  }
-  req.wait();
-  off = 0;
-  for (const auto& nb : d_.neighbors) {
-    std::size_t j = 0;
-    for (int i : nb.shared)
-      if (d_.node_owner[i] == nb.rank)
-        for (std::size_t c = 0; c < k; ++c) arrays[c][i] = recv_[off + j++];
-    off += nb.shared.size() * k;
-  }
 }
 
 namespace {

@@ -27,6 +27,11 @@ struct FeDecomposition {
   std::vector<std::int64_t> node_gid;   // global id of each local node, ascending
   std::vector<std::uint8_t> node_owned; // 1 where this rank owns the node
   std::vector<int> node_owner;          // owning rank of each local node (lowest toucher)
+  // The ranks that hold each local node, as a group of the table below (the same on every
+  // rank): group g's ranks, ascending, are holder_ranks[holder_start[g], holder_start[g +
+  // 1]); group r < ranks is rank r alone. Contact forces go to every holder of a node.
+  std::vector<int> node_holders;
+  std::vector<int> holder_start, holder_ranks;
 
   struct Block {
     std::vector<std::int64_t> gid;        // owned elements of this mesh block, ascending
@@ -81,21 +86,6 @@ public:
   // change in between.
   void start(std::initializer_list<double*> arrays);
   void finish(std::initializer_list<double*> arrays);
-
-private:
-  const FeDecomposition& d_;
-  const Comm& comm_;
-  std::vector<double> send_, recv_;
-  Requests requests_; // reused: the exchange allocates nothing
-};
-
-// Copies nodal values from each shared node's owner to the other ranks that hold it
-// (for values computed on owners only, such as contact forces).
-class NodeExchange {
-public:
-  NodeExchange(const FeDecomposition& d, const Comm& comm);
-  // `arrays` hold one value per local node; non-owned shared entries are overwritten.
-  void from_owners(std::initializer_list<double*> list);
 
 private:
   const FeDecomposition& d_;

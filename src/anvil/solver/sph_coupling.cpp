@@ -160,7 +160,7 @@ void Simulation::predict_particles(double dt_avg, double& ke, double& work) {
 }
 
 // The contact items of the particles in contact this cycle (cycle step 4): predicted
-// position x + dt v(n+1/2), id offset past the mesh's nodes and faces, owner this rank.
+// position x + dt v(n+1/2), id offset past the mesh's nodes and faces, held by this rank.
 std::vector<ContactNodeItem>& Simulation::particle_contact_items(double dt) {
   const auto& pt = sph_->particles();
   particle_items_.clear();
@@ -170,7 +170,7 @@ std::vector<ContactNodeItem>& Simulation::particle_contact_items(double dt) {
     if (!sph_contact_set_[static_cast<std::size_t>(pt.set[i])]) continue;
     ContactNodeItem it{};
     it.gid = offset + pt.gid[i];
-    it.owner = comm_.rank();
+    it.holders = comm_.rank(); // (holder group r: this rank alone)
     for (int k = 0; k < 3; ++k) {
       it.x[k] = pt.x[k][i] + dt * pt.v[k][i];
       it.v[k] = pt.v[k][i];
