@@ -52,11 +52,6 @@ FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, in
       if (owner[corner[p] / 8] == r) return true;
     return false;
   };
-  auto min_rank = [&](std::int64_t n) {
-    int m = ranks;
-    for (auto p = ptr[n]; p < ptr[n + 1]; ++p) m = std::min(m, owner[corner[p] / 8]);
-    return m;
-  };
   // The holder groups: first one per rank (a node only it holds), then each set of two or
   // more ranks that hold a node, in ascending id of the first node they hold together.
   // Every rank lists every node, so every rank builds the same table.
@@ -82,11 +77,11 @@ FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, in
       }
       group = it->second;
     }
-    if (touches(n, rank)) {
+    if (std::binary_search(set.begin(), set.end(), rank)) { // the ranks that touch it
       g2l[n] = static_cast<int>(d.node_gid.size());
       d.node_gid.push_back(n);
-      d.node_owned.push_back(min_rank(n) == rank ? 1 : 0);
-      d.node_owner.push_back(min_rank(n));
+      d.node_owned.push_back(set[0] == rank ? 1 : 0); // the lowest toucher owns it
+      d.node_owner.push_back(set[0]);
       d.node_holders.push_back(group);
     }
   }
