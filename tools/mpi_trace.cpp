@@ -47,53 +47,51 @@ void add(double t0, void* site, Kind kind, int bytes = 0) {
   records().push_back({t0, now(), reinterpret_cast<std::uint64_t>(site), kind, bytes});
 }
 
+// Times call() (the PMPI function) as one record of `kind` made at `site` (the wrapper's
+// return address: it must be taken in the wrapper itself).
+template <class Call>
+int timed(Kind kind, void* site, Call&& call) {
+  const double t0 = now();
+  const int rc = call();
+  add(t0, site, kind);
+  return rc;
+}
+
 } // namespace
 
 extern "C" {
 
 int MPI_Allreduce(const void* s, void* r, int n, MPI_Datatype t, MPI_Op op, MPI_Comm c) {
-  const double t0 = now();
-  const int rc = PMPI_Allreduce(s, r, n, t, op, c);
-  add(t0, __builtin_return_address(0), allreduce);
-  return rc;
+  return timed(allreduce, __builtin_return_address(0),
+               [&] { return PMPI_Allreduce(s, r, n, t, op, c); });
 }
 
 int MPI_Allgather(const void* s, int sn, MPI_Datatype st, void* r, int rn, MPI_Datatype rt,
                   MPI_Comm c) {
-  const double t0 = now();
-  const int rc = PMPI_Allgather(s, sn, st, r, rn, rt, c);
-  add(t0, __builtin_return_address(0), allgather);
-  return rc;
+  return timed(allgather, __builtin_return_address(0),
+               [&] { return PMPI_Allgather(s, sn, st, r, rn, rt, c); });
 }
 
 int MPI_Alltoall(const void* s, int sn, MPI_Datatype st, void* r, int rn, MPI_Datatype rt,
                  MPI_Comm c) {
-  const double t0 = now();
-  const int rc = PMPI_Alltoall(s, sn, st, r, rn, rt, c);
-  add(t0, __builtin_return_address(0), alltoall);
-  return rc;
+  return timed(alltoall, __builtin_return_address(0),
+               [&] { return PMPI_Alltoall(s, sn, st, r, rn, rt, c); });
 }
 
 int MPI_Waitall(int n, MPI_Request* q, MPI_Status* st) {
-  const double t0 = now();
-  const int rc = PMPI_Waitall(n, q, st);
-  add(t0, __builtin_return_address(0), waitall);
-  return rc;
+  return timed(waitall, __builtin_return_address(0), [&] { return PMPI_Waitall(n, q, st); });
 }
 
 int MPI_Sendrecv(const void* s, int sn, MPI_Datatype st, int dest, int stag, void* r, int rn,
                  MPI_Datatype rt, int source, int rtag, MPI_Comm c, MPI_Status* status) {
-  const double t0 = now();
-  const int rc = PMPI_Sendrecv(s, sn, st, dest, stag, r, rn, rt, source, rtag, c, status);
-  add(t0, __builtin_return_address(0), sendrecv);
-  return rc;
+  return timed(sendrecv, __builtin_return_address(0), [&] {
+    return PMPI_Sendrecv(s, sn, st, dest, stag, r, rn, rt, source, rtag, c, status);
+  });
 }
 
 int MPI_Recv(void* b, int n, MPI_Datatype t, int source, int tag, MPI_Comm c, MPI_Status* st) {
-  const double t0 = now();
-  const int rc = PMPI_Recv(b, n, t, source, tag, c, st);
-  add(t0, __builtin_return_address(0), recv);
-  return rc;
+  return timed(recv, __builtin_return_address(0),
+               [&] { return PMPI_Recv(b, n, t, source, tag, c, st); });
 }
 
 int MPI_Isend(const void* b, int n, MPI_Datatype t, int dest, int tag, MPI_Comm c, MPI_Request* q) {
