@@ -46,6 +46,22 @@ inline V side_move(const V& delta, const V& a, const V& b) {
   return delta * (1 + a * (b + 4 * delta));
 }
 
+// The lanes of a per-face column: face f (double) or the faces from f (simd::vdouble);
+// directly, or through an index column (at()).
+inline double lanes(const std::vector<double>& c, std::size_t f, double) {
+  return c[f];
+}
+inline simd::vdouble lanes(const std::vector<double>& c, std::size_t f, simd::vdouble) {
+  return simd::load(c.data() + f);
+}
+inline double at(const std::vector<double>& c, const std::vector<int>& idx, std::size_t f, double) {
+  return c[static_cast<std::size_t>(idx[f])];
+}
+inline simd::vdouble at(const std::vector<double>& c, const std::vector<int>& idx, std::size_t f,
+                        simd::vdouble) {
+  return simd::gather(c.data(), idx.data() + f);
+}
+
 } // namespace
 
 ContactPhase::~ContactPhase() = default;
@@ -466,22 +482,32 @@ void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live
   shared_ = true; // (never with extra nodes anywhere: they change every cycle)
 }
 
-void ContactPhase::set_bound_reference(std::size_t f) {
-  FaceRef& r = sf_ref_[f];
-  for (int a = 0; a < 4; ++a) {
-    r.corner[a] = corner_[a][f];
-    for (int i = 0; i < 3; ++i) r.x[a][i] = xs_[i][static_cast<std::size_t>(r.corner[a])];
+void ContactPhase::FaceRefs::resize(std::size_t n) {
+  for (int k = 0; k < 4; ++k) {
+    corner[k].resize(n);
+    for (auto& c : x[k]) c.resize(n);
   }
-  r.a = r.b = r.largest = 0;
+  a.resize(n);
+  b.resize(n);
+  largest.resize(n);
+}
+
+void ContactPhase::set_bound_reference(std::size_t f) {
+  FaceRefs& r = sf_ref_;
+  for (int k = 0; k < 4; ++k) {
+    r.corner[k][f] = corner_[k][f];
+    for (int i = 0; i < 3; ++i) r.x[k][i][f] = xs_[i][static_cast<std::size_t>(corner_[k][f])];
+  }
+  r.a[f] = r.b[f] = r.largest[f] = 0;
   if (f >= my_face_gid_.size()) return; // padding
-  r.a = bound_a(my_face_depth_[f], cap_.len[f]);
-  r.b = 2 * cap_.diag[f];
+  r.a[f] = bound_a(my_face_depth_[f], cap_.len[f]);
+  r.b[f] = 2 * cap_.diag[f];
   // The largest delta for which the first bound holds: the root of 1.001 m(delta) = budget.
-  const double beta = sf_budget_[f] / 1.001, p = 1 + r.a * r.b;
-  r.largest = beta < std::numeric_limits<double>::infinity()
-                  ? 2 * beta / (p + std::sqrt(p * p + 16 * r.a * beta))
-                  : beta;
-  set_due(f, {0, 0, 0}); // no motion at the reference
+  const double beta = sf_budget_[f] / 1.001, p = 1 + r.a[f] * r.b[f];
+  r.largest[f] = beta < std::numeric_limits<double>::infinity()
+                     ? 2 * beta / (p + std::sqrt(p * p + 16 * r.a[f] * beta))
+                     : beta;
+  due_drifts<double>(f, {0, 0, 0}, sf_due_[f], sf_due_rel_[f]); // no motion at the reference
 }
 
 void ContactPhase::set_face_reference(std::size_t f) {
@@ -542,36 +568,41 @@ double ContactPhase::depth_in_box(double lo0, double lo1, double lo2, double hi0
 // by T is its box moved by T (the plane, size and warp are those of the reference), so its
 // sides have moved at most t + m(r), and at most m(delta) (m: side_move(), with A and B of
 // the reference geometry). A NaN gives a NaN.
-ContactPhase::FaceMotionBound ContactPhase::face_motion(std::size_t f) const {
-  const FaceRef& ref = sf_ref_[f];
-  double u[4][3], T[3] = {0, 0, 0};
-  for (int a = 0; a < 4; ++a) {
-    const auto p = static_cast<std::size_t>(ref.corner[a]);
+template <class V>
+ContactPhase::FaceMotionBound<V> ContactPhase::face_motion(std::size_t f) const {
+  using std::abs;
+  using std::sqrt;
+  const FaceRefs& ref = sf_ref_;
+  V u[4][3], T[3] = {0.0, 0.0, 0.0};
+  for (int a = 0; a < 4; ++a)
     for (int i = 0; i < 3; ++i) {
-      u[a][i] = xs_[i][p] - ref.x[a][i];
+      u[a][i] = at(xs_[i], ref.corner[a], f, V()) - lanes(ref.x[a][i], f, V());
       T[i] += 0.25 * u[a][i];
     }
+  V t = 0.0, r2 = 0.0, d2 = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const V Ti = abs(T[i]);
+    t = simd::select(!(t >= Ti), Ti, t);
   }
-  double t = 0, r2 = 0, d2 = 0;
-  for (int i = 0; i < 3; ++i)
-    if (!(t >= std::abs(T[i]))) t = std::abs(T[i]);
   for (int a = 0; a < 4; ++a) {
-    double q = 0, e = 0;
+    V q = 0.0, e = 0.0;
     for (int i = 0; i < 3; ++i) {
-      const double d = u[a][i] - T[i];
+      const V d = u[a][i] - T[i];
       q += d * d;
       e += u[a][i] * u[a][i];
     }
-    if (!(r2 >= q)) r2 = q;
-    if (!(d2 >= e)) d2 = e;
+    r2 = simd::select(!(r2 >= q), q, r2);
+    d2 = simd::select(!(d2 >= e), e, d2);
   }
-  return {std::sqrt(d2), t, std::sqrt(r2)};
+  return {sqrt(d2), t, sqrt(r2)};
 }
 
 // Whether face f's sides are within its budget by either bound, with 0.1% for rounding.
-bool ContactPhase::within_budget(std::size_t f, const FaceMotionBound& m) const {
-  const double a = sf_ref_[f].a, b = sf_ref_[f].b;
-  return 1.001 * std::min(side_move(m.delta, a, b), m.t + side_move(m.r, a, b)) <= sf_budget_[f];
+template <class V>
+auto ContactPhase::within_budget(std::size_t f, const FaceMotionBound<V>& m) const {
+  const V a = lanes(sf_ref_.a, f, V()), b = lanes(sf_ref_.b, f, V());
+  const V first = side_move(m.delta, a, b), second = m.t + side_move(m.r, a, b);
+  return 1.001 * simd::select(second < first, second, first) <= lanes(sf_budget_, f, V());
 }
 
 // How much further drift_ may grow before both of face f's bounds could fail, from its
@@ -581,15 +612,17 @@ bool ContactPhase::within_budget(std::size_t f, const FaceMotionBound& m) const 
 // the largest s with 1.001 m(delta + s) <= budget and of the largest s with
 // 1.001 (t + s + m(r + 1.5 s)) <= budget (with D = r + 1.5 s the root of
 // 4 A D^2 + (5/3 + A B) D = budget / 1.001 - t + 2/3 r); infinite for an infinite budget.
-double ContactPhase::drift_allowed(std::size_t f, const FaceMotionBound& m) const {
-  const FaceRef& r = sf_ref_[f];
-  const double a = r.a, b = r.b, beta = sf_budget_[f] / 1.001;
-  if (!(beta < std::numeric_limits<double>::infinity())) return beta;
-  const double s1 = r.largest - m.delta;
-  const double c = beta - m.t + (2.0 / 3.0) * m.r;
-  const double p2 = 5.0 / 3.0 + a * b;
-  const double s2 = (2.0 / 3.0) * (2 * c / (p2 + std::sqrt(p2 * p2 + 16 * a * c)) - m.r);
-  return std::max(s1, s2);
+template <class V>
+V ContactPhase::drift_allowed(std::size_t f, const FaceMotionBound<V>& m) const {
+  using std::sqrt;
+  const V a = lanes(sf_ref_.a, f, V()), b = lanes(sf_ref_.b, f, V());
+  const V beta = lanes(sf_budget_, f, V()) / 1.001;
+  const V s1 = lanes(sf_ref_.largest, f, V()) - m.delta;
+  const V c = beta - m.t + (2.0 / 3.0) * m.r;
+  const V p2 = 5.0 / 3.0 + a * b;
+  const V s2 = (2.0 / 3.0) * (2.0 * c / (p2 + sqrt(p2 * p2 + 16.0 * a * c)) - m.r);
+  return simd::select(beta < std::numeric_limits<double>::infinity(), simd::select(s1 < s2, s2, s1),
+                      beta);
 }
 
 // Face f's due drifts from its motion m now: its bound cannot fail while drift_ grows by at
@@ -601,23 +634,27 @@ double ContactPhase::drift_allowed(std::size_t f, const FaceMotionBound& m) cons
 // m(r) + S / 2). Which of the two: the second where it lasts a quarter longer if
 // rel_drift_ keeps growing at its recent rate against drift_'s (only when the face is
 // looked at depends on the choice, not what the look finds).
-void ContactPhase::set_due(std::size_t f, const FaceMotionBound& m) {
+template <class V>
+void ContactPhase::due_drifts(std::size_t f, const FaceMotionBound<V>& m, V& due,
+                              V& due_rel) const {
+  using std::sqrt;
   const double inf = std::numeric_limits<double>::infinity();
-  const double one = drift_allowed(f, m);
-  sf_due_[f] = drift_ + 0.999999 * one;
-  sf_due_rel_[f] = inf;
-  const FaceRef& r = sf_ref_[f];
-  const double a = r.a, b = r.b, beta = sf_budget_[f] / 1.001;
-  if (!(beta < inf) || !(drift_ > 0)) return;
-  const double mr = side_move(m.r, a, b);
-  const double half = 0.5 * (beta - m.t - mr);
-  if (!(half > one)) return; // (also a NaN)
-  const double q = 1 + a * b, c = mr + half;
-  const double br = (2 * c / (q + std::sqrt(q * q + 16 * a * c)) - m.r) / 1.5;
+  const V one = drift_allowed(f, m);
+  due = drift_ + 0.999999 * one;
+  due_rel = inf;
+  if (!(drift_ > 0)) return;
+  const V a = lanes(sf_ref_.a, f, V()), b = lanes(sf_ref_.b, f, V());
+  const V beta = lanes(sf_budget_, f, V()) / 1.001;
+  const V mr = side_move(m.r, a, b);
+  const V half = 0.5 * (beta - m.t - mr);
+  const V q = 1.0 + a * b, c = mr + half;
+  const V br = (2.0 * c / (q + sqrt(q * q + 16.0 * a * c)) - m.r) / 1.5;
   const double rate = rel_rate_ / drift_rate_; // rel_drift_'s recent growth per drift_'s
-  if (!(std::min(half, rate > 0 ? br / rate : inf) > 1.25 * one)) return;
-  sf_due_[f] = drift_ + 0.999999 * half;
-  sf_due_rel_[f] = rel_drift_ + 0.999999 * br;
+  const V lasts = rate > 0 ? V(br / rate) : V(inf);
+  const auto second = (beta < inf) && (half > one) &&
+                      (simd::select(lasts < half, lasts, half) > 1.25 * one); // (not a NaN)
+  due = simd::select(second, drift_ + 0.999999 * half, due);
+  due_rel = simd::select(second, rel_drift_ + 0.999999 * br, due_rel);
 }
 
 // The nodes against their budgets, each when its move could have reached it (sn_due_: a
@@ -646,22 +683,25 @@ void ContactPhase::find_failing_faces() {
   fail_.clear();
   // No corner moves more than the growth of drift_ in the meantime, and no corner's offset
   // from the mean move more than 1.5 times the growth of rel_drift_: a face is looked at
-  // again only when its bound could fail (sf_due_, sf_due_rel_, set_due()), and the
-  // others pass.
+  // again only when its bound could fail (sf_due_, sf_due_rel_, due_drifts()), and the
+  // others pass. A vector of faces is looked at together; only its faces that are due
+  // get new due drifts or fail.
+  using V = simd::vdouble;
   const std::size_t nfp = sf_budget_.size();
   for (std::size_t f = 0; f < nfp; f += simd::width) {
-    if (all_of((simd::load(sf_due_.data() + f) >= drift_) &
-               (simd::load(sf_due_rel_.data() + f) >= rel_drift_)))
-      continue; // (a NaN is looked at)
-    for (int l = 0; l < simd::width; ++l) {
-      const std::size_t g = f + static_cast<std::size_t>(l);
-      if (sf_due_[g] >= drift_ && sf_due_rel_[g] >= rel_drift_) continue;
-      const FaceMotionBound m = face_motion(g);
-      if (!within_budget(g, m))
-        fail_.push_back(static_cast<int>(g));
-      else
-        set_due(g, m);
-    }
+    const V due = simd::load(sf_due_.data() + f), due_rel = simd::load(sf_due_rel_.data() + f);
+    const simd::vmask look = !((due >= drift_) & (due_rel >= rel_drift_)); // (and a NaN)
+    if (none_of(look)) continue;
+    const FaceMotionBound<V> m = face_motion<V>(f);
+    const simd::vmask holds = within_budget(f, m);
+    V next, next_rel;
+    due_drifts(f, m, next, next_rel);
+    simd::store(simd::select(look && holds, next, due), sf_due_.data() + f);
+    simd::store(simd::select(look && holds, next_rel, due_rel), sf_due_rel_.data() + f);
+    const simd::vmask fails = look && !holds;
+    if (any_of(fails))
+      for (int l = 0; l < simd::width; ++l)
+        if (fails[l]) fail_.push_back(static_cast<int>(f) + l);
   }
 }
 

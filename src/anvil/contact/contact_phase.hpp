@@ -188,13 +188,14 @@ private:
                                              // (largest coordinate), and for the ghosting
   std::vector<double> sn_due_; // per node (padded): the drift_ at which it may first have
                                // moved its budget (shared_bound_holds() looks at it then)
-  struct alignas(64) FaceRef { // per face (padded), at its reference:
-    double x[4][3];            // its corners' x*
-    double a, b;               // the bound's coefficients
-    double largest;            // the largest corner move its budget allows (first bound)
-    int corner[4];             // its corners' points (corner_)
+  struct FaceRefs { // per face (padded), at its reference, in columns (a look takes a vector):
+    std::vector<int> corner[4];  // its corners' points (corner_)
+    std::vector<double> x[4][3]; // their x*
+    std::vector<double> a, b;    // the bound's coefficients
+    std::vector<double> largest; // the largest corner move its budget allows (first bound)
+    void resize(std::size_t n);
   };
-  std::vector<FaceRef> sf_ref_;   // what a look at a face reads, together
+  FaceRefs sf_ref_;               // what a look at a face reads
   std::vector<double> sf_box_[6]; // per face: capture box then (lo, then hi)
   // drift_: the sum over cycles of the largest move of any point's x* since the previous
   // cycle, m. sf_due_: per face (padded), the drift_ at which its corners may first have
@@ -289,16 +290,23 @@ private:
   // Several ranks: true when every node is within its budget; fail_ gets the faces whose
   // bound fails.
   bool shared_bound_holds();
+  // The bound of face f (V = double) or of the vector of faces from f (V = simd::vdouble;
+  // one template, the same operations lane by lane): their motion since the reference,
+  // whether their sides are within their budgets, how much further drift_ may grow
+  // before that could fail, and their due drifts from there (sf_due_, sf_due_rel_).
+  template <class V>
   struct FaceMotionBound {
-    double delta; // largest move of a corner, m
-    double t, r;  // largest coordinate of the corners' mean move; largest move about it, m
+    V delta; // largest move of a corner, m
+    V t, r;  // largest coordinate of the corners' mean move; largest move about it, m
   };
-  FaceMotionBound face_motion(std::size_t f) const; // f's since its reference
-  bool within_budget(std::size_t f, const FaceMotionBound& m) const;
-  // How much drift_ may grow before f's bound could fail, from its motion m now.
-  double drift_allowed(std::size_t f, const FaceMotionBound& m) const;
-  // Sets sf_due_[f] and sf_due_rel_[f] from its motion m now.
-  void set_due(std::size_t f, const FaceMotionBound& m);
+  template <class V>
+  FaceMotionBound<V> face_motion(std::size_t f) const;
+  template <class V>
+  auto within_budget(std::size_t f, const FaceMotionBound<V>& m) const;
+  template <class V>
+  V drift_allowed(std::size_t f, const FaceMotionBound<V>& m) const;
+  template <class V>
+  void due_drifts(std::size_t f, const FaceMotionBound<V>& m, V& due, V& due_rel) const;
   // The faces of fail_ checked exactly: true when each is within its budget; each then
   // gets this cycle as its reference, its budgets less what it used.
   bool rebase_faces();
