@@ -47,15 +47,12 @@ inline V side_move(const V& delta, const V& a, const V& b) {
 }
 
 // The lanes of a per-face column: face f (double) or the faces from f (simd::vdouble);
-// directly, or through an index column (at()).
+// and those of a column through an index column (a vector only: face_motion()).
 inline double lanes(const std::vector<double>& c, std::size_t f, double) {
   return c[f];
 }
 inline simd::vdouble lanes(const std::vector<double>& c, std::size_t f, simd::vdouble) {
   return simd::load(c.data() + f);
-}
-inline double at(const std::vector<double>& c, const std::vector<int>& idx, std::size_t f, double) {
-  return c[static_cast<std::size_t>(idx[f])];
 }
 inline simd::vdouble at(const std::vector<double>& c, const std::vector<int>& idx, std::size_t f,
                         simd::vdouble) {
