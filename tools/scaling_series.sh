@@ -32,10 +32,11 @@ options:
   --full                 run each problem to 3.2 ms instead of --cycles (slow)
   --anvil PATH           anvil executable (default: build/apps/anvil next to tools/)
   --mpirun CMD           MPI launcher (default: mpirun)
-  --mpi-args "ARGS"      extra launcher arguments (default: "--bind-to none --mca
-                         mpi_yield_when_idle 1": a rank waiting in MPI yields its core;
-                         without it a rank that polls starves its partner whenever the
-                         machine has other work, and P = 2 looks 3-6x slower)
+  --mpi-args "ARGS"      extra launcher arguments (default: "--bind-to none"; Open MPI
+                         then polls while a rank waits when the ranks fit the cores and
+                         yields the core when they do not. On a machine busy with other
+                         work add "--mca mpi_yield_when_idle 1": a rank that polls there
+                         starves its partner, and P = 2 looks 3-6x slower)
   --repeat N             run each rank count N times and keep the fastest (least
                          grind time) in P<P>/, the others in P<P>/rep<k>/ (default 1)
   --timeout SEC          kill a run after SEC seconds (default: none)
@@ -53,7 +54,7 @@ die() { echo "scaling_series.sh: error: $*" >&2; exit 2; }
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 anvil="$here/../build/apps/anvil"
 mpirun_cmd=mpirun
-mpi_args="--bind-to none --mca mpi_yield_when_idle 1"
+mpi_args="--bind-to none"
 min_ranks=1
 max_ranks=8
 ranks_list=""
