@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "anvil/core/simd.hpp"
 
@@ -38,8 +39,10 @@ void put_box_and_plane(std::vector<double> (&box)[12], std::size_t j, const Face
 // its sides move by at most m = delta (1 + A (B + 4 delta)) when no corner has moved more
 // than delta since the reference, with A and B from the reference geometry (len = |D1 x
 // D2|, diag = |D1| + |D2| of the diagonals, depth the face's contact depth).
-inline double bound_a(double depth, double len) {
-  return 4 * depth / len + 0.025 / std::sqrt(0.5 * len);
+template <class V>
+inline V bound_a(const V& depth, const V& len) {
+  using std::sqrt;
+  return 4.0 * depth / len + 0.025 / sqrt(0.5 * len);
 }
 template <class V>
 inline V side_move(const V& delta, const V& a, const V& b) {
@@ -53,6 +56,12 @@ inline double lanes(const std::vector<double>& c, std::size_t f, double) {
 }
 inline simd::vdouble lanes(const std::vector<double>& c, std::size_t f, simd::vdouble) {
   return simd::load(c.data() + f);
+}
+inline void put(double v, std::vector<double>& c, std::size_t f) {
+  c[f] = v;
+}
+inline void put(const simd::vdouble& v, std::vector<double>& c, std::size_t f) {
+  simd::store(v, c.data() + f);
 }
 inline simd::vdouble at(const std::vector<double>& c, const std::vector<int>& idx, std::size_t f,
                         simd::vdouble) {
@@ -309,7 +318,7 @@ void ContactPhase::set_lazy_reference() {
   sf_budget_.assign(nfp, std::numeric_limits<double>::infinity());
   fail_.reserve(nfp);
   for (std::size_t f = 0; f < nf; ++f) sf_budget_[f] = h - build_deviation(f);
-  for (std::size_t f = 0; f < nfp; ++f) set_bound_reference(f);
+  set_bound_references();
   const std::size_t nn = my_nodes_.size();
   node_due_.assign(static_cast<std::size_t>(simd::padded_size(static_cast<int>(nn))),
                    std::numeric_limits<double>::infinity());
@@ -474,7 +483,8 @@ void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live
   sf_due_rel_.resize(nfp);
   sf_near_.assign(nf, 0);
   near_.clear();
-  for (std::size_t f = 0; f < nfp; ++f) set_face_reference(f);
+  for (std::size_t f = 0; f < nfp; ++f) set_face_budget(f);
+  set_bound_references();
   live_ref_ = live;
   shared_ = true; // (never with extra nodes anywhere: they change every cycle)
 }
@@ -489,27 +499,50 @@ void ContactPhase::FaceRefs::resize(std::size_t n) {
   largest.resize(n);
 }
 
+template <class V>
 void ContactPhase::set_bound_reference(std::size_t f) {
+  using std::sqrt;
+  constexpr std::size_t n = std::is_same_v<V, double> ? 1 : simd::width;
   FaceRefs& r = sf_ref_;
-  for (int k = 0; k < 4; ++k) {
-    r.corner[k][f] = corner_[k][f];
-    for (int i = 0; i < 3; ++i) r.x[k][i][f] = xs_[i][static_cast<std::size_t>(corner_[k][f])];
-  }
-  r.a[f] = r.b[f] = r.largest[f] = 0;
-  if (f >= my_face_gid_.size()) return; // padding
-  r.a[f] = bound_a(my_face_depth_[f], cap_.len[f]);
-  r.b[f] = 2 * cap_.diag[f];
+  for (std::size_t g = f; g < f + n; ++g)
+    for (int k = 0; k < 4; ++k) {
+      r.corner[k][g] = corner_[k][g];
+      for (int i = 0; i < 3; ++i) r.x[k][i][g] = xs_[i][static_cast<std::size_t>(corner_[k][g])];
+    }
+  if constexpr (std::is_same_v<V, double>)
+    if (f >= my_face_gid_.size()) { // padding
+      r.a[f] = r.b[f] = r.largest[f] = 0;
+      return;
+    }
+  const V a = bound_a(lanes(my_face_depth_, f, V()), lanes(cap_.len, f, V()));
+  const V b = 2.0 * lanes(cap_.diag, f, V());
   // The largest delta for which the first bound holds: the root of 1.001 m(delta) = budget.
-  const double beta = sf_budget_[f] / 1.001, p = 1 + r.a[f] * r.b[f];
-  r.largest[f] = beta < std::numeric_limits<double>::infinity()
-                     ? 2 * beta / (p + std::sqrt(p * p + 16 * r.a[f] * beta))
-                     : beta;
-  due_drifts<double>(f, {0, 0, 0}, sf_due_[f], sf_due_rel_[f]); // no motion at the reference
+  const V beta = lanes(sf_budget_, f, V()) / 1.001, p = 1.0 + a * b;
+  const V largest = simd::select(beta < std::numeric_limits<double>::infinity(),
+                                 2.0 * beta / (p + sqrt(p * p + 16.0 * a * beta)), beta);
+  put(a, r.a, f);
+  put(b, r.b, f);
+  put(largest, r.largest, f);
+  V due, due_rel;
+  due_drifts<V>(f, {0.0, 0.0, 0.0}, due, due_rel); // no motion at the reference
+  put(due, sf_due_, f);
+  put(due_rel, sf_due_rel_, f);
+}
+
+void ContactPhase::set_bound_references() {
+  const std::size_t nf = my_face_gid_.size(), nfp = sf_budget_.size();
+  std::size_t f = 0;
+  for (; f + simd::width <= nf; f += simd::width) set_bound_reference<simd::vdouble>(f);
+  for (; f < nfp; ++f) set_bound_reference<double>(f);
 }
 
 void ContactPhase::set_face_reference(std::size_t f) {
+  set_face_budget(f);
+  set_bound_reference<double>(f);
+}
+
+void ContactPhase::set_face_budget(std::size_t f) {
   if (f >= my_face_gid_.size() || !alive(f)) { // (sf_budget_[f] is infinite)
-    set_bound_reference(f);
     if (f < my_face_gid_.size())
       for (int i = 0; i < 3; ++i) {
         sf_box_[i][f] = cap_.lo[i][f];
@@ -547,7 +580,6 @@ void ContactPhase::set_face_reference(std::size_t f) {
   }
   if (sf_near_[f] == 0) budget = std::min(budget, 0.9 * depth);
   sf_budget_[f] = budget;
-  set_bound_reference(f);
 }
 
 // How deep the box [lo, hi] (a point where lo = hi) lies inside rank r's box: the least
@@ -815,7 +847,7 @@ bool ContactPhase::lazy_bound_holds() {
   for (int fi : fail_) {
     const auto f = static_cast<std::size_t>(fi);
     sf_budget_[f] = h - build_deviation(f);
-    set_bound_reference(f);
+    set_bound_reference<double>(f);
   }
   return true;
 }

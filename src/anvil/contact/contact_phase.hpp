@@ -310,14 +310,19 @@ private:
   // The faces of fail_ checked exactly: true when each is within its budget; each then
   // gets this cycle as its reference, its budgets less what it used.
   bool rebase_faces();
-  // Face f's reference: this cycle's corners and exact box (cap_), and its rank.
+  // Face f's reference: this cycle's corners and exact box (cap_), and its rank
+  // (set_face_budget(), then set_bound_reference()).
   void set_face_reference(std::size_t f);
+  void set_face_budget(std::size_t f); // its box, budget and rank
   // How deep the box [lo, hi] lies inside rank r's box (rank_box_), m; negative outside.
   double depth_in_box(double lo0, double lo1, double lo2, double hi0, double hi1, double hi2,
                       int r) const;
   // Its bound's part (corners and coefficients, when it is next looked at), given its
-  // budget.
+  // budget: of face f (V = double), or of the faces from f (V = simd::vdouble; no
+  // padding among them).
+  template <class V>
   void set_bound_reference(std::size_t f);
+  void set_bound_references(); // of every face (padded), a vector at a time where it can
   // fail_: the faces whose bound fails (the others are within their budgets).
   void find_failing_faces();
   // A lazy cycle's fields of a received face: the box and plane (recv_box_), and the
