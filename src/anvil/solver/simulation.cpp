@@ -361,17 +361,20 @@ void Simulation::predict() {
   dt_avg_ = dt_avg;
   const std::size_t nn = nodes_.size();
 
-  // Work of the constraint reactions over this step (before the velocities change).
-  double work = 0;
+  // Work of the constraint reactions over this step (before the velocities change),
+  // summed in a local whose address is not taken (work's is, below: the sum went through
+  // memory at every term, a quarter of this function's time on the can crush).
+  double work_bc = 0;
   for (int n : constrained_nodes_) {
     for (int i = 0; i < 3; ++i) {
       if (!(constrained_[n] & (1u << i))) continue;
       const double v_old = nodes_.v[i][n];
       const double v_free = v_old + dt_avg * nodes_.f[i][n] / nodes_.mass[n];
       const double v_new = v_bc_[i][n];
-      if (fe_.node_owned[n]) work += nodes_.mass[n] * (v_new - v_free) * 0.5 * (v_old + v_new);
+      if (fe_.node_owned[n]) work_bc += nodes_.mass[n] * (v_new - v_free) * 0.5 * (v_old + v_new);
     }
   }
+  double work = work_bc; // (the same sum)
   double ke = 0;
   for (std::size_t p = 0; p < probe_node_.size(); ++p)
     if (probe_node_[p] >= 0) {
