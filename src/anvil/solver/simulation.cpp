@@ -492,29 +492,48 @@ void Simulation::correct() {
     // impulse times the mean of the step's start and end velocities (attributing the
     // kinetic energy change of the step exactly among the impulses that make it).
     // Only the contact nodes can carry a force (ascending: the sums' order is that of a
-    // pass over every node).
-    double work = 0, reaction = 0;
-    for (const int l : contact_->force_nodes()) {
-      const auto n = static_cast<std::size_t>(l);
-      if (contact_force_[0][n] == 0.0 && contact_force_[1][n] == 0.0 && contact_force_[2][n] == 0.0)
-        continue; // most nodes: no pair acts on them
+    // pass over every node). The sums are locals whose address is not taken (work's is,
+    // below). Where every node is a contact node (a thin wall), a vector of nodes without
+    // force is skipped at once.
+    double work_c = 0, reaction = 0;
+    const double* cf[3] = {contact_force_[0].data(), contact_force_[1].data(),
+                           contact_force_[2].data()};
+    auto impulse = [&](std::size_t n) {
+      if (cf[0][n] == 0.0 && cf[1][n] == 0.0 && cf[2][n] == 0.0)
+        return; // most nodes: no pair acts on them
       const double inv_m = dt_avg_ / nodes_.mass[n];
       for (int i = 0; i < 3; ++i) {
-        const double f = contact_force_[i][n];
+        const double f = cf[i][n];
         if (f == 0.0) continue;
         if (constrained_[n] & (1u << i)) {
           // The constraint cancels the impulse: the contact force still works on the node
           // (part of the pair's energy) and the constraint's reaction is external work.
           if (fe_.node_owned[n]) {
-            work += f * dt_avg_ * nodes_.v[i][n];
+            work_c += f * dt_avg_ * nodes_.v[i][n];
             reaction -= f * dt_avg_ * nodes_.v[i][n];
           }
           continue;
         }
         nodes_.v[i][n] += inv_m * f;
-        if (fe_.node_owned[n]) work += f * dt_avg_ * 0.5 * (v_prev_[i][n] + nodes_.v[i][n]);
+        if (fe_.node_owned[n]) work_c += f * dt_avg_ * 0.5 * (v_prev_[i][n] + nodes_.v[i][n]);
       }
+    };
+    const std::span<const int> fn = contact_->force_nodes();
+    const std::size_t nn = nodes_.size();
+    if (fn.size() == nn) {
+      constexpr auto W = static_cast<std::size_t>(simd::width);
+      std::size_t n = 0;
+      for (; n + W <= nn; n += W) {
+        if (all_of((simd::load(cf[0] + n) == 0.0) & (simd::load(cf[1] + n) == 0.0) &
+                   (simd::load(cf[2] + n) == 0.0)))
+          continue;
+        for (std::size_t k = n; k < n + W; ++k) impulse(k);
+      }
+      for (; n < nn; ++n) impulse(n);
+    } else {
+      for (const int l : fn) impulse(static_cast<std::size_t>(l));
     }
+    double work = work_c; // (the same sum)
     external_work_ += reaction;
     if (sph_) correct_particles(work);
     contact_energy_ -= work;
