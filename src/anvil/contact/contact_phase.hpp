@@ -290,10 +290,11 @@ private:
   // Several ranks: true when every node is within its budget; fail_ gets the faces whose
   // bound fails.
   bool shared_bound_holds();
-  // The bound of face f (V = double) or of the vector of faces from f (V = simd::vdouble;
-  // one template, the same operations lane by lane): their motion since the reference,
-  // whether their sides are within their budgets, how much further drift_ may grow
-  // before that could fail, and their due drifts from there (sf_due_, sf_due_rel_).
+  // The bound of the vector of faces from f (V = simd::vdouble) or of face f (V = double;
+  // one template, the same operations lane by lane): their motion since the reference
+  // (vectors only: looks), whether their sides are within their budgets, how much further
+  // drift_ may grow before that could fail, and their due drifts from there (sf_due_,
+  // sf_due_rel_).
   template <class V>
   struct FaceMotionBound {
     V delta; // largest move of a corner, m
