@@ -81,7 +81,6 @@ FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, in
       g2l[n] = static_cast<int>(d.node_gid.size());
       d.node_gid.push_back(n);
       d.node_owned.push_back(set[0] == rank ? 1 : 0); // the lowest toucher owns it
-      d.node_owner.push_back(set[0]);
       d.node_holders.push_back(group);
     }
   }

@@ -25,8 +25,7 @@ struct FeDecomposition {
   int rank = 0, ranks = 1;
 
   std::vector<std::int64_t> node_gid;   // global id of each local node, ascending
-  std::vector<std::uint8_t> node_owned; // 1 where this rank owns the node
-  std::vector<int> node_owner;          // owning rank of each local node (lowest toucher)
+  std::vector<std::uint8_t> node_owned; // 1 where this rank owns the node (lowest toucher)
   // The ranks that hold each local node, as a group of the table below (the same on every
   // rank): group g's ranks, ascending, are holder_ranks[holder_start[g], holder_start[g +
   // 1]); group r < ranks is rank r alone. Contact forces go to every holder of a node.
