@@ -426,6 +426,26 @@ def check_tools(outdir, tmp):
         run_tool(bad, 2)
 
 
+def check_balance(tmp):
+    """plot_history's balance error: E0 from summary.json, else the first row's E - W."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import plot_history  # noqa: E402 - the tool under test
+
+    class H:  # a fixed node's initial kinetic energy (2 J of 12) booked as work at t=0
+        data = {"total": np.array([10.0, 9.0, 8.0]), "external_work": np.array([-2.0, -3.0, -4.0])}
+
+        def __getitem__(self, k):
+            return self.data[k]
+
+    h = H()
+    e0 = plot_history.initial_energy(h, None)
+    assert e0 == 12.0, e0
+    assert np.allclose(plot_history.balance_error(h, e0), 0.0)
+    e0 = plot_history.initial_energy(h, {"energy": {"initial": 12.3}})
+    assert e0 == 12.3, e0
+    assert np.allclose(plot_history.balance_error(h, e0), 0.3 / 12.3)
+
+
 def check_mpi_trace(tmp):
     """mpi_trace.py on synthetic records: 3 cycles of (reduction, wait, wait), a message
     each; cycle and call counts, and exit status 2 on missing or foreign files."""
@@ -466,6 +486,7 @@ def main():
         c.run("plot_figure2 / plot_parallel_evidence on a synthetic series",
               check_series_tools, tmp)
         c.run("plot_figure3 on the synthetic run", check_figure3, outdir, tmp)
+        c.run("plot_history: balance error against E0", check_balance, tmp)
         c.run("mpi_trace on synthetic records", check_mpi_trace, tmp)
     finally:
         if args.keep:
