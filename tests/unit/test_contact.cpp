@@ -10,6 +10,7 @@
 #include "anvil/contact/capture.hpp"
 #include "anvil/contact/geometry.hpp"
 #include "anvil/contact/penalty.hpp"
+#include "anvil/contact/rigid_wall.hpp"
 #include "anvil/contact/search.hpp"
 #include "anvil/contact/surface.hpp"
 #include "anvil/mesh/generators.hpp"
@@ -367,6 +368,52 @@ TEST(Contact, PenaltyForcesConserveMomentum) {
       EXPECT_EQ(dest[j], 0);
     }
   EXPECT_EQ(copies, 2);
+}
+
+// A rigid wall (kinematic: the node lands on the wall at the end of the step) on nodes
+// with constrained components. Reference: the constraint itself, exact to round-off:
+// constrained components keep their value; the free ones put the node on the wall
+// (a wedge); the impulse reported is the one applied, m (v' - v).n.
+TEST(RigidWall, ConstrainedComponentsAndTheImpulseApplied) {
+  const double dt = 1e-6, m = 2.0;
+  auto run = [&](Vec3 normal, std::uint8_t fixed, Vec3 v0, Vec3& v1, double& impulse) {
+    const double x[3] = {0.0, 0.0, 1e-6}; // 1 um above the wall's point
+    double v[3] = {v0.x, v0.y, v0.z};
+    const double v_start[3] = {v0.x, v0.y, v0.z};
+    const double mass = m;
+    const std::uint8_t owned = 1;
+    const WallNodes nd{{&x[0], &x[1], &x[2]},
+                       {&v[0], &v[1], &v[2]},
+                       {&v_start[0], &v_start[1], &v_start[2]},
+                       &mass,
+                       &fixed,
+                       &owned,
+                       1};
+    std::vector<double> imp(1, 0.0);
+    const RigidWallConfig wall{{0, 0, 0}, normal * (1 / norm(normal)), 0.0};
+    apply_rigid_walls({wall}, dt, nd, imp);
+    v1 = {v[0], v[1], v[2]};
+    impulse = imp[0];
+    return Vec3{x[0], x[1], x[2]} + dt * v1; // the position at the end of the step
+  };
+  Vec3 v1;
+  double impulse;
+  // Free node: lands on the wall; impulse m dv.n.
+  Vec3 xe = run({0, 0, 1}, 0u, {0, 0, -20}, v1, impulse);
+  EXPECT_NEAR(xe.z, 0.0, 1e-18);
+  EXPECT_NEAR(impulse, m * (v1.z + 20), 1e-12);
+  // z prescribed (driven into a flat wall): the wall cannot move it and applies nothing.
+  xe = run({0, 0, 1}, 4u, {0, 0, -20}, v1, impulse);
+  EXPECT_EQ(v1.z, -20.0);
+  EXPECT_EQ(v1.x, 0.0);
+  EXPECT_EQ(impulse, 0.0);
+  // z prescribed, oblique wall: x alone brings the node onto the wall in one step.
+  const Vec3 n = Vec3{0.2, 0, 1} * (1 / norm(Vec3{0.2, 0, 1}));
+  xe = run({0.2, 0, 1}, 4u, {0, 0, -20}, v1, impulse);
+  EXPECT_EQ(v1.z, -20.0);
+  EXPECT_NEAR(dot(xe, n), 0.0, 1e-18);
+  EXPECT_GT(v1.x, 0.0);
+  EXPECT_NEAR(impulse, m * dot(v1 - Vec3{0, 0, -20}, n), 1e-12);
 }
 
 } // namespace

@@ -4,10 +4,10 @@
 
 namespace anvil {
 
-double apply_rigid_walls(const std::vector<RigidWallConfig>& walls, double dt, WallNodes nd,
-                         std::vector<double>& impulse) {
-  double work = 0;
-  if (!(dt > 0)) return work;
+WallResult apply_rigid_walls(const std::vector<RigidWallConfig>& walls, double dt, WallNodes nd,
+                             std::vector<double>& impulse) {
+  WallResult r;
+  if (!(dt > 0)) return r;
   for (std::size_t w = 0; w < walls.size(); ++w) {
     const Vec3 p = walls[w].point, n = walls[w].normal;
     const double mu = walls[w].friction;
@@ -25,18 +25,36 @@ double apply_rigid_walls(const std::vector<RigidWallConfig>& walls, double dt, W
         const double speed = norm(vt);
         if (speed > 0) vn -= std::min(1.0, mu * dvn / speed) * vt;
       }
-      for (int i = 0; i < 3; ++i) // constrained components keep their prescribed value
-        if (fixed & (1u << i)) vn[i] = v[i];
+      if (fixed != 0u) {
+        // Constrained components keep their prescribed value; the free ones alone bring
+        // the node onto the wall: the rest of the normal change along n's free part
+        // n_f, which moves the node along n by |n_f|^2 per unit (a wedge: a node driven
+        // into an oblique wall slides along it). A wall nearly square to every free
+        // direction cannot move the node: it is left alone, as a fully fixed one.
+        Vec3 nf = n;
+        for (int i = 0; i < 3; ++i)
+          if (fixed & (1u << i)) {
+            vn[i] = v[i];
+            nf[i] = 0.0;
+          }
+        const double nf2 = dot(nf, nf);
+        if (!(nf2 > 1e-6)) continue;
+        vn += ((dvn - dot(vn - v, n)) / nf2) * nf;
+      }
       for (int i = 0; i < 3; ++i) nd.v[i][k] = vn[i];
       if (nd.owned[k]) {
-        impulse[w] += nd.mass[k] * dvn;
+        // The impulse applied: a constrained component the wall left alone gave none.
+        const Vec3 dv = vn - v;
+        impulse[w] += nd.mass[k] * dot(dv, n);
         // Impulse times the mean of the step's start and end velocities.
         const Vec3 v0{nd.v_start[0][k], nd.v_start[1][k], nd.v_start[2][k]};
-        work += nd.mass[k] * dot(vn - v, 0.5 * (v0 + vn));
+        r.work += nd.mass[k] * dot(dv, 0.5 * (v0 + vn));
+        const Vec3 before = 0.5 * (v0 + v), after = 0.5 * (v0 + vn);
+        r.kinetic += 0.5 * nd.mass[k] * (dot(after, after) - dot(before, before));
       }
     }
   }
-  return work;
+  return r;
 }
 
 } // namespace anvil

@@ -24,9 +24,16 @@ struct WallNodes {
   std::size_t size;
 };
 
+// What the walls did to the owned nodes over the step.
+struct WallResult {
+  double work = 0;    // the impulses times the mean of the step's start and end velocities (J)
+  double kinetic = 0; // change of 1/2 m |v(n)|^2, v(n) the mean of v(n-1/2) and v(n+1/2) (J)
+};
+
 // Corrects the velocities; adds to impulse[w] the normal impulse wall w gave to owned
-// nodes (N s) and returns the work the walls did on owned nodes over the step (J).
-double apply_rigid_walls(const std::vector<RigidWallConfig>& walls, double dt, WallNodes nodes,
-                         std::vector<double>& impulse);
+// nodes (N s: the velocity change the wall applied, constrained components excluded,
+// along its normal).
+WallResult apply_rigid_walls(const std::vector<RigidWallConfig>& walls, double dt, WallNodes nodes,
+                             std::vector<double>& impulse);
 
 } // namespace anvil

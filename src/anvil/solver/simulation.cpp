@@ -376,13 +376,11 @@ void Simulation::predict() {
   }
   double work = work_bc; // (the same sum)
   double ke = 0;
+  // Probe displacements at t(n); their velocities once correct() has set v(n+1/2).
   for (std::size_t p = 0; p < probe_node_.size(); ++p)
     if (probe_node_[p] >= 0) {
       const int n = probe_node_[p];
-      for (int i = 0; i < 3; ++i) {
-        probe_local_[6 * p + i] = nodes_.x[i][n] - nodes_.x0[i][n];
-        probe_local_[6 * p + 3 + i] = nodes_.v[i][n]; // v(n-1/2), averaged below
-      }
+      for (int i = 0; i < 3; ++i) probe_local_[6 * p + i] = nodes_.x[i][n] - nodes_.x0[i][n];
     }
   double* v[3] = {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()};
   double* v_prev[3] = {v_prev_[0].data(), v_prev_[1].data(), v_prev_[2].data()};
@@ -436,12 +434,7 @@ void Simulation::predict() {
   ke = ke_nodes; // (ke is 0 before the nodes: the same sum)
   if (sph_) predict_particles(dt_avg, ke, work);
   external_work_ += work;
-  // Probe velocity at t(n): mean of the two half-step velocities.
-  for (std::size_t p = 0; p < probe_node_.size(); ++p)
-    if (probe_node_[p] >= 0)
-      for (int i = 0; i < 3; ++i)
-        probe_local_[6 * p + 3 + i] = 0.5 * (probe_local_[6 * p + 3 + i] + v[i][probe_node_[p]]);
-  kinetic_local_ = ke;
+  kinetic_local_ = ke; // correct() adds what contact and walls change
   sample_time_ = clock_.time;
   sample_cycle_ = clock_.cycle;
   sample_dt_ = dt;
@@ -498,6 +491,7 @@ void Simulation::correct() {
     double work_c = 0, reaction = 0;
     const double* cf[3] = {contact_force_[0].data(), contact_force_[1].data(),
                            contact_force_[2].data()};
+    double ke_change = 0; // of 1/2 m |v(n)|^2, v(n) = (v(n-1/2) + v(n+1/2)) / 2
     auto impulse = [&](std::size_t n) {
       if (cf[0][n] == 0.0 && cf[1][n] == 0.0 && cf[2][n] == 0.0)
         return; // most nodes: no pair acts on them
@@ -514,8 +508,13 @@ void Simulation::correct() {
           }
           continue;
         }
+        const double before = 0.5 * (v_prev_[i][n] + nodes_.v[i][n]);
         nodes_.v[i][n] += inv_m * f;
-        if (fe_.node_owned[n]) work_c += f * dt_avg_ * 0.5 * (v_prev_[i][n] + nodes_.v[i][n]);
+        const double after = 0.5 * (v_prev_[i][n] + nodes_.v[i][n]);
+        if (fe_.node_owned[n]) {
+          work_c += f * dt_avg_ * after;
+          ke_change += 0.5 * nodes_.mass[n] * (after * after - before * before);
+        }
       }
     };
     const std::span<const int> fn = contact_->force_nodes();
@@ -535,11 +534,16 @@ void Simulation::correct() {
     }
     double work = work_c; // (the same sum)
     external_work_ += reaction;
-    if (sph_) correct_particles(work);
+    if (sph_) correct_particles(work, ke_change);
     contact_energy_ -= work;
+    kinetic_local_ += ke_change;
   }
   ScopedPhase t(timers_, Phase::contact_force);
-  if (config_.rigid_walls.empty()) return;
+  if (!config_.rigid_walls.empty()) apply_walls();
+  sample_probe_velocities();
+}
+
+void Simulation::apply_walls() {
   std::fill(wall_impulse_.begin(), wall_impulse_.end(), 0.0);
   const WallNodes wn{{nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()},
                      {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()},
@@ -548,7 +552,11 @@ void Simulation::correct() {
                      constrained_.data(),
                      fe_.node_owned.data(),
                      nodes_.size()};
-  external_work_ += apply_rigid_walls(config_.rigid_walls, clock_.dt, wn, wall_impulse_);
+  auto add = [&](const WallResult& r) {
+    external_work_ += r.work;
+    kinetic_local_ += r.kinetic;
+  };
+  add(apply_rigid_walls(config_.rigid_walls, clock_.dt, wn, wall_impulse_));
   if (sph_) {
     // Particles meet the walls as nodes do (every own particle is "owned").
     auto& pt = sph_->particles();
@@ -560,8 +568,19 @@ void Simulation::correct() {
                        pt.constrained.data(),
                        particle_owned_.data(),
                        pt.size()};
-    external_work_ += apply_rigid_walls(config_.rigid_walls, clock_.dt, wp, wall_impulse_);
+    add(apply_rigid_walls(config_.rigid_walls, clock_.dt, wp, wall_impulse_));
   }
+}
+
+// The probes' velocity at t(n): the mean of v(n-1/2) and the corrected v(n+1/2).
+void Simulation::sample_probe_velocities() {
+  for (std::size_t p = 0; p < probe_node_.size(); ++p)
+    if (probe_node_[p] >= 0) {
+      const auto n = static_cast<std::size_t>(probe_node_[p]);
+      for (int i = 0; i < 3; ++i)
+        probe_local_[6 * p + 3 + i] = 0.5 * (v_prev_[i][n] + nodes_.v[i][n]);
+    }
+  if (sph_) sample_particle_probe_velocities();
 }
 
 void Simulation::update() {

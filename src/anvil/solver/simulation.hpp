@@ -120,6 +120,8 @@ private:
   void predict();
   void detect_contacts();
   void correct();
+  void apply_walls();             // the rigid walls' part of correct()
+  void sample_probe_velocities(); // at the end of correct()
   ContactNodes contact_view();
   void update();
   void apply_initial_conditions(const Mesh& mesh);
@@ -138,7 +140,8 @@ private:
   double particle_internal_energy() const;
   void predict_particles(double dt_avg, double& ke, double& work);
   std::vector<ContactNodeItem>& particle_contact_items(double dt);
-  void correct_particles(double& contact_work);
+  void correct_particles(double& contact_work, double& kinetic);
+  void sample_particle_probe_velocities();
   void update_particles(double dt);
   // restore() for the particles; `from` names the checkpoint in messages. Collective.
   void restore_particles(const Checkpoint& c, const std::string& from);

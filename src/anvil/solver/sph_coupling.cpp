@@ -152,10 +152,19 @@ void Simulation::predict_particles(double dt_avg, double& ke, double& work) {
     for (int k = 0; k < 6; ++k) probe_local_[6 * p + k] = 0.0;
     const int q = sph_->find(probe_particle_[p]);
     if (q < 0) continue;
-    for (int k = 0; k < 3; ++k) {
-      probe_local_[6 * p + k] = pt.x[k][q] - pt.x0[k][q];
-      probe_local_[6 * p + 3 + k] = 0.5 * (pv_prev_[k][q] + pt.v[k][q]);
-    }
+    for (int k = 0; k < 3; ++k) probe_local_[6 * p + k] = pt.x[k][q] - pt.x0[k][q];
+  }
+}
+
+// The particle probes' velocity at t(n), once v(n+1/2) is corrected (the rank holding the
+// particle; predict_particles() zeroed the slots of the others).
+void Simulation::sample_particle_probe_velocities() {
+  const auto& pt = sph_->particles();
+  for (std::size_t p = 0; p < probe_particle_.size(); ++p) {
+    if (probe_particle_[p] < 0) continue;
+    const int q = sph_->find(probe_particle_[p]);
+    if (q < 0) continue;
+    for (int k = 0; k < 3; ++k) probe_local_[6 * p + 3 + k] = 0.5 * (pv_prev_[k][q] + pt.v[k][q]);
   }
 }
 
@@ -184,8 +193,9 @@ std::vector<ContactNodeItem>& Simulation::particle_contact_items(double dt) {
 }
 
 // Cycle step 5 for the particles: the penalty forces the contact phase returned change
-// v(n+1/2) by dt_avg f / m; their work is added to `contact_work` (J), as for nodes.
-void Simulation::correct_particles(double& contact_work) {
+// v(n+1/2) by dt_avg f / m; their work is added to `contact_work` (J) and the change of
+// the kinetic energy at t(n) to `kinetic` (J), as for nodes.
+void Simulation::correct_particles(double& contact_work, double& kinetic) {
   auto& pt = sph_->particles();
   const auto f = contact_->extra_forces();
   const auto faces = contact_->extra_faces();
@@ -195,8 +205,11 @@ void Simulation::correct_particles(double& contact_work) {
     const double inv_m = dt_avg_ / pt.mass[i];
     for (int d = 0; d < 3; ++d) {
       if (f[k][d] == 0.0 || (pt.constrained[i] & (1u << d))) continue;
+      const double before = 0.5 * (pv_prev_[d][i] + pt.v[d][i]);
       pt.v[d][i] += inv_m * f[k][d];
-      contact_work += f[k][d] * dt_avg_ * 0.5 * (pv_prev_[d][i] + pt.v[d][i]);
+      const double after = 0.5 * (pv_prev_[d][i] + pt.v[d][i]);
+      contact_work += f[k][d] * dt_avg_ * after;
+      kinetic += 0.5 * pt.mass[i] * (after * after - before * before);
     }
   }
 }
