@@ -370,6 +370,36 @@ TEST(Contact, PenaltyForcesConserveMomentum) {
   EXPECT_EQ(copies, 2);
 }
 
+// The stiffness cap (penalty.hpp): a pair's stiffness never exceeds
+// stable_stiffness_fraction m / dt^2, m the node against the face's nodes at the foot
+// (1 / m = 1 / m_node + sum N_a^2 / m_face_a). Reference: that formula, to round-off.
+TEST(Contact, PenaltyStiffnessCappedForLightNodes) {
+  Scene s;
+  s.face(1, 0, 0, 100);
+  s.node(7, {0.3, 0.4, -0.05});
+  s.run();
+  ASSERT_EQ(s.pairs.size(), 1u);
+  s.pairs[0].allowance = 0.0;
+  const int one_start[] = {0, 1}, one_rank[] = {0};
+  auto force = [&](double node_mass, double dt) {
+    s.nodes[0].mass = node_mass;
+    std::vector<ContactForceItem> items;
+    std::vector<int> dest;
+    penalty_forces(s.nodes, s.faces, s.pairs, {0.0, dt}, {one_start, one_rank}, items, dest);
+    return items.at(0).f[2];
+  };
+  const double pen = -s.pairs[0].gap;
+  // Heavy node, short step: the face's stiffness (1e6 N/m).
+  EXPECT_NEAR(force(1.0, 1e-6), 1e6 * pen, 1e-9);
+  // A light node (1e-9 kg) at 1e-6 s: the cap, 0.5 m / dt^2 with the faces' unit masses.
+  const auto N = quad_shape(s.pairs[0].xi, s.pairs[0].eta);
+  double inv_m = 1e9;
+  for (int a = 0; a < 4; ++a) inv_m += N[a] * N[a];
+  const double k = stable_stiffness_fraction / (inv_m * 1e-12);
+  EXPECT_LT(k, 1e6);
+  EXPECT_NEAR(force(1e-9, 1e-6), k * pen, 1e-12 * k * pen);
+}
+
 // A rigid wall (kinematic: the node lands on the wall at the end of the step) on nodes
 // with constrained components. Reference: the constraint itself, exact to round-off:
 // constrained components keep their value; the free ones put the node on the wall

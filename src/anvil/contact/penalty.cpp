@@ -22,15 +22,16 @@ void penalty_forces(const std::vector<ContactNodeItem>& nodes,
     const auto& n = nodes[static_cast<std::size_t>(p.node)];
     const auto& f = faces[static_cast<std::size_t>(p.face)];
     const auto N = quad_shape(p.xi, p.eta);
-    const double fn = f.stiffness * std::max(0.0, -p.gap - p.allowance);
+    // The pair's inverse mass: the node against the face's nodes at the foot.
+    double inv_m = 1 / n.mass;
+    for (int a = 0; a < 4; ++a) inv_m += N[a] * N[a] / f.mass[a];
+    double k = f.stiffness;
+    if (opt.dt > 0) k = std::min(k, stable_stiffness_fraction / (inv_m * opt.dt * opt.dt));
+    const double fn = k * std::max(0.0, -p.gap - p.allowance);
     Vec3 F = fn * p.normal;
     if (opt.friction > 0 && opt.dt > 0) {
       Vec3 vr{n.v[0], n.v[1], n.v[2]};
-      double inv_m = 1 / n.mass;
-      for (int a = 0; a < 4; ++a) {
-        vr -= N[a] * Vec3{f.v[a][0], f.v[a][1], f.v[a][2]};
-        inv_m += N[a] * N[a] / f.mass[a];
-      }
+      for (int a = 0; a < 4; ++a) vr -= N[a] * Vec3{f.v[a][0], f.v[a][1], f.v[a][2]};
       const Vec3 vt = vr - dot(vr, p.normal) * p.normal;
       const double speed = norm(vt);
       if (speed > 0) {

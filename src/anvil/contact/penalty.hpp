@@ -3,7 +3,11 @@
 // -N_a F (N_a the face's shape functions at the foot), so momentum is conserved to
 // round-off between deformable bodies; optional Coulomb friction opposes the relative
 // tangential velocity, limited by mu |F| and by the force that would stop the sliding in
-// one step. MPI-free: forces leave as items addressed to every FE rank that holds the node.
+// one step. The stiffness is the face's (contact_phase.cpp: penalty_scale K A^2 / V), but
+// never more than stable_stiffness_fraction m / dt^2, m the pair's mass (the node against
+// the face's nodes at the foot): a light node (a gas particle) on a stiff face would
+// otherwise ring unstably, k dt^2 / m past central difference's limit of 4.
+// MPI-free: forces leave as items addressed to every FE rank that holds the node.
 #pragma once
 
 #include <cstdint>
@@ -25,9 +29,12 @@ struct ContactForceItem {
   double f[3];         // N
 };
 
+// The cap on a pair's stiffness, in m / dt^2 (the spring alone: omega dt = 0.71).
+inline constexpr double stable_stiffness_fraction = 0.5;
+
 struct PenaltyOptions {
   double friction = 0; // Coulomb coefficient
-  double dt = 0;       // the step over which the force acts (for the sticking limit)
+  double dt = 0;       // the step (for the stiffness cap and the sticking limit)
 };
 
 // The holder groups of the items' `holders` fields: group g's ranks are
