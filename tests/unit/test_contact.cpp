@@ -412,18 +412,22 @@ TEST(RigidWall, ConstrainedComponentsAndTheImpulseApplied) {
     const double v_start[3] = {v0.x, v0.y, v0.z};
     const double mass = m;
     const std::uint8_t owned = 1;
+    const std::int64_t gid = 5;
     const WallNodes nd{{&x[0], &x[1], &x[2]},
                        {&v[0], &v[1], &v[2]},
                        {&v_start[0], &v_start[1], &v_start[2]},
                        &mass,
                        &fixed,
                        &owned,
+                       &gid,
+                       100,
                        1};
-    std::vector<double> imp(1, 0.0);
+    std::vector<WallHit> hits;
     const RigidWallConfig wall{{0, 0, 0}, normal * (1 / norm(normal)), 0.0};
-    apply_rigid_walls({wall}, dt, nd, imp);
+    apply_rigid_walls({wall}, dt, nd, hits);
     v1 = {v[0], v[1], v[2]};
-    impulse = imp[0];
+    impulse = hits.empty() ? 0.0 : hits[0].impulse;
+    if (!hits.empty()) EXPECT_EQ(hits[0].key, 105);
     return Vec3{x[0], x[1], x[2]} + dt * v1; // the position at the end of the step
   };
   Vec3 v1;
@@ -444,6 +448,15 @@ TEST(RigidWall, ConstrainedComponentsAndTheImpulseApplied) {
   EXPECT_NEAR(dot(xe, n), 0.0, 1e-18);
   EXPECT_GT(v1.x, 0.0);
   EXPECT_NEAR(impulse, m * dot(v1 - Vec3{0, 0, -20}, n), 1e-12);
+  // A wall's force sums its hits in ascending key, whatever order they come in.
+  std::vector<WallHit> a = {{3, 0, 0.1}, {1, 1, 5.0}, {2, 0, 1e16}, {1, 0, -1e16}},
+                       b = {a[2], a[1], a[3], a[0]};
+  std::vector<double> fa(2), fb(2);
+  wall_forces(a, 0.5, fa);
+  wall_forces(b, 0.5, fb);
+  EXPECT_EQ(fa[0], ((-1e16 + 1e16) + 0.1) / 0.5);
+  EXPECT_EQ(fa[1], 10.0);
+  EXPECT_EQ(fa, fb);
 }
 
 } // namespace

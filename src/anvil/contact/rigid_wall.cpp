@@ -1,11 +1,12 @@
 #include "anvil/contact/rigid_wall.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace anvil {
 
 WallResult apply_rigid_walls(const std::vector<RigidWallConfig>& walls, double dt, WallNodes nd,
-                             std::vector<double>& impulse) {
+                             std::vector<WallHit>& hits) {
   WallResult r;
   if (!(dt > 0)) return r;
   for (std::size_t w = 0; w < walls.size(); ++w) {
@@ -45,7 +46,8 @@ WallResult apply_rigid_walls(const std::vector<RigidWallConfig>& walls, double d
       if (nd.owned[k]) {
         // The impulse applied: a constrained component the wall left alone gave none.
         const Vec3 dv = vn - v;
-        impulse[w] += nd.mass[k] * dot(dv, n);
+        hits.push_back(
+            {nd.gid[k] + nd.gid_offset, static_cast<std::int32_t>(w), nd.mass[k] * dot(dv, n)});
         // Impulse times the mean of the step's start and end velocities.
         const Vec3 v0{nd.v_start[0][k], nd.v_start[1][k], nd.v_start[2][k]};
         r.work += nd.mass[k] * dot(dv, 0.5 * (v0 + vn));
@@ -55,6 +57,15 @@ WallResult apply_rigid_walls(const std::vector<RigidWallConfig>& walls, double d
     }
   }
   return r;
+}
+
+void wall_forces(std::vector<WallHit>& hits, double dt, std::vector<double>& force) {
+  std::sort(hits.begin(), hits.end(), [](const WallHit& a, const WallHit& b) {
+    return a.wall != b.wall ? a.wall < b.wall : a.key < b.key;
+  });
+  std::fill(force.begin(), force.end(), 0.0);
+  for (const WallHit& h : hits) force[static_cast<std::size_t>(h.wall)] += h.impulse;
+  for (double& f : force) f = dt > 0 ? f / dt : 0.0;
 }
 
 } // namespace anvil

@@ -21,7 +21,17 @@ struct WallNodes {
   const double* mass;
   const std::uint8_t* constrained; // bit i: component i is constrained and left alone
   const std::uint8_t* owned;       // diagnostics count owned nodes only
+  const std::int64_t* gid;         // global ids, keys of the force's summation order
+  std::int64_t gid_offset;         // added to gid (particles come after the nodes)
   std::size_t size;
+};
+
+// The normal impulse (N s) one wall gave one owned node over the step: the velocity
+// change the wall applied, constrained components excluded, along its normal.
+struct WallHit {
+  std::int64_t key; // gid + gid_offset
+  std::int32_t wall;
+  double impulse;
 };
 
 // What the walls did to the owned nodes over the step.
@@ -30,10 +40,14 @@ struct WallResult {
   double kinetic = 0; // change of 1/2 m |v(n)|^2, v(n) the mean of v(n-1/2) and v(n+1/2) (J)
 };
 
-// Corrects the velocities; adds to impulse[w] the normal impulse wall w gave to owned
-// nodes (N s: the velocity change the wall applied, constrained components excluded,
-// along its normal).
+// Corrects the velocities; appends to `hits` each owned node a wall acted on. A wall's
+// force is the sum of its hits in ascending key over every rank (wall_forces), the same
+// bits on any number of ranks.
 WallResult apply_rigid_walls(const std::vector<RigidWallConfig>& walls, double dt, WallNodes nodes,
-                             std::vector<double>& impulse);
+                             std::vector<WallHit>& hits);
+
+// Sums the hits of every wall in ascending key: force[w] = sum of wall w's impulses / dt.
+// `hits` is every rank's list (in any order); it is sorted in place.
+void wall_forces(std::vector<WallHit>& hits, double dt, std::vector<double>& force);
 
 } // namespace anvil

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace anvil {
 
@@ -198,6 +199,19 @@ void Comm::broadcast(std::string& s, int root) const {
 void Comm::allgather_bytes(const void* send, std::size_t bytes, void* recv) const {
   const int n = to_int(bytes, "allgather");
   check(MPI_Allgather(send, n, MPI_BYTE, recv, n, MPI_BYTE, to_mpi(handle_)), "MPI_Allgather");
+}
+void Comm::allgatherv_bytes(const void* send, std::size_t bytes, void* recv,
+                            std::span<const std::int64_t> recv_bytes) const {
+  std::vector<int> counts(static_cast<std::size_t>(size_)), displ(counts.size());
+  std::int64_t offset = 0;
+  for (std::size_t q = 0; q < counts.size(); ++q) {
+    counts[q] = to_int(static_cast<std::size_t>(recv_bytes[q]), "allgatherv");
+    displ[q] = to_int(static_cast<std::size_t>(offset), "allgatherv");
+    offset += recv_bytes[q];
+  }
+  check(MPI_Allgatherv(send, to_int(bytes, "allgatherv"), MPI_BYTE, recv, counts.data(),
+                       displ.data(), MPI_BYTE, to_mpi(handle_)),
+        "MPI_Allgatherv");
 }
 void Comm::alltoall_bytes(const void* send, std::size_t bytes, void* recv) const {
   const int n = to_int(bytes, "alltoall");

@@ -96,6 +96,9 @@ public:
   // Raw byte transfers; the typed templates below are the intended interface.
   void broadcast_bytes(void* data, std::size_t bytes, int root) const;
   void allgather_bytes(const void* send, std::size_t bytes_per_rank, void* recv) const;
+  // Each rank's `bytes` bytes, concatenated in rank order into recv (sum of recv_bytes).
+  void allgatherv_bytes(const void* send, std::size_t bytes, void* recv,
+                        std::span<const std::int64_t> recv_bytes) const;
   void alltoall_bytes(const void* send, std::size_t bytes_per_rank, void* recv) const;
   // Variable all-to-all in bytes: counts and displacements per rank.
   void alltoallv_bytes(const void* send, std::span<const std::int64_t> send_bytes,
@@ -129,6 +132,17 @@ public:
     static_assert(std::is_trivially_copyable_v<T>);
     std::vector<T> out(static_cast<std::size_t>(size_));
     allgather_bytes(&value, sizeof(T), out.data());
+    return out;
+  }
+  // Every rank's values, concatenated in rank order (not for the hot cycle: it allocates).
+  template <class T>
+  std::vector<T> allgatherv(std::span<const T> mine) const {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const auto bytes = allgather(static_cast<std::int64_t>(mine.size_bytes()));
+    std::int64_t total = 0;
+    for (const std::int64_t b : bytes) total += b;
+    std::vector<T> out(static_cast<std::size_t>(total) / sizeof(T));
+    allgatherv_bytes(mine.data(), mine.size_bytes(), out.data(), bytes);
     return out;
   }
   // One value to each rank, one value from each rank.

@@ -89,7 +89,6 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     for (int e = 0; e < b.size(); ++e) part_mass_[b.part] += b.mass[e];
   comm_.sum(std::span<double>(part_mass_));
 
-  wall_impulse_.assign(config_.rigid_walls.size(), 0.0);
   if (!config_.contact.empty()) {
     contact_ = std::make_unique<ContactPhase>(config_.contact[0], mesh, fe_, blocks_, comm_,
                                               config_.decomposition.scale);
@@ -544,19 +543,21 @@ void Simulation::correct() {
 }
 
 void Simulation::apply_walls() {
-  std::fill(wall_impulse_.begin(), wall_impulse_.end(), 0.0);
+  wall_hits_.clear();
   const WallNodes wn{{nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()},
                      {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()},
                      {v_prev_[0].data(), v_prev_[1].data(), v_prev_[2].data()},
                      nodes_.mass.data(),
                      constrained_.data(),
                      fe_.node_owned.data(),
+                     fe_.node_gid.data(),
+                     0,
                      nodes_.size()};
   auto add = [&](const WallResult& r) {
     external_work_ += r.work;
     kinetic_local_ += r.kinetic;
   };
-  add(apply_rigid_walls(config_.rigid_walls, clock_.dt, wn, wall_impulse_));
+  add(apply_rigid_walls(config_.rigid_walls, clock_.dt, wn, wall_hits_));
   if (sph_) {
     // Particles meet the walls as nodes do (every own particle is "owned").
     auto& pt = sph_->particles();
@@ -567,8 +568,10 @@ void Simulation::apply_walls() {
                        pt.mass.data(),
                        pt.constrained.data(),
                        particle_owned_.data(),
+                       pt.gid.data(),
+                       global_nodes_,
                        pt.size()};
-    add(apply_rigid_walls(config_.rigid_walls, clock_.dt, wp, wall_impulse_));
+    add(apply_rigid_walls(config_.rigid_walls, clock_.dt, wp, wall_hits_));
   }
 }
 
@@ -622,10 +625,12 @@ Sample Simulation::sample() const {
   s.external_work = local[3];
   s.probes = probe_local_;
   comm_.sum(std::span<double>(s.probes));
-  s.wall_force.assign(wall_impulse_.size(), 0.0);
-  for (std::size_t w = 0; w < wall_impulse_.size(); ++w)
-    s.wall_force[w] = dt_avg_ > 0 ? wall_impulse_[w] / dt_avg_ : 0.0;
-  comm_.sum(std::span<double>(s.wall_force));
+  // The walls' forces: every rank's hits, summed in ascending key (DESIGN.md section 3).
+  s.wall_force.assign(config_.rigid_walls.size(), 0.0);
+  if (!s.wall_force.empty()) {
+    std::vector<WallHit> all = comm_.allgatherv(std::span<const WallHit>(wall_hits_));
+    wall_forces(all, dt_avg_, s.wall_force);
+  }
   return s;
 }
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "anvil/contact/contact_phase.hpp"
+#include "anvil/contact/rigid_wall.hpp"
 #include "anvil/core/timer.hpp"
 #include "anvil/fe/hex_block.hpp"
 #include "anvil/io/config.hpp"
@@ -172,7 +173,7 @@ private:
   double contact_energy_ = 0; // penalty energy stored plus friction dissipated, owned nodes
 
   // Rigid walls: normal impulse given to owned nodes in the last step, per wall.
-  std::vector<double> wall_impulse_;
+  std::vector<WallHit> wall_hits_; // of the last step (owned nodes, own particles)
   double dt_avg_ = 0; // the velocity step of the last cycle (mean of the two intervals)
 
   // Diagnostics accumulated by this rank over owned entities.
