@@ -16,6 +16,7 @@
 
 #include "anvil/io/keyword.hpp"
 #include "anvil/solver/model.hpp"
+#include "anvil/solver/simulation.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -137,6 +138,22 @@ TEST(Keyword, ReadsADeck) {
     std::array<Vec3, 8> x;
     for (int a = 0; a < 8; ++a) x[a] = m.nodes[h[a]];
     EXPECT_NEAR(hex_volume(x), 1.0, 1e-12); // LS-DYNA's node order is anvil's
+  }
+}
+
+// An inverted element is named by its EID, not by its position in the part.
+TEST(Keyword, InvertedElementIsNamedByItsId) {
+  std::string text = with(good, "       1       1       1", "     100       1       1");
+  text =
+      with(text, "       2       1       5       6       7       8       9      10      11      12",
+           "     200       1       9      10      11      12       5       6       7       8");
+  try {
+    Simulation sim(kw(text), Comm::world());
+    ADD_FAILURE() << "no error for an inverted element";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("element 200 of part part1 has a non-positive volume"),
+              std::string::npos)
+        << e.what();
   }
 }
 

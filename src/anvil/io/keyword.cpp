@@ -672,14 +672,9 @@ private:
                 fmt::format("element {} has {} nodes; anvil reads 8-node hexahedra only (no "
                             "tetrahedra or other solids)",
                             e.eid, given));
-      for (int a = 0; a < 8; ++a)
-        for (int k = 0; k < a; ++k)
-          if (e.nodes[a] == e.nodes[k])
-            nc.fail(fmt::format("N{}", a + 1),
-                    fmt::format("element {} uses node {} twice (N{} and N{}): degenerate "
-                                "hexahedra (wedges and tetrahedra written as hexahedra) are "
-                                "not supported",
-                                e.eid, e.nodes[a], k + 1, a + 1));
+      int corner = 0;
+      if (const std::string why = degenerate_hex(e.nodes, e.eid, &corner); !why.empty())
+        nc.fail(fmt::format("N{}", corner + 1), why);
       const auto [it, fresh] = element_index_.emplace(e.eid, elements_.size());
       if (!fresh)
         first.fail("EID", fmt::format("element {} is defined twice (first at {})", e.eid,
@@ -1290,7 +1285,7 @@ private:
     std::unordered_map<std::int64_t, std::size_t> block_of;
     for (const auto pid : pids) {
       block_of.emplace(pid, m.blocks.size());
-      m.blocks.push_back(ElementBlock{fmt::format("part{}", pid), {}});
+      m.blocks.push_back(ElementBlock{fmt::format("part{}", pid), {}, {}});
     }
     for (const auto& e : elements_) {
       const auto b = block_of.find(e.pid);
@@ -1306,6 +1301,7 @@ private:
         h[a] = node_position(e.nodes[a], e.at, fmt::format("*ELEMENT_SOLID.N{}", a + 1),
                              fmt::format("element {}", e.eid));
       m.blocks[b->second].elements.push_back(h);
+      m.blocks[b->second].ids.push_back(e.eid);
     }
     for (const auto& [sid, s] : node_sets_)
       m.node_sets[fmt::format("nodeset_{}", sid)] = resolve_node_set(sid, s);

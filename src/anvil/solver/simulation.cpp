@@ -69,10 +69,12 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     const std::int64_t bad_gid = comm_.min(bad >= 0 ? hb.gid[bad] : none);
     if (bad_gid != none) {
       const double v = comm_.min(bad >= 0 && hb.gid[bad] == bad_gid ? hb.volume[bad] : 1e300);
-      throw InputError(part.mesh.where,
-                       fmt::format("element {} of part {} has a non-positive volume ({:.3g} m^3): "
-                                   "check the node order",
-                                   bad_gid - block_offsets_[b] + 1, part.name, v));
+      throw InputError(
+          part.mesh.where,
+          fmt::format("element {} of part {} has a non-positive volume ({:.3g} m^3): "
+                      "check the node order",
+                      mesh.blocks[b].id(static_cast<std::size_t>(bad_gid - block_offsets_[b])),
+                      part.name, v));
     }
     for (int e = 0; e < hb.size(); ++e)
       for (int a = 0; a < 8; ++a)
