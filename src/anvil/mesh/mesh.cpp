@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "anvil/core/hash.hpp"
+
 namespace anvil {
 
 std::int64_t Mesh::num_elements() const {
@@ -57,6 +59,16 @@ std::string degenerate_hex(const Hex& nodes, std::int64_t id, int* corner) {
                            id, nodes[a], k + 1, a + 1);
       }
   return {};
+}
+
+std::uint64_t mesh_fingerprint(const Mesh& mesh) {
+  Fnv1a h;
+  h.values(mesh.nodes);
+  for (const auto& b : mesh.blocks) {
+    const std::uint64_t n = b.elements.size();
+    h.bytes(&n, sizeof n).values(b.elements);
+  }
+  return h.value();
 }
 
 namespace {

@@ -67,6 +67,10 @@ struct Mesh {
 // the 0-based corner of the repeat. Every mesh reader checks its elements with it.
 std::string degenerate_hex(const Hex& nodes, std::int64_t id, int* corner = nullptr);
 
+// A hash of the nodes' coordinates (their bits) and of every block's connectivity, in
+// global id order: equal for equal meshes, whoever computes it. A checkpoint carries it.
+std::uint64_t mesh_fingerprint(const Mesh& mesh);
+
 // Signed volume of a hexahedron (exact for the trilinear map).
 double hex_volume(const std::array<Vec3, 8>& x);
 
