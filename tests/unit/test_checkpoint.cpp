@@ -77,7 +77,8 @@ std::string written(const Checkpoint& c, const std::string& name) {
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-// Expects reading `bytes` (as file `name`) to throw an InputError naming the file and
+// Expects reading `bytes` (as file `name`, unique to its test: ctest runs tests in
+// parallel) to throw an InputError naming the file and
 // saying `fragment`.
 void expect_refused(const std::string& bytes, const std::string& name,
                     const std::string& fragment) {
@@ -145,7 +146,7 @@ TEST(Checkpoint, OlderFormatIsRefused) {
 
 // One flipped bit anywhere past the magic (a velocity, a count, the header) is refused.
 TEST(Checkpoint, FlippedBitIsRefused) {
-  const std::string good = written(sample(), "good.anvil");
+  const std::string good = written(sample(), "flip_source.anvil");
   for (std::size_t at = 8; at < good.size(); at += 7) {
     SCOPED_TRACE(at);
     std::string s = good;
@@ -158,7 +159,7 @@ TEST(Checkpoint, FlippedBitIsRefused) {
 }
 
 TEST(Checkpoint, TruncatedOrExtendedFileIsRefused) {
-  const std::string good = written(sample(), "good.anvil");
+  const std::string good = written(sample(), "cut_source.anvil");
   expect_refused(good.substr(0, good.size() - 1), "short.anvil", "is truncated");
   expect_refused(good.substr(0, 12), "short.anvil", "is truncated");
   expect_refused("", "empty.anvil", "not an anvil checkpoint");
