@@ -1,20 +1,19 @@
-// The checkpoint file format (io/checkpoint.hpp): a version 4 file keeps every section
-// bit for bit, particles, eroded elements, thick-shell points and both .pvd lists
-// included; a version 1 file
-// (written before particles and erosion were checkpointed) still reads, as a model without
-// particles whose elements are all alive; a file whose
-// sections disagree is an InputError naming it. The restart itself is tested end to end
-// by tests/regression (test_restart.sh, test_restart_sph.sh).
+// The checkpoint file format (io/checkpoint.hpp): a file keeps every section bit for bit,
+// particles, eroded elements, thick-shell points, the mesh fingerprint and both .pvd lists
+// included; a file that is damaged (checksum), truncated, extended, inconsistent, of an
+// older format or of an unknown one is an InputError naming it. The restart itself is
+// tested end to end by tests/regression (test_restart.sh, test_restart_sph.sh) and its
+// refusals on every rank by tests/mpi/test_collective_errors.cpp.
 #include <gtest/gtest.h>
 
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <limits>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "anvil/core/error.hpp"
 #include "anvil/io/checkpoint.hpp"
@@ -60,6 +59,7 @@ Checkpoint sample() {
   c.point_gid = {0};
   for (int k = 0; k < Checkpoint::point_values; ++k) c.point_data.push_back(k / 13.0 + 0.5);
   c.point_count = {3};
+  c.mesh_fingerprint = 0xfedcba9876543210ULL;
   return c;
 }
 
@@ -69,33 +69,28 @@ bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
          (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
-// A version 1 file, as the previous reader expected it: magic ANVILCK1, the header without
-// the particle keys, no particle sections.
-std::string version1(const Checkpoint& c) {
-  nlohmann::json h;
-  h["deck"] = c.deck;
-  h["cycle"] = c.cycle;
-  h["model_nodes"] = c.model_nodes;
-  h["model_elements"] = c.model_elements;
-  h["field_count"] = c.outputs.field_count;
-  h["pvd"] = c.outputs.pvd;
-  std::string s = "ANVILCK1";
-  auto put = [&s](const auto& v) {
-    const std::uint64_t n = v.size();
-    s.append(reinterpret_cast<const char*>(&n), sizeof n);
-    if (n) s.append(reinterpret_cast<const char*>(v.data()), n * sizeof(v[0]));
-  };
-  const std::string header = h.dump();
-  put(std::vector<char>(header.begin(), header.end()));
-  put(std::vector<double>{c.time, c.dt, c.dt_prev, c.dt_initial, 0, 0, c.outputs.next_fields,
-                          c.outputs.next_history});
-  put(std::vector<double>{c.outputs.next_checkpoint});
-  put(c.node_gid);
-  put(c.node_data);
-  put(c.node_face);
-  put(c.element_gid);
-  put(c.element_data);
-  return s;
+// The bytes of `c` as written.
+std::string written(const Checkpoint& c, const std::string& name) {
+  const std::string path = temp_path(name);
+  anvil::write_checkpoint(path, c);
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// Expects reading `bytes` (as file `name`, unique to its test: ctest runs tests in
+// parallel) to throw an InputError naming the file and
+// saying `fragment`.
+void expect_refused(const std::string& bytes, const std::string& name,
+                    const std::string& fragment) {
+  const std::string path = temp_path(name);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+  try {
+    anvil::read_checkpoint(path);
+    ADD_FAILURE() << name << ": accepted";
+  } catch (const anvil::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+  }
 }
 
 TEST(Checkpoint, RoundTripKeepsParticlesAndBothSeries) {
@@ -118,23 +113,7 @@ TEST(Checkpoint, RoundTripKeepsParticlesAndBothSeries) {
   EXPECT_EQ(r.point_count, c.point_count);
   EXPECT_EQ(r.outputs.pvd, c.outputs.pvd);
   EXPECT_EQ(r.outputs.particle_pvd, c.outputs.particle_pvd);
-}
-
-TEST(Checkpoint, VersionOneReadsWithoutParticles) {
-  Checkpoint c = sample();
-  const std::string path = temp_path("version1.anvil");
-  std::ofstream(path, std::ios::binary) << version1(c);
-  const Checkpoint r = anvil::read_checkpoint(path);
-  EXPECT_EQ(r.cycle, c.cycle);
-  EXPECT_EQ(std::memcmp(&r.dt_prev, &c.dt_prev, sizeof c.dt_prev), 0);
-  EXPECT_TRUE(same_bits(r.node_data, c.node_data));
-  EXPECT_TRUE(same_bits(r.element_data, c.element_data));
-  EXPECT_EQ(r.element_eroded, std::vector<std::int64_t>{0});
-  EXPECT_EQ(r.outputs.pvd, c.outputs.pvd);
-  EXPECT_EQ(r.model_particles, 0);
-  EXPECT_TRUE(r.particle_gid.empty());
-  EXPECT_TRUE(r.outputs.particle_pvd.empty());
-  EXPECT_TRUE(r.point_gid.empty());
+  EXPECT_EQ(r.mesh_fingerprint, c.mesh_fingerprint);
 }
 
 TEST(Checkpoint, InconsistentParticleCountNamesTheFile) {
@@ -151,16 +130,54 @@ TEST(Checkpoint, InconsistentParticleCountNamesTheFile) {
 }
 
 TEST(Checkpoint, UnknownVersionIsRefused) {
-  const std::string path = temp_path("version9.anvil");
-  std::string s = version1(sample());
+  std::string s = written(sample(), "version9.anvil");
   s[7] = '9';
-  std::ofstream(path, std::ios::binary) << s;
-  try {
-    anvil::read_checkpoint(path);
-    FAIL() << "a checkpoint of an unknown version was accepted";
-  } catch (const anvil::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("version 9"), std::string::npos) << e.what();
+  expect_refused(s, "version9.anvil", "version 9");
+}
+
+// Files of formats 1 to 4 had no checksum: refused, with what to do.
+TEST(Checkpoint, OlderFormatIsRefused) {
+  for (const char v : {'1', '4'}) {
+    std::string s = written(sample(), "older.anvil");
+    s[7] = v;
+    expect_refused(s, "older.anvil", "written by an older anvil");
   }
+}
+
+// One flipped bit anywhere past the magic (a velocity, a count, the header) is refused.
+TEST(Checkpoint, FlippedBitIsRefused) {
+  const std::string good = written(sample(), "flip_source.anvil");
+  for (std::size_t at = 8; at < good.size(); at += 7) {
+    SCOPED_TRACE(at);
+    std::string s = good;
+    s[at] = static_cast<char>(s[at] ^ 0x10);
+    expect_refused(s, "flipped.anvil", "checkpoint");
+  }
+  std::string s = good;
+  s[s.size() - 100] = static_cast<char>(s[s.size() - 100] ^ 0x01); // in the thick-shell data
+  expect_refused(s, "flipped.anvil", "is corrupt: its checksum does not match");
+}
+
+TEST(Checkpoint, TruncatedOrExtendedFileIsRefused) {
+  const std::string good = written(sample(), "cut_source.anvil");
+  expect_refused(good.substr(0, good.size() - 1), "short.anvil", "is truncated");
+  expect_refused(good.substr(0, 12), "short.anvil", "is truncated");
+  expect_refused("", "empty.anvil", "not an anvil checkpoint");
+  expect_refused(good + "garbage", "long.anvil", "is corrupt: 7 bytes follow its end");
+}
+
+// Sections that pass the checksum but cannot come from a run (a writer's bug) are refused
+// too: ids out of order, a non-finite value.
+TEST(Checkpoint, ImpossibleContentIsRefused) {
+  Checkpoint c = sample();
+  c.node_gid = {1, 0};
+  expect_refused(written(c, "order.anvil"), "order.anvil", "node ids are not ascending");
+  c = sample();
+  c.node_data[Checkpoint::node_values + 1] = std::numeric_limits<double>::quiet_NaN();
+  expect_refused(written(c, "nan.anvil"), "nan.anvil", "non-finite value for node 2");
+  c = sample();
+  c.point_count = {6};
+  expect_refused(written(c, "points.anvil"), "points.anvil", "is inconsistent");
 }
 
 } // namespace

@@ -16,6 +16,7 @@
 
 #include "anvil/io/keyword.hpp"
 #include "anvil/solver/model.hpp"
+#include "anvil/solver/simulation.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -137,6 +138,50 @@ TEST(Keyword, ReadsADeck) {
     std::array<Vec3, 8> x;
     for (int a = 0; a < 8; ++a) x[a] = m.nodes[h[a]];
     EXPECT_NEAR(hex_volume(x), 1.0, 1e-12); // LS-DYNA's node order is anvil's
+  }
+}
+
+// Free format reads every field of a list card (a set's ids); any other card with more
+// fields than it holds is an error naming the file and line, not fields dropped (a ninth
+// comma-separated id of *SET_NODE_LIST was lost, and with it a boundary condition).
+TEST(Keyword, FreeFormatFieldsAreAllReadOrRefused) {
+  const std::string set_card = "         7\n         1         2         3         4\n";
+  const Config c = kw(with(good, set_card, "7\n1,2,3,4,5,6,7,8,9,10,11,12\n"));
+  EXPECT_EQ(build_mesh(c).node_sets.at("nodeset_7"),
+            (std::vector<std::int64_t>{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11}));
+  const Config g = kw(with(with(good, "*SET_NODE_LIST\n", "*SET_NODE_LIST_GENERATE\n"), set_card,
+                           "7\n1,2,5,5,7,7,9,9,11,12\n"));
+  EXPECT_EQ(build_mesh(g).node_sets.at("nodeset_7"),
+            (std::vector<std::int64_t>{0, 1, 4, 6, 8, 10, 11}));
+  const Config h = kw(with(good, "*DATABASE_HISTORY_NODE\n        12\n",
+                           "*DATABASE_HISTORY_NODE\n1,2,3,4,5,6,7,8,9,10\n"));
+  EXPECT_EQ(h.probes.size(), 10u);
+  // Trailing empty fields are no fields.
+  EXPECT_NO_THROW(
+      kw(with(good, "         1    7850.0   2.0E+11       0.3", "1,7850.0,2.0E+11,0.3,,,,,,,,,")));
+  expect_error(
+      with(good, "         1    7850.0   2.0E+11       0.3", "1,7850.0,2.0E+11,0.3,0,0,0,0,5"),
+      {"model.k:14: *MAT_ELASTIC.card", "9 comma-separated fields", "at most 8"});
+  expect_error(with(good,
+                    "       1       1       1       2       3       4       5       6       "
+                    "7       8",
+                    "1,1,1,2,3,4,5,6,7,8,0,0"),
+               {"model.k:30: *ELEMENT_SOLID.card", "12 comma-separated fields", "at most 10"});
+}
+
+// An inverted element is named by its EID, not by its position in the part.
+TEST(Keyword, InvertedElementIsNamedByItsId) {
+  std::string text = with(good, "       1       1       1", "     100       1       1");
+  text =
+      with(text, "       2       1       5       6       7       8       9      10      11      12",
+           "     200       1       9      10      11      12       5       6       7       8");
+  try {
+    Simulation sim(kw(text), Comm::world());
+    ADD_FAILURE() << "no error for an inverted element";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("element 200 of part part1 has a non-positive volume"),
+              std::string::npos)
+        << e.what();
   }
 }
 

@@ -124,6 +124,9 @@ TEST(ReadExodus, BoxBlocksSetsAndSides) {
   // The file's element order and node order (1-based positions, not the id map).
   EXPECT_EQ(m.blocks[0].elements[0], (Hex{0, 1, 4, 3, 9, 10, 13, 12}));
   EXPECT_EQ(m.blocks[1].elements[3], (Hex{13, 14, 17, 16, 22, 23, 26, 25}));
+  // The file's element ids (elem_num_map), for messages.
+  EXPECT_EQ(m.blocks[0].ids, (std::vector<std::int64_t>{500, 499, 498, 497}));
+  EXPECT_EQ(m.blocks[1].ids, (std::vector<std::int64_t>{496, 495, 494, 493}));
 
   ASSERT_EQ(m.node_sets.size(), 2u);
   EXPECT_EQ(m.node_sets.at("bottom"), nodes_where(m, [](const Vec3& x) { return near(x[2], 0); }));
@@ -161,6 +164,7 @@ TEST(ReadExodus, ClassicAndNetcdf4FilesReadTheSame) {
     for (std::size_t b = 0; b < m.blocks.size(); ++b) {
       EXPECT_EQ(m.blocks[b].name, ref.blocks[b].name);
       EXPECT_EQ(m.blocks[b].elements, ref.blocks[b].elements);
+      EXPECT_EQ(m.blocks[b].ids, ref.blocks[b].ids);
     }
     EXPECT_EQ(m.node_sets, ref.node_sets);
     EXPECT_EQ(m.side_sets.size(), ref.side_sets.size());
@@ -198,6 +202,10 @@ TEST(ReadExodus, BadContentNamesWhatIsWrong) {
   expect_exodus_error(data("bad_side_range.exo"), {"side set 'top'", "side 7", "sides 1 to 6"});
   expect_exodus_error(data("bad_elem_range.exo"), {"side set 'top'", "element 9", "1 to 8"});
   expect_exodus_error(data("bad_2d.exo"), {"2-dimensional"});
+  // A repeated node is refused as in .k and .msh files, naming the element's id.
+  expect_exodus_error(data("bad_degenerate_hex.exo"),
+                      {"element block 'lower'", "element 500 uses node 13 twice (N7 and N8)",
+                       "degenerate hexahedra"});
 }
 
 // Defects the Exodus library does not survive by itself (it writes past fixed-size
@@ -355,6 +363,7 @@ TEST(ReadGmsh, UnnamedGroupsAndNoGroup) {
   {
     const Mesh m = parse_gmsh(one_hex_41("", 0), "none.msh");
     ASSERT_EQ(m.blocks.size(), 1u);
+    EXPECT_EQ(m.blocks[0].ids, std::vector<std::int64_t>{1}); // the element's tag
     EXPECT_EQ(m.blocks[0].name, "mesh");
     EXPECT_TRUE(m.node_sets.empty());
   }
@@ -459,6 +468,9 @@ std::vector<Case> malformed_gmsh() {
        replace("3 2 5 4\n16 5 17 26 20 9 21 27 24", "3 2 4 4\n16 5 17 26 20"),
        {"m.msh:169:", "volume 2 (physical volume 'upper')", "4-node tetrahedron", "type 4"}},
       {"hexahedron in a surface", replace("2 1 3 4", "2 1 5 4"), {"type 5) in surface 1"}},
+      {"degenerate hexahedron",
+       replace("12 1 13 25 16 5 17 26 20", "12 1 13 25 16 5 17 26 26"),
+       {"m.msh:", "$Elements", "element 12 uses node 26 twice (N7 and N8)", "degenerate"}},
       {"undefined node",
        replace("12 1 13 25 16 5 17 26 20", "12 1 13 25 16 5 17 26 99"),
        {"node 99 is not defined"}},

@@ -1,14 +1,18 @@
 #include "anvil/io/checkpoint.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "anvil/core/error.hpp"
+#include "anvil/core/hash.hpp"
 #include "anvil/io/files.hpp"
 #include "anvil/solver/simulation.hpp"
 
@@ -16,14 +20,12 @@ namespace anvil {
 
 namespace {
 
-// The format's version is the magic's last character. Version 2 added the particle
-// sections after the element sections and the header keys model_particles and
-// particle_pvd; version 3 the eroded flag of every element, after the particle sections
-// (erosion survives a restart); version 4 the state at the points through the thickness
-// of thick-shell elements, last. Files of versions 1 (no particles), 2 and 3 still load,
-// with every element alive (1, 2) and no thick-shell state (1-3).
-constexpr char magic[8] = {'A', 'N', 'V', 'I', 'L', 'C', 'K', '4'};
+// The format's version is the magic's last character. Version 5 put the payload's length
+// and its FNV-1a checksum after the magic and the mesh's fingerprint in the header; files
+// of versions 1 to 4 (no checksum) are refused: rerun to write a new one.
+constexpr char magic[8] = {'A', 'N', 'V', 'I', 'L', 'C', 'K', '5'};
 constexpr std::size_t magic_version = 7;
+constexpr std::size_t payload_start = sizeof magic + 2 * sizeof(std::uint64_t); // length, sum
 static_assert(Checkpoint::point_values == 8 * ThickShell::max_points);
 
 // Sends this rank's records to rank 0, which keeps them in ascending global id.
@@ -102,6 +104,7 @@ Checkpoint capture(const Simulation& sim, const OutputState& outputs) {
   c.outputs = outputs;
   c.model_nodes = sim.global_nodes();
   c.model_elements = sim.global_elements();
+  c.mesh_fingerprint = sim.mesh_fingerprint();
   double diag[2] = {sim.external_work_local(), sim.contact_energy_local()};
   comm.sum(std::span<double>(diag, 2));
   c.external_work = diag[0];
@@ -192,6 +195,7 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
   h["model_nodes"] = c.model_nodes;
   h["model_elements"] = c.model_elements;
   h["model_particles"] = c.model_particles;
+  h["mesh_fingerprint"] = c.mesh_fingerprint;
   h["next_fields"] = c.outputs.next_fields;
   h["next_history"] = c.outputs.next_history;
   h["next_checkpoint"] = c.outputs.next_checkpoint;
@@ -207,7 +211,8 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
                            c.contact_energy,
                            c.outputs.next_fields,
                            c.outputs.next_history};
-  std::string s(magic, sizeof magic);
+  std::string s(payload_start, '\0');
+  std::memcpy(s.data(), magic, sizeof magic);
   const std::string header = h.dump();
   put(s, std::vector<char>(header.begin(), header.end()));
   put(s, std::vector<double>(exact, exact + 8));
@@ -224,8 +229,34 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
   put(s, c.point_gid);
   put(s, c.point_data);
   put(s, c.point_count);
+  const std::string_view payload = std::string_view(s).substr(payload_start);
+  const std::uint64_t trailer[2] = {payload.size(), Fnv1a().bytes(payload).value()};
+  std::memcpy(s.data() + sizeof magic, trailer, sizeof trailer);
   write_file_atomic(path, s);
 }
+
+namespace {
+
+// Throws unless `gid` is strictly ascending and within [0, limit).
+void check_ids(const std::vector<std::int64_t>& gid, std::int64_t limit, const char* what,
+               const std::string& path) {
+  for (std::size_t k = 0; k < gid.size(); ++k)
+    if (gid[k] < 0 || gid[k] >= limit || (k > 0 && gid[k] <= gid[k - 1]))
+      throw InputError(fmt::format("checkpoint '{}' is inconsistent: its {} ids are not "
+                                   "ascending ids of the model",
+                                   path, what));
+}
+
+// Throws unless every value of the section is finite.
+void check_finite(const std::vector<double>& data, int width, const char* what,
+                  const std::vector<std::int64_t>& gid, const std::string& path) {
+  for (std::size_t k = 0; k < data.size(); ++k)
+    if (!std::isfinite(data[k]))
+      throw InputError(fmt::format("checkpoint '{}' holds a non-finite value for {} {}", path, what,
+                                   gid[k / static_cast<std::size_t>(width)] + 1));
+}
+
+} // namespace
 
 Checkpoint read_checkpoint(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -236,10 +267,30 @@ Checkpoint read_checkpoint(const std::string& path) {
   if (s.size() < sizeof magic || std::memcmp(s.data(), magic, magic_version) != 0)
     throw InputError("'" + path + "' is not an anvil checkpoint");
   const char version = s[magic_version];
-  if (version < '1' || version > '4')
-    throw InputError(fmt::format("checkpoint '{}' has format version {}; this anvil reads 1 to 4",
-                                 path, version));
-  std::size_t pos = sizeof magic;
+  if (version >= '1' && version < magic[magic_version])
+    throw InputError(fmt::format("checkpoint '{}' was written by an older anvil (format version "
+                                 "{}, without a checksum); this anvil reads version {} only: run "
+                                 "the deck again to write a new checkpoint",
+                                 path, version, magic[magic_version]));
+  if (version != magic[magic_version])
+    throw InputError(
+        fmt::format("checkpoint '{}' has format version {}; this anvil reads version {}", path,
+                    version, magic[magic_version]));
+  if (s.size() < payload_start) throw InputError("checkpoint '" + path + "' is truncated");
+  std::uint64_t trailer[2] = {};
+  std::memcpy(trailer, s.data() + sizeof magic, sizeof trailer);
+  const std::string_view payload = std::string_view(s).substr(payload_start);
+  if (payload.size() < trailer[0])
+    throw InputError(fmt::format("checkpoint '{}' is truncated: {} of its {} bytes", path, s.size(),
+                                 trailer[0] + payload_start));
+  if (payload.size() > trailer[0])
+    throw InputError(fmt::format("checkpoint '{}' is corrupt: {} bytes follow its end", path,
+                                 payload.size() - trailer[0]));
+  if (Fnv1a().bytes(payload).value() != trailer[1])
+    throw InputError(fmt::format("checkpoint '{}' is corrupt: its checksum does not match its "
+                                 "contents",
+                                 path));
+  std::size_t pos = payload_start;
   Checkpoint c;
   c.file = path;
   std::vector<char> header;
@@ -252,37 +303,29 @@ Checkpoint read_checkpoint(const std::string& path) {
   get(s, pos, c.node_face, path);
   get(s, pos, c.element_gid, path);
   get(s, pos, c.element_data, path);
-  if (version >= '2') {
-    get(s, pos, c.particle_gid, path);
-    get(s, pos, c.particle_data, path);
-    get(s, pos, c.particle_face, path);
-  }
-  if (version >= '3')
-    get(s, pos, c.element_eroded, path);
-  else // earlier versions did not record erosion: every element alive
-    c.element_eroded.assign(c.element_gid.size(), 0);
-  if (version >= '4') {
-    get(s, pos, c.point_gid, path);
-    get(s, pos, c.point_data, path);
-    get(s, pos, c.point_count, path);
-  }
+  get(s, pos, c.particle_gid, path);
+  get(s, pos, c.particle_data, path);
+  get(s, pos, c.particle_face, path);
+  get(s, pos, c.element_eroded, path);
+  get(s, pos, c.point_gid, path);
+  get(s, pos, c.point_data, path);
+  get(s, pos, c.point_count, path);
   try {
     const auto h = nlohmann::json::parse(std::string(header.begin(), header.end()));
     c.deck = h.at("deck").get<std::string>();
     c.cycle = h.at("cycle").get<std::int64_t>();
     c.model_nodes = h.at("model_nodes").get<std::int64_t>();
     c.model_elements = h.at("model_elements").get<std::int64_t>();
+    c.model_particles = h.at("model_particles").get<std::int64_t>();
+    c.mesh_fingerprint = h.at("mesh_fingerprint").get<std::uint64_t>();
     c.outputs.field_count = h.at("field_count").get<int>();
     c.outputs.pvd = h.at("pvd").get<std::vector<std::pair<double, std::string>>>();
-    // Optional: absent from version 1 files.
-    c.model_particles = h.value("model_particles", std::int64_t{0});
-    if (h.contains("particle_pvd"))
-      c.outputs.particle_pvd =
-          h.at("particle_pvd").get<std::vector<std::pair<double, std::string>>>();
+    c.outputs.particle_pvd =
+        h.at("particle_pvd").get<std::vector<std::pair<double, std::string>>>();
   } catch (const std::exception& e) {
     throw InputError("checkpoint '" + path + "' has a damaged header: " + e.what());
   }
-  if (exact.size() != 8 || next_checkpoint.size() != 1 ||
+  if (pos != s.size() || exact.size() != 8 || next_checkpoint.size() != 1 ||
       c.node_data.size() != c.node_gid.size() * Checkpoint::node_values ||
       c.node_face.size() != c.node_gid.size() ||
       c.element_data.size() != c.element_gid.size() * Checkpoint::element_values ||
@@ -291,8 +334,21 @@ Checkpoint read_checkpoint(const std::string& path) {
       c.particle_face.size() != c.particle_gid.size() ||
       c.point_data.size() != c.point_gid.size() * Checkpoint::point_values ||
       c.point_count.size() != c.point_gid.size() ||
-      c.model_particles != static_cast<std::int64_t>(c.particle_gid.size()))
+      c.model_nodes != static_cast<std::int64_t>(c.node_gid.size()) ||
+      c.model_elements != static_cast<std::int64_t>(c.element_gid.size()) ||
+      c.model_particles != static_cast<std::int64_t>(c.particle_gid.size()) ||
+      std::any_of(c.point_count.begin(), c.point_count.end(),
+                  [](std::int64_t n) { return n < 1 || n > ThickShell::max_points; }))
     throw InputError("checkpoint '" + path + "' is inconsistent");
+  constexpr std::int64_t any = std::numeric_limits<std::int64_t>::max();
+  check_ids(c.node_gid, any, "node", path);
+  check_ids(c.element_gid, c.model_elements, "element", path);
+  check_ids(c.point_gid, c.model_elements, "thick-shell element", path);
+  check_ids(c.particle_gid, any, "particle", path);
+  check_finite(c.node_data, Checkpoint::node_values, "node", c.node_gid, path);
+  check_finite(c.element_data, Checkpoint::element_values, "element", c.element_gid, path);
+  check_finite(c.particle_data, Checkpoint::particle_values, "particle", c.particle_gid, path);
+  check_finite(c.point_data, Checkpoint::point_values, "thick-shell element", c.point_gid, path);
   c.time = exact[0];
   c.dt = exact[1];
   c.dt_prev = exact[2];

@@ -2,7 +2,9 @@
 // elements and SPH particles keyed by global id), written atomically (temporary file,
 // fsync, rename; the previous checkpoint stays until the new one is complete). `anvil run
 // DECK --restart CHECKPOINT` continues from one, on the same or another number of ranks,
-// and reproduces the uninterrupted run bit for bit.
+// and reproduces the uninterrupted run bit for bit. The file carries its length and an
+// FNV-1a checksum of its contents (a damaged, truncated or extended file is refused) and
+// a fingerprint of the mesh it was written for (a restart with another mesh is refused).
 #pragma once
 
 #include <cstdint>
@@ -30,7 +32,7 @@ struct Checkpoint {
   // plastic strain, temperature, wave speed. What the deck fixes (set, mass, reference
   // position, constraints) is not stored: the restarted run rebuilds it from the deck.
   static constexpr int particle_values = 18;
-  // Per thick-shell element (version 4): stress (6), plastic strain and temperature at
+  // Per thick-shell element: stress (6), plastic strain and temperature at
   // each of up to five points through the thickness (zero past the element's points).
   static constexpr int point_values = 8 * 5; // 5: ThickShell::max_points
   std::string deck;                          // the deck the run came from (for messages)
@@ -44,15 +46,16 @@ struct Checkpoint {
   std::vector<std::int64_t> node_face;              // contact history: last face per node
   std::vector<std::int64_t> element_gid;            // ascending
   std::vector<double> element_data;                 // element_values per element
-  std::vector<std::int64_t> element_eroded;         // 1 for an eroded element (version 3)
+  std::vector<std::int64_t> element_eroded;         // 1 for an eroded element
   std::vector<std::int64_t> particle_gid;           // ascending (empty without particles)
   std::vector<double> particle_data;                // particle_values per particle
   std::vector<std::int64_t> particle_face;          // contact history: last face per particle
-  std::vector<std::int64_t> point_gid;              // thick-shell elements, ascending (version 4)
+  std::vector<std::int64_t> point_gid;              // thick-shell elements, ascending
   std::vector<double> point_data;                   // point_values per thick-shell element
   std::vector<std::int64_t> point_count;            // points through each one's thickness
   std::int64_t model_nodes = 0, model_elements = 0; // sizes of the model, for validation
   std::int64_t model_particles = 0;
+  std::uint64_t mesh_fingerprint = 0; // mesh_fingerprint() of the model's initial mesh
 };
 
 // Gathers the state of `sim` on rank 0 (collective); other ranks get an empty checkpoint.
@@ -61,9 +64,9 @@ Checkpoint capture(const Simulation& sim, const OutputState& outputs);
 // Writes `c` to `path` atomically (rank 0's job).
 void write_checkpoint(const std::string& path, const Checkpoint& c);
 
-// Reads a checkpoint (this format, or the first one, which had no particles: it reads as
-// a model without particles); InputError (with the file name) when it is missing or
-// damaged.
+// Reads a checkpoint of this format; InputError (with the file name) when it is missing,
+// of an older format, truncated, damaged (checksum) or inconsistent. Every rank reads the
+// same bytes, so every rank throws the same error.
 Checkpoint read_checkpoint(const std::string& path);
 
 } // namespace anvil

@@ -270,21 +270,36 @@ private:
 // ---- cards and fields -------------------------------------------------------------------
 
 // The fields of one card: fixed columns (widths adjusted for the long and I10 formats) or
-// comma-separated free format when the line holds a comma.
+// comma-separated free format when the line holds a comma. A free-format card holds at
+// most the fields its fixed-column form fits in 80 columns (`widths`, continued with the
+// last width): more is an error, not fields silently dropped. A list card (a set's ids)
+// or a card of a keyword anvil only skips (Extra::keep) keeps them all.
 class Card {
 public:
-  Card(const Block& kw, const Line& line, std::initializer_list<int> widths)
+  enum class Extra { error, keep };
+
+  Card(const Block& kw, const Line& line, std::initializer_list<int> widths,
+       Extra extra = Extra::error)
       : kw_(kw), line_(line) {
     const std::string_view text = line.text;
+    fields_.reserve(widths.size());
     if (text.find(',') != std::string_view::npos) {
       std::size_t start = 0;
-      while (count_ < max_fields) {
+      for (;;) {
         const auto comma = text.find(',', start);
-        fields_[count_++] = trim(text.substr(
-            start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+        fields_.push_back(trim(text.substr(
+            start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
         if (comma == std::string_view::npos) break;
         start = comma + 1;
       }
+      std::size_t used = fields_.size(); // trailing empty fields are no fields
+      while (used > 0 && fields_[used - 1].empty()) --used;
+      const int most = fields_in_80_columns(widths);
+      if (extra == Extra::error && used > static_cast<std::size_t>(most))
+        throw InputError(line.where(kw.key("card")),
+                         fmt::format("the card has {} comma-separated fields; a card of *{} "
+                                     "here holds at most {}",
+                                     used, kw.name, most));
       return;
     }
     if (text.find('\t') != std::string_view::npos)
@@ -293,14 +308,15 @@ public:
                        "(use blanks, or commas for free format)");
     std::size_t col = 0;
     for (int w : widths) {
-      if (count_ == max_fields) break;
       const std::size_t width = kw.long_format ? 20 : (kw.i10 && w < 10 ? 10 : w);
-      fields_[count_++] = col < text.size() ? trim(text.substr(col, width)) : std::string_view();
+      fields_.push_back(col < text.size() ? trim(text.substr(col, width)) : std::string_view());
       col += width;
     }
   }
 
-  bool blank(int i) const { return i >= count_ || fields_[i].empty(); }
+  // Fields on the card: its widths in fixed format, every comma-separated one in free.
+  int size() const { return static_cast<int>(fields_.size()); }
+  bool blank(int i) const { return i >= size() || fields_[i].empty(); }
 
   std::int64_t integer(int i, std::string_view name, std::int64_t def = 0) const {
     if (blank(i)) return def;
@@ -341,7 +357,13 @@ public:
   const Line& line() const { return line_; }
 
 private:
-  static constexpr int max_fields = 10;
+  // The fields of the card's fixed-column form in standard format (80 columns).
+  static int fields_in_80_columns(std::initializer_list<int> widths) {
+    int columns = 0;
+    for (int w : widths) columns += w;
+    const int last = widths.size() ? *(widths.end() - 1) : 10;
+    return static_cast<int>(widths.size()) + std::max(0, 80 - columns) / last;
+  }
 
   std::string_view unparameter(int i, std::string_view name) const {
     const std::string_view f = fields_[i];
@@ -386,8 +408,7 @@ private:
 
   const Block& kw_;
   Line line_;
-  std::array<std::string_view, max_fields> fields_{};
-  int count_ = 0;
+  std::vector<std::string_view> fields_;
 };
 
 // A card of free text (title, heading): the whole line, trimmed.
@@ -672,14 +693,9 @@ private:
                 fmt::format("element {} has {} nodes; anvil reads 8-node hexahedra only (no "
                             "tetrahedra or other solids)",
                             e.eid, given));
-      for (int a = 0; a < 8; ++a)
-        for (int k = 0; k < a; ++k)
-          if (e.nodes[a] == e.nodes[k])
-            nc.fail(fmt::format("N{}", a + 1),
-                    fmt::format("element {} uses node {} twice (N{} and N{}): degenerate "
-                                "hexahedra (wedges and tetrahedra written as hexahedra) are "
-                                "not supported",
-                                e.eid, e.nodes[a], k + 1, a + 1));
+      int corner = 0;
+      if (const std::string why = degenerate_hex(e.nodes, e.eid, &corner); !why.empty())
+        nc.fail(fmt::format("N{}", corner + 1), why);
       const auto [it, fresh] = element_index_.emplace(e.eid, elements_.size());
       if (!fresh)
         first.fail("EID", fmt::format("element {} is defined twice (first at {})", e.eid,
@@ -725,9 +741,9 @@ private:
     IdSet s;
     s.at = where_of(l);
     while (auto r = c.next_record()) {
-      const Card card(b, *r, {10, 10, 10, 10, 10, 10, 10, 10});
+      const Card card(b, *r, {10, 10, 10, 10, 10, 10, 10, 10}, Card::Extra::keep);
       if (generate) {
-        for (int k = 0; k < 8; k += 2) {
+        for (int k = 0; k < card.size(); k += 2) {
           const auto lo = card.id(k, fmt::format("B{}BEG", k / 2 + 1));
           const auto hi = card.id(k + 1, fmt::format("B{}END", k / 2 + 1));
           if (lo == 0 && hi == 0) continue;
@@ -737,7 +753,7 @@ private:
           s.ranges.emplace_back(lo, hi);
         }
       } else {
-        for (int k = 0; k < 8; ++k)
+        for (int k = 0; k < card.size(); ++k)
           if (const auto id = card.id(k, fmt::format("ID{}", k + 1)); id != 0) s.ids.push_back(id);
       }
     }
@@ -781,7 +797,7 @@ private:
     skip_title(b, c);
     if (c.done()) return unsupported(b);
     const Line l = c.next();
-    const Card card(b, l, {10});
+    const Card card(b, l, {10}, Card::Extra::keep);
     std::int64_t id = 0;
     try {
       id = card.integer(0, "ID", 0);
@@ -958,7 +974,7 @@ private:
     skip_title(b, c);
     if (!c.done()) {
       const Line l = c.next();
-      const Card card(b, l, {10});
+      const Card card(b, l, {10}, Card::Extra::keep);
       std::int64_t mid = 0;
       try {
         mid = card.integer(0, "MID", 0);
@@ -1248,8 +1264,8 @@ private:
   void history_nodes(const Block& b) {
     Cursor c(b);
     while (auto l = c.next_record()) {
-      const Card card(b, *l, {10, 10, 10, 10, 10, 10, 10, 10});
-      for (int k = 0; k < 8; ++k)
+      const Card card(b, *l, {10, 10, 10, 10, 10, 10, 10, 10}, Card::Extra::keep);
+      for (int k = 0; k < card.size(); ++k)
         if (const auto id = card.id(k, fmt::format("ID{}", k + 1)); id != 0)
           history_nodes_.emplace_back(id, where_of(*l));
     }
@@ -1290,7 +1306,7 @@ private:
     std::unordered_map<std::int64_t, std::size_t> block_of;
     for (const auto pid : pids) {
       block_of.emplace(pid, m.blocks.size());
-      m.blocks.push_back(ElementBlock{fmt::format("part{}", pid), {}});
+      m.blocks.push_back(ElementBlock{fmt::format("part{}", pid), {}, {}});
     }
     for (const auto& e : elements_) {
       const auto b = block_of.find(e.pid);
@@ -1306,6 +1322,7 @@ private:
         h[a] = node_position(e.nodes[a], e.at, fmt::format("*ELEMENT_SOLID.N{}", a + 1),
                              fmt::format("element {}", e.eid));
       m.blocks[b->second].elements.push_back(h);
+      m.blocks[b->second].ids.push_back(e.eid);
     }
     for (const auto& [sid, s] : node_sets_)
       m.node_sets[fmt::format("nodeset_{}", sid)] = resolve_node_set(sid, s);

@@ -34,7 +34,7 @@ Mesh extrude(const std::vector<std::array<double, 2>>& pts,
     const double z = length * l / layers;
     for (const auto& p : pts) m.nodes.push_back(orient({p[0], p[1], z}, axis) + origin);
   }
-  ElementBlock b{name, {}};
+  ElementBlock b{name, {}, {}};
   b.elements.reserve(quads.size() * static_cast<std::size_t>(layers));
   for (int l = 0; l < layers; ++l) {
     for (const auto& q : quads) {
@@ -83,7 +83,7 @@ Mesh generate_box(const BoxSpec& s) {
         m.nodes[id(i, j, k)] = {lerp(s.min.x, s.max.x, nx, i), lerp(s.min.y, s.max.y, ny, j),
                                 lerp(s.min.z, s.max.z, nz, k)};
       }
-  ElementBlock b{"box", {}};
+  ElementBlock b{"box", {}, {}};
   b.elements.reserve(static_cast<std::size_t>(nx) * ny * nz);
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)

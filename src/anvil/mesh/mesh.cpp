@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
+
+#include "anvil/core/hash.hpp"
+
 namespace anvil {
 
 std::int64_t Mesh::num_elements() const {
@@ -23,7 +27,7 @@ void Mesh::append(const Mesh& other, const std::string& prefix) {
   const std::int64_t elem_shift = num_elements();
   nodes.insert(nodes.end(), other.nodes.begin(), other.nodes.end());
   for (const auto& b : other.blocks) {
-    ElementBlock nb{b.name, b.elements};
+    ElementBlock nb{b.name, b.elements, b.ids};
     for (auto& h : nb.elements)
       for (auto& n : h) n += node_shift;
     blocks.push_back(std::move(nb));
@@ -43,6 +47,28 @@ void Mesh::append(const Mesh& other, const std::string& prefix) {
 
 void Mesh::translate(const Vec3& d) {
   for (auto& p : nodes) p += d;
+}
+
+std::string degenerate_hex(const Hex& nodes, std::int64_t id, int* corner) {
+  for (int a = 0; a < 8; ++a)
+    for (int k = 0; k < a; ++k)
+      if (nodes[a] == nodes[k]) {
+        if (corner) *corner = a;
+        return fmt::format("element {} uses node {} twice (N{} and N{}): degenerate hexahedra "
+                           "(wedges and tetrahedra written as hexahedra) are not supported",
+                           id, nodes[a], k + 1, a + 1);
+      }
+  return {};
+}
+
+std::uint64_t mesh_fingerprint(const Mesh& mesh) {
+  Fnv1a h;
+  h.values(mesh.nodes);
+  for (const auto& b : mesh.blocks) {
+    const std::uint64_t n = b.elements.size();
+    h.bytes(&n, sizeof n).values(b.elements);
+  }
+  return h.value();
 }
 
 namespace {

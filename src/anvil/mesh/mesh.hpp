@@ -28,6 +28,13 @@ inline constexpr std::array<std::array<int, 4>, 6> hex_faces = {
 struct ElementBlock {
   std::string name;          // part name (deck) or block name (mesh file)
   std::vector<Hex> elements; // connectivity by global node id
+  // The mesh file's id of each element (LS-DYNA EID, Gmsh tag, Exodus elem_num_map),
+  // for messages; empty for a generated mesh, whose elements are 1, 2, ... in order.
+  std::vector<std::int64_t> ids;
+
+  std::int64_t id(std::size_t e) const {
+    return ids.empty() ? static_cast<std::int64_t>(e) + 1 : ids[e];
+  }
 };
 
 struct SideEntry {
@@ -53,6 +60,16 @@ struct Mesh {
   // Moves every node by `d`.
   void translate(const Vec3& d);
 };
+
+// Why a hexahedron that names a node twice is refused, or an empty string when its eight
+// nodes differ: "element 2 uses node 11 twice (N7 and N8): degenerate hexahedra ... are
+// not supported". `nodes` and `id` are numbered as in the file; `corner` (if given) gets
+// the 0-based corner of the repeat. Every mesh reader checks its elements with it.
+std::string degenerate_hex(const Hex& nodes, std::int64_t id, int* corner = nullptr);
+
+// A hash of the nodes' coordinates (their bits) and of every block's connectivity, in
+// global id order: equal for equal meshes, whoever computes it. A checkpoint carries it.
+std::uint64_t mesh_fingerprint(const Mesh& mesh);
 
 // Signed volume of a hexahedron (exact for the trilinear map).
 double hex_volume(const std::array<Vec3, 8>& x);

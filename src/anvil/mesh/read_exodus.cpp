@@ -52,7 +52,9 @@ public:
   int id() const { return id_; }
   const std::string& path() const { return path_; }
   // Whether the coordinates are three variables (coordx, ...) rather than one (coord).
-  bool stored_coordinates_separately() const { return stored_values("coordx") >= 0; }
+  bool stored_coordinates_separately() const { return has("coordx"); }
+  // Whether the file has the netCDF variable `var`.
+  bool has(const std::string& var) const { return stored_values(var) >= 0; }
 
   [[noreturn]] void fail(const std::string& message) const {
     throw InputError(SourceLocation{path_, 0, ""}, message);
@@ -353,6 +355,13 @@ Mesh read_all(const ExodusFile& f) {
   const auto block_ids = entity_ids(f, EX_ELEM_BLOCK, init.num_elem_blk, "the element block ids");
   const auto block_names =
       entity_names(f, EX_ELEM_BLOCK, init.num_elem_blk, "the element block names");
+  // The file's element ids (elem_num_map; 1 to N without one), for messages.
+  fits(init.num_elem, "elements");
+  std::vector<std::int64_t> element_ids(static_cast<std::size_t>(init.num_elem));
+  if (init.num_elem > 0) {
+    if (f.has("elem_num_map")) f.expect_values("elem_num_map", init.num_elem, "the element ids");
+    f.check(ex_get_id_map(f.id(), EX_ELEM_MAP, element_ids.data()), "the element ids");
+  }
   std::int64_t elements = 0;
   for (std::size_t b = 0; b < block_ids.size(); ++b) {
     const std::int64_t bid = block_ids[b];
@@ -377,7 +386,11 @@ Mesh read_all(const ExodusFile& f) {
                          label, type_name.empty() ? "(none)" : type_name, npe));
     fits(count, "elements in " + label);
     fits(count * npe, "connectivity entries in " + label);
-    ElementBlock eb{name, {}};
+    if (count > init.num_elem - elements)
+      f.fail(
+          fmt::format("the header declares {} elements but the blocks hold more", init.num_elem));
+    ElementBlock eb{name, {}, {}};
+    eb.ids.assign(element_ids.begin() + elements, element_ids.begin() + elements + count);
     if (count > 0) {
       f.expect_values(conn_var, count * npe, "the connectivity of " + label);
       std::vector<std::int64_t> conn(static_cast<std::size_t>(count * npe));
@@ -393,6 +406,12 @@ Mesh read_all(const ExodusFile& f) {
                                label, elements + e + 1, e + 1, n, nn));
           eb.elements[e][a] = n - 1;
         }
+      for (std::int64_t e = 0; e < count; ++e) {
+        Hex numbers; // the file's node numbers, 1-based
+        for (int a = 0; a < 8; ++a) numbers[a] = eb.elements[e][a] + 1;
+        if (const std::string why = degenerate_hex(numbers, eb.ids[e]); !why.empty())
+          f.fail(label + ": " + why);
+      }
     }
     elements += count;
     mesh.blocks.push_back(std::move(eb));
@@ -549,6 +568,7 @@ std::string encode(const Mesh& m) {
   for (const auto& b : m.blocks) {
     w.str(b.name);
     w.vec(b.elements);
+    w.vec(b.ids);
   }
   w.pod<std::uint64_t>(m.node_sets.size());
   for (const auto& [name, ids] : m.node_sets) {
@@ -571,6 +591,7 @@ std::optional<Mesh> decode(std::string_view bytes) {
     ElementBlock b;
     b.name = r.str();
     b.elements = r.vec<Hex>();
+    b.ids = r.vec<std::int64_t>();
     m.blocks.push_back(std::move(b));
   }
   for (auto n = r.pod<std::uint64_t>(); r.ok && n > 0; --n) {

@@ -120,6 +120,7 @@ using EntityKey = std::pair<int, std::int64_t>; // (dimension, tag)
 struct HexRecord {
   Hex nodes;          // 0-based node positions
   std::int64_t group; // 3-D physical tag of its block, 0 for none
+  std::int64_t tag;   // the element's tag
 };
 
 // A line-oriented parser over the whole text. Gmsh writes one record per line, so the
@@ -477,7 +478,10 @@ private:
       set.insert(set.end(), node_ids_.begin(), node_ids_.end());
     }
     if (dim != 3) return;
-    HexRecord h{{}, phys.empty() ? 0 : phys[0]};
+    Hex tags;
+    for (int a = 0; a < 8; ++a) tags[a] = integer(tokens_[first + a], "a node tag");
+    if (const std::string why = degenerate_hex(tags, etag); !why.empty()) fail(why);
+    HexRecord h{{}, phys.empty() ? 0 : phys[0], etag};
     std::copy_n(node_ids_.begin(), 8, h.nodes.begin());
     // MSH 2 writes an element once per physical group it belongs to: the copies add set
     // membership (done above), not elements.
@@ -596,9 +600,12 @@ private:
     if (!order.empty() && order.front() == 0)
       std::rotate(order.begin(), order.begin() + 1, order.end());
     for (const auto g : order) {
-      ElementBlock b{g == 0 ? std::string("mesh") : group_name(3, g), {}};
+      ElementBlock b{g == 0 ? std::string("mesh") : group_name(3, g), {}, {}};
       for (const auto& h : hexes_)
-        if (h.group == g) b.elements.push_back(h.nodes);
+        if (h.group == g) {
+          b.elements.push_back(h.nodes);
+          b.ids.push_back(h.tag);
+        }
       mesh.blocks.push_back(std::move(b));
     }
     // Node sets; two groups may not share a name (their sets would silently merge).

@@ -99,7 +99,8 @@ Mesh build_mesh(const Config& config) {
         embedded_offset.emplace_back(src, shift);
         it = std::prev(embedded_offset.end());
       }
-      ElementBlock b{p.name, src->blocks[p.mesh.embedded_block].elements};
+      const ElementBlock& sb = src->blocks[p.mesh.embedded_block];
+      ElementBlock b{p.name, sb.elements, sb.ids};
       for (auto& h : b.elements)
         for (auto& n : h) n += it->second;
       if (b.elements.empty()) throw InputError(p.mesh.where, "the part's mesh has no elements");
@@ -109,9 +110,14 @@ Mesh build_mesh(const Config& config) {
     Mesh m = part_mesh(p);
     // A part is one block named after the part, whatever the source called it.
     if (m.blocks.size() != 1) {
-      ElementBlock merged{p.name, {}};
-      for (auto& b : m.blocks)
+      ElementBlock merged{p.name, {}, {}};
+      const bool file_ids = std::any_of(m.blocks.begin(), m.blocks.end(),
+                                        [](const auto& b) { return !b.ids.empty(); });
+      for (auto& b : m.blocks) {
         merged.elements.insert(merged.elements.end(), b.elements.begin(), b.elements.end());
+        for (std::size_t e = 0; file_ids && e < b.elements.size(); ++e)
+          merged.ids.push_back(b.id(e));
+      }
       m.blocks = {std::move(merged)};
     }
     m.blocks[0].name = p.name;

@@ -20,6 +20,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
   // every rank gets the same owner of every element (partition_model).
   const Mesh mesh = build_mesh(config_);
   global_elements_ = mesh.num_elements();
+  mesh_fingerprint_ = anvil::mesh_fingerprint(mesh);
   block_offsets_ = mesh.block_offsets();
   const std::vector<int> owner = partition_model(mesh, config_, comm_);
   fe_ = decompose_fe(mesh, owner, comm_.rank(), comm_.size());
@@ -69,10 +70,12 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     const std::int64_t bad_gid = comm_.min(bad >= 0 ? hb.gid[bad] : none);
     if (bad_gid != none) {
       const double v = comm_.min(bad >= 0 && hb.gid[bad] == bad_gid ? hb.volume[bad] : 1e300);
-      throw InputError(part.mesh.where,
-                       fmt::format("element {} of part {} has a non-positive volume ({:.3g} m^3): "
-                                   "check the node order",
-                                   bad_gid - block_offsets_[b] + 1, part.name, v));
+      throw InputError(
+          part.mesh.where,
+          fmt::format("element {} of part {} has a non-positive volume ({:.3g} m^3): "
+                      "check the node order",
+                      mesh.blocks[b].id(static_cast<std::size_t>(bad_gid - block_offsets_[b])),
+                      part.name, v));
     }
     for (int e = 0; e < hb.size(); ++e)
       for (int a = 0; a < 8; ++a)
@@ -653,6 +656,41 @@ void Simulation::restore(const Checkpoint& c) {
   if (c.model_particles != particles)
     throw InputError(fmt::format("{} holds {} particles, this model has {}", from,
                                  c.model_particles, particles));
+  if (c.mesh_fingerprint != mesh_fingerprint_)
+    throw InputError(fmt::format("{} was written for another mesh: the deck's node coordinates "
+                                 "or element connectivity differ from those of the run that "
+                                 "wrote it (restart with the deck it came from)",
+                                 from));
+  auto find = [](const std::vector<std::int64_t>& ids, std::int64_t id) -> std::int64_t {
+    const auto it = std::lower_bound(ids.begin(), ids.end(), id);
+    return it != ids.end() && *it == id ? it - ids.begin() : -1;
+  };
+  // What the checkpoint lacks is found on the ranks holding it; every rank must throw
+  // (the smallest such id over all ranks), not only those.
+  const std::int64_t none = std::numeric_limits<std::int64_t>::max();
+  std::int64_t missing[3] = {none, none, none}; // node, element, thick-shell element
+  for (std::size_t n = 0; n < nodes_.size(); ++n)
+    if (find(c.node_gid, fe_.node_gid[n]) < 0) missing[0] = std::min(missing[0], fe_.node_gid[n]);
+  for (const auto& b : blocks_)
+    for (int e = 0; e < b.size(); ++e) {
+      if (find(c.element_gid, b.gid[e]) < 0) missing[1] = std::min(missing[1], b.gid[e]);
+      if (!b.thick_shell.enabled()) continue;
+      const std::int64_t kp = find(c.point_gid, b.gid[e]);
+      if (kp < 0 || c.point_count[static_cast<std::size_t>(kp)] != b.thick_shell.points)
+        missing[2] = std::min(missing[2], b.gid[e]);
+    }
+  comm_.min(std::span<std::int64_t>(missing, 3));
+  if (missing[0] != none) throw InputError(from + " lacks node " + std::to_string(missing[0] + 1));
+  if (missing[1] != none)
+    throw InputError(from + " lacks element " + std::to_string(missing[1] + 1));
+  if (missing[2] != none) {
+    int points = 0; // the deck's points through that element's thickness
+    for (std::size_t b = 0; b < blocks_.size(); ++b)
+      if (missing[2] >= block_offsets_[b] && missing[2] < block_offsets_[b + 1])
+        points = blocks_[b].thick_shell.points;
+    throw InputError(fmt::format("{} lacks the {} thick-shell points of element {}", from, points,
+                                 missing[2] + 1));
+  }
   clock_.time = c.time;
   clock_.cycle = c.cycle;
   clock_.dt = c.dt;
@@ -661,13 +699,8 @@ void Simulation::restore(const Checkpoint& c) {
   // Global diagnostics restart on rank 0 (they are sums over ranks).
   external_work_ = comm_.rank() == 0 ? c.external_work : 0.0;
   contact_energy_ = comm_.rank() == 0 ? c.contact_energy : 0.0;
-  auto find = [](const std::vector<std::int64_t>& ids, std::int64_t id) -> std::int64_t {
-    const auto it = std::lower_bound(ids.begin(), ids.end(), id);
-    return it != ids.end() && *it == id ? it - ids.begin() : -1;
-  };
   for (std::size_t n = 0; n < nodes_.size(); ++n) {
     const std::int64_t k = find(c.node_gid, fe_.node_gid[n]);
-    if (k < 0) throw InputError(from + " lacks node " + std::to_string(fe_.node_gid[n] + 1));
     const double* d = &c.node_data[static_cast<std::size_t>(k) * Checkpoint::node_values];
     for (int i = 0; i < 3; ++i) {
       nodes_.x[i][n] = d[i];
@@ -678,7 +711,6 @@ void Simulation::restore(const Checkpoint& c) {
   for (auto& b : blocks_)
     for (int e = 0; e < b.size(); ++e) {
       const std::int64_t k = find(c.element_gid, b.gid[e]);
-      if (k < 0) throw InputError(from + " lacks element " + std::to_string(b.gid[e] + 1));
       const double* d = &c.element_data[static_cast<std::size_t>(k) * Checkpoint::element_values];
       for (int j = 0; j < 6; ++j) b.stress[j][e] = d[j];
       if (!b.plastic_strain.empty()) b.plastic_strain[e] = d[6];
@@ -690,9 +722,6 @@ void Simulation::restore(const Checkpoint& c) {
       b.alive[e] = c.element_eroded[static_cast<std::size_t>(k)] != 0 ? 0.0 : 1.0;
       if (!b.thick_shell.enabled()) continue;
       const std::int64_t kp = find(c.point_gid, b.gid[e]);
-      if (kp < 0 || c.point_count[static_cast<std::size_t>(kp)] != b.thick_shell.points)
-        throw InputError(fmt::format("{} lacks the {} thick-shell points of element {}", from,
-                                     b.thick_shell.points, b.gid[e] + 1));
       const double* pd = &c.point_data[static_cast<std::size_t>(kp) * Checkpoint::point_values];
       for (int p = 0; p < b.thick_shell.points; ++p, pd += 8) {
         for (int j = 0; j < 6; ++j) b.point_stress[p][j][e] = pd[j];

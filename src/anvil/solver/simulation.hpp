@@ -111,6 +111,8 @@ public:
   sph::SphPhase* sph() { return sph_.get(); }
   std::int64_t global_nodes() const { return global_nodes_; }
   std::int64_t global_elements() const { return global_elements_; }
+  // mesh_fingerprint() of the initial global mesh (the same on every rank).
+  std::uint64_t mesh_fingerprint() const { return mesh_fingerprint_; }
   const std::vector<double>& part_masses() const { return part_mass_; }
   // Global element id -> part name (for messages).
   std::string describe_element(std::int64_t gid) const;
@@ -212,6 +214,7 @@ private:
   double dt_stable_local_ = 0;
   std::int64_t stable_gid_local_ = -1;
   std::int64_t global_nodes_ = 0, global_elements_ = 0;
+  std::uint64_t mesh_fingerprint_ = 0;
   std::vector<std::int64_t> block_offsets_;
   std::vector<double> part_mass_;
 };

@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# A checkpoint that cannot continue the deck is refused on every rank, with exit status 2
+# and a message naming the file, within seconds (never a hang, a crash, a physics failure
+# or a silently different run):
+#  - damaged (one flipped bit in a velocity), truncated, or followed by extra bytes;
+#  - of a deck whose thick-shell part has other points through the thickness (found on
+#    the ranks holding that part only: this hung on 2 ranks);
+#  - of another mesh with the same numbers of nodes and elements.
+set -euo pipefail
+anvil=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+cat > deck.yaml <<'EOF'
+termination: {cycles: 60}
+materials:
+  steel: {model: j2_plasticity, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3, yield_stress: 250.0e6, hardening_modulus: 1.0e9}
+parts:
+  bar:
+    mesh: {generate: box, min: [0, 0, 0], max: [0.01, 0.01, 0.04], divisions: [4, 4, 16]}
+    material: steel
+  plate:
+    mesh: {generate: box, min: [0.02, 0, 0], max: [0.03, 0.01, 0.001], divisions: [2, 2, 1]}
+    material: steel
+    thick_shell: {points: 3}
+initial_conditions:
+  - {part: bar, velocity: [0, 0, -50.0]}
+  - {part: plate, velocity: [0, 0, 50.0]}
+EOF
+run() { timeout 60 mpirun --oversubscribe -np "$@"; }
+
+set +e
+run 2 "$anvil" run deck.yaml -o first -q --stop-at-cycle 20 2>/dev/null
+set -e
+[ -f first/checkpoint.anvil ] || { echo "no checkpoint written"; exit 1; }
+
+# Expects `anvil run DECK --restart CHECKPOINT` on 2 ranks to exit 2 saying FRAGMENT.
+refused() {
+  local deck=$1 checkpoint=$2 fragment=$3 status
+  set +e
+  run 2 "$anvil" run "$deck" -o out -q --restart "$checkpoint" 2> err.txt
+  status=$?
+  set -e
+  if [ "$status" -ne 2 ] || ! grep -q "$checkpoint" err.txt || ! grep -q -- "$fragment" err.txt; then
+    echo "restart of $deck from $checkpoint: exit $status (expected 2 and '$fragment'):"
+    cat err.txt
+    exit 1
+  fi
+}
+
+size=$(stat -c %s first/checkpoint.anvil)
+# One flipped bit a third into the file (node data).
+cp first/checkpoint.anvil flipped.anvil
+offset=$((size / 3))
+byte=$(od -An -tu1 -j "$offset" -N1 flipped.anvil | tr -d ' ')
+printf "$(printf '\\%03o' $((byte ^ 4)))" | dd of=flipped.anvil bs=1 seek="$offset" conv=notrunc 2>/dev/null
+refused deck.yaml flipped.anvil "is corrupt"
+head -c $((size - 5)) first/checkpoint.anvil > short.anvil
+refused deck.yaml short.anvil "is truncated"
+{ cat first/checkpoint.anvil; echo garbage; } > long.anvil
+refused deck.yaml long.anvil "bytes follow its end"
+
+sed -e 's/points: 3/points: 5/' deck.yaml > points5.yaml
+refused points5.yaml first/checkpoint.anvil "lacks the 5 thick-shell points of element 257"
+sed -e 's/divisions: \[4, 4, 16\]/divisions: [16, 4, 4]/' deck.yaml > other_mesh.yaml
+refused other_mesh.yaml first/checkpoint.anvil "was written for another mesh"
+
+# The checkpoint itself still continues the run.
+run 2 "$anvil" run deck.yaml -o first -q --restart first/checkpoint.anvil
+grep -q '"status": "completed"' first/summary.json
+echo "damaged and mismatched checkpoints refused with exit 2 on 2 ranks"
