@@ -46,6 +46,43 @@ TEST(Contact, ExteriorFacesOfBoxesAndCans) {
 // every kind of query: near and far points, warped, flat, degenerate (two corners equal,
 // all four equal) faces, feet inside and outside, and a count that leaves a partial
 // vector.
+// The faces erosion may expose: with an erodible block, every face between two of its
+// elements is listed twice (once per element), `behind` naming the other element; the
+// exterior faces have behind -1. Reference: counting on a 2 x 3 x 4 box.
+TEST(Contact, FacesErosionMayExpose) {
+  Mesh m = generate_box({{0, 0, 0}, {1, 1, 1}, {2, 3, 4}});
+  const auto plain = exterior_faces(m, {true});
+  const auto f = exterior_faces(m, {true}, {true});
+  const std::size_t interior = 1 * 3 * 4 + 2 * 2 * 4 + 2 * 3 * 3; // x, y and z planes
+  EXPECT_EQ(f.size(), plain.size() + 2 * interior);
+  std::size_t exterior = 0;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (f.behind[i] < 0) {
+      ++exterior;
+      continue;
+    }
+    // The element behind lists the same face, its own behind naming this element.
+    std::array<std::int64_t, 4> a = f.nodes[i];
+    std::sort(a.begin(), a.end());
+    int twins = 0;
+    for (std::size_t j = 0; j < f.size(); ++j) {
+      std::array<std::int64_t, 4> b = f.nodes[j];
+      std::sort(b.begin(), b.end());
+      if (j != i && a == b) {
+        ++twins;
+        EXPECT_EQ(f.element[j], f.behind[i]);
+        EXPECT_EQ(f.behind[j], f.element[i]);
+      }
+    }
+    EXPECT_EQ(twins, 1);
+  }
+  EXPECT_EQ(exterior, plain.size());
+  EXPECT_EQ(static_cast<std::int64_t>(f.contact_nodes.size()), m.num_nodes());
+  for (std::size_t i = 1; i < f.size(); ++i) // ordered by (element, side): ids are positions
+    EXPECT_TRUE(f.element[i - 1] < f.element[i] ||
+                (f.element[i - 1] == f.element[i] && f.side[i - 1] < f.side[i]));
+}
+
 TEST(Contact, BatchedProjectionIsTheScalarOneBitForBit) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-0.4, 0.4);

@@ -75,13 +75,18 @@ ContactPhase::~ContactPhase() = default;
 ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const FeDecomposition& fe,
                            const std::vector<HexBlock>& blocks, const Comm& comm,
                            const Vec3& rcb_scale)
-    : config_(config), fe_(fe), comm_(comm), blocks_(blocks), rcb_(comm, rcb_scale) {
+    : config_(config), fe_(fe), comm_(comm), rcb_(comm, rcb_scale) {
   global_nodes_ = mesh.num_nodes();
   std::vector<bool> selected(mesh.blocks.size(), config.parts.empty());
   for (const auto& name : config.parts)
     for (std::size_t b = 0; b < mesh.blocks.size(); ++b)
       if (mesh.blocks[b].name == name) selected[b] = true;
-  const ExteriorFaces surf = exterior_faces(mesh, selected);
+  // Parts that erode also list the faces between their elements, active once erosion
+  // exposes them (set_eroded).
+  std::vector<bool> erodible(mesh.blocks.size(), false);
+  for (std::size_t b = 0; b < blocks.size() && b < erodible.size(); ++b)
+    erodible[b] = blocks[b].erosion.enabled();
+  const ExteriorFaces surf = exterior_faces(mesh, selected, erodible);
   extra_offset_ = global_nodes_ + static_cast<std::int64_t>(surf.size());
 
   node_index_ = GidIndex(fe.node_gid);
@@ -125,8 +130,12 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
     my_face_stiffness_.push_back(config.penalty_scale * K * area * area / vol);
     my_face_depth_.push_back(config.depth_fraction * vol / area);
     my_face_element_.emplace_back(el, surf.side[f]);
-    my_face_slot_.emplace_back(static_cast<int>(b), static_cast<int>(e));
+    my_face_behind_.push_back(surf.behind[f]);
   }
+  face_active_.resize(my_face_gid_.size());
+  face_exposed_.assign(my_face_gid_.size(), 0);
+  for (std::size_t f = 0; f < face_active_.size(); ++f) face_active_[f] = my_face_behind_[f] < 0;
+  live_ = static_cast<std::size_t>(std::count(face_active_.begin(), face_active_.end(), 1));
   my_face_rank_.assign(my_face_gid_.size(), comm.rank());
   const std::size_t nf_all = my_face_gid_.size();
   // The fields of the items that never change (ids, owners, penalty data), set once.
@@ -243,6 +252,7 @@ void ContactPhase::pack_cycle(std::size_t f, const ContactNodes& nd, Item& it) c
   }
   it.offset = cap_.offset[f];
   it.warp = cap_.warp[f];
+  it.exposed = face_exposed_[f];
 }
 
 // (Inlined: it runs once per owned contact node on full cycles.)
@@ -281,11 +291,27 @@ void ContactPhase::complete_item(const FaceMotion& m, std::size_t j) {
   }
   it.offset = m.offset;
   it.warp = m.warp;
+  it.exposed = m.exposed;
 }
 
-bool ContactPhase::alive(std::size_t f) const {
-  const auto [b, e] = my_face_slot_[f];
-  return blocks_[static_cast<std::size_t>(b)].alive[static_cast<std::size_t>(e)] != 0.0;
+void ContactPhase::set_eroded(std::span<const std::int64_t> eroded) {
+  auto gone = [&](std::int64_t el) { return std::binary_search(eroded.begin(), eroded.end(), el); };
+  bool changed = false;
+  for (std::size_t f = 0; f < face_active_.size(); ++f) {
+    const std::int64_t behind = my_face_behind_[f];
+    const std::uint8_t a = !gone(my_face_element_[f].first) && (behind < 0 || gone(behind));
+    if (a != face_active_[f]) {
+      changed = true;
+      if (a != 0 && behind >= 0) {
+        face_exposed_[f] = 1;
+        exposed_age_ = 1;
+      }
+    }
+    face_active_[f] = a;
+  }
+  if (!changed) return;
+  live_ = static_cast<std::size_t>(std::count(face_active_.begin(), face_active_.end(), 1));
+  ++surface_version_;
 }
 
 FaceCorners ContactPhase::corners() const {
@@ -367,7 +393,7 @@ double ContactPhase::build_deviation(std::size_t f) const {
 // bounds every face's box (shared_bound_holds); a face whose bound fails is checked
 // exactly, and if within its budget gets a new reference (rebase_faces). Any failure
 // makes the next cycle full on every rank (detect()).
-void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live, bool recomputed) {
+void ContactPhase::set_shared_reference(const FaceBoxes& boxes, bool recomputed) {
   const std::size_t nf = my_face_gid_.size(), nn = my_nodes_.size();
   const std::size_t nfp = static_cast<std::size_t>(simd::padded_size(static_cast<int>(nf)));
   const SearchWorkspace& w = search_;
@@ -485,7 +511,7 @@ void ContactPhase::set_shared_reference(const FaceBoxes& boxes, std::size_t live
   near_.clear();
   for (std::size_t f = 0; f < nfp; ++f) set_face_budget(f);
   set_bound_references();
-  live_ref_ = live;
+  version_ref_ = surface_version_;
   shared_ = true; // (never with extra nodes anywhere: they change every cycle)
 }
 
@@ -542,7 +568,7 @@ void ContactPhase::set_face_reference(std::size_t f) {
 }
 
 void ContactPhase::set_face_budget(std::size_t f) {
-  if (f >= my_face_gid_.size() || !alive(f)) { // (sf_budget_[f] is infinite)
+  if (f >= my_face_gid_.size() || !active(f)) { // (sf_budget_[f] is infinite)
     if (f < my_face_gid_.size())
       for (int i = 0; i < 3; ++i) {
         sf_box_[i][f] = cap_.lo[i][f];
@@ -781,7 +807,7 @@ bool ContactPhase::compute_destinations(std::size_t live) {
   face_src_.clear();
   one_copy_each_ = live == nf; // then copy k is face k
   for (std::size_t f = 0; f < nf; ++f) {
-    if (!alive(f)) continue;
+    if (!active(f)) continue;
     const Box3 q{{cap_.lo[0][f] - g, cap_.lo[1][f] - g, cap_.lo[2][f] - g},
                  {cap_.hi[0][f] + g, cap_.hi[1][f] + g, cap_.hi[2][f] + g}};
     // A box strictly inside the box of the face's last rank overlaps that rank only, and
@@ -920,22 +946,23 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       w_step_[1] = s1 / static_cast<double>(np);
       w_step_[2] = s2 / static_cast<double>(np);
     }
-    // The faces alive: counted again only when some element has eroded since.
-    std::int64_t eroded = 0;
-    for (const auto& b : blocks_) eroded += b.eroded;
-    if (eroded != eroded_seen_) {
-      live_ = 0;
-      for (std::size_t f = 0; f < nf; ++f) live_ += alive(f) ? 1 : 0;
-      eroded_seen_ = eroded;
+    live = live_; // (set_eroded() counts them)
+    // Faces erosion exposed are marked for the cycle of their exposure only; clearing the
+    // marks changes the surface as exposing them did (a full cycle sends every item).
+    if (exposed_age_ == 1) {
+      exposed_age_ = 2;
+    } else if (exposed_age_ == 2) {
+      std::fill(face_exposed_.begin(), face_exposed_.end(), 0);
+      exposed_age_ = 0;
+      ++surface_version_;
     }
-    live = live_;
     // While the bound shows the candidate lists valid (and, on several ranks, the
     // ghosting), only the faces some list reads need their box (below); otherwise every
     // face gets it.
     if (alone)
       lazy_cycle = live == nf && extra_.empty() && lazy_ && search_.built &&
                    search_.builds == lazy_builds_ && lazy_bound_holds();
-    else if (shared_ && !rebalance_due_ && extra_.empty() && live == live_ref_) {
+    else if (shared_ && !rebalance_due_ && extra_.empty() && surface_version_ == version_ref_) {
       // Faces whose bound fails may still be within their budgets (exact boxes).
       bound_ok = shared_bound_holds();
       if (bound_ok && !fail_.empty()) bound_ok = rebase_faces();
@@ -1002,7 +1029,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
         face_dest_.assign(live, 0);
         face_src_.clear();
         for (std::size_t f = 0; f < nf; ++f)
-          if (alive(f)) face_src_.push_back(static_cast<int>(f));
+          if (active(f)) face_src_.push_back(static_cast<int>(f));
       }
       changed = !plans_built_ || node_dest_ != node_dest_built_ || face_dest_ != face_dest_built_ ||
                 face_src_ != face_src_built_;
@@ -1227,7 +1254,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
   }
   if (!alone && !lazy && !extra_somewhere) {
     ScopedPhase t(timers, Phase::transfer);
-    set_shared_reference(boxes, live, !bound_ok);
+    set_shared_reference(boxes, !bound_ok);
   } else if (extra_somewhere) {
     shared_ = false;
   }

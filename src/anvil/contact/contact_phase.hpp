@@ -93,6 +93,12 @@ public:
   std::span<const std::array<double, 3>> extra_forces() const { return extra_force_; }
   std::span<const std::int64_t> extra_faces() const { return extra_face_; }
 
+  // The eroded elements of the whole mesh (global ids, ascending; every rank the same
+  // list): their faces leave the surfaces, and the faces they covered join them, from the
+  // next detect() on (LS-DYNA's eroding contact). Collective in effect: every rank calls
+  // it with the same list whenever an element has eroded anywhere.
+  void set_eroded(std::span<const std::int64_t> eroded);
+
   const ContactStats& stats() const { return stats_; }
   // Local indices, ascending, of the nodes that a contact force can act on here: the
   // contact nodes this rank holds, owned or not. forces() writes nodes.force there only.
@@ -121,9 +127,8 @@ private:
   const FeDecomposition& fe_;
   GidIndex node_index_; // fe_.node_gid[k] -> k
   const Comm& comm_;
-  const std::vector<HexBlock>& blocks_; // the FE blocks (their `alive` flags)
-  std::int64_t global_nodes_ = 0;       // offset that keeps face point ids apart from node ids
-  std::int64_t extra_offset_ = 0;       // first id of extra nodes (after nodes and faces)
+  std::int64_t global_nodes_ = 0; // offset that keeps face point ids apart from node ids
+  std::int64_t extra_offset_ = 0; // first id of extra nodes (after nodes and faces)
 
   // Extra nodes of this cycle (set_extra_nodes) and what forces() returns for them.
   std::vector<ContactNodeItem> extra_;
@@ -145,10 +150,13 @@ private:
   std::vector<std::array<int, 4>> my_face_opposite_; // the element's other four nodes
   std::vector<double> my_face_stiffness_, my_face_depth_;
   std::vector<std::pair<std::int64_t, int>> my_face_element_; // (element gid, side)
-  std::vector<std::pair<int, int>> my_face_slot_;             // (block, element index) of each face
-  std::vector<int> my_face_rank_; // contact rank of the centroid, last cycle
-  std::size_t live_ = 0;          // faces alive (of elements not eroded)
-  std::int64_t eroded_seen_ = -1; // the blocks' eroded elements when live_ was counted
+  std::vector<std::int64_t> my_face_behind_;                  // ExteriorFaces::behind of each face
+  std::vector<std::uint8_t> face_active_;  // its element alive, and exterior or exposed
+  std::vector<std::uint8_t> face_exposed_; // 1 on the cycle erosion exposed it
+  int exposed_age_ = 0;               // 1: set_eroded() exposed faces this cycle; 2: last cycle
+  std::vector<int> my_face_rank_;     // contact rank of the centroid, last cycle
+  std::size_t live_ = 0;              // faces active (face_active_)
+  std::uint64_t surface_version_ = 0; // counts the changes of face_active_
   // The surface's points on this rank: the owned contact nodes and the corners of the
   // faces above (local node indices, ascending), with their predicted positions, computed
   // once a cycle; the nodes' and the faces' corners as indices into them.
@@ -182,7 +190,7 @@ private:
   // within its budget, gets a new reference on its own (rebase_faces()).
   double ghost_margin_ = 0;                  // g, m (the same on every rank, set at construction)
   bool shared_ = false;                      // the references are set
-  std::size_t live_ref_ = 0;                 // faces alive at the last full cycle
+  std::uint64_t version_ref_ = 0;            // surface_version_ at the last full cycle
   std::vector<double> sn_x_[3];              // per owned contact node: x* at its reference
   std::vector<double> sn_budget_, sn_ghost_; // per node: how far it may move from there
                                              // (largest coordinate), and for the ghosting
@@ -230,6 +238,7 @@ private:
   struct FaceMotion {
     double x[4][3], v[4][3], mass[4];
     double normal[3], offset, warp, lo[3], hi[3];
+    std::int32_t exposed;
   };
   Migration node_sub_, face_sub_; // the kept part of node_plan_, face_plan_
   std::vector<ContactNodeItem> node_sub_in_;
@@ -286,7 +295,7 @@ private:
   double node_deviation(std::size_t k) const;
   // Several ranks, after a full cycle's search (collective): the receivers' budgets and
   // keep flags back to the senders, the bound's reference, and the subset plans.
-  void set_shared_reference(const FaceBoxes& boxes, std::size_t live, bool recomputed);
+  void set_shared_reference(const FaceBoxes& boxes, bool recomputed);
   // Several ranks: true when every node is within its budget; fail_ gets the faces whose
   // bound fails.
   bool shared_bound_holds();
@@ -330,8 +339,9 @@ private:
   // rest of them into its item face_in_[j] (only for the faces the search checks).
   void unpack_motion(const FaceMotion& m, std::size_t j);
   void complete_item(const FaceMotion& m, std::size_t j);
-  // Face f's element has not eroded.
-  bool alive(std::size_t f) const;
+  // Face f is on the surface: its element has not eroded, and it is exterior or erosion
+  // has removed the element across it.
+  bool active(std::size_t f) const { return face_active_[f] != 0; }
   // Several ranks: node and face destinations (faces by their enlarged capture box); true
   // when they differ from those the plans were built for.
   bool compute_destinations(std::size_t live);

@@ -468,7 +468,9 @@ void check_queued(const std::vector<ContactNodeItem>& nodes,
       // of the step (x - dt v for node and face alike) it was in front of the face's mean
       // plane. A node found behind a face it never crossed is on the far side of the same
       // wall, or came round an edge, and is not in contact with this face.
-      if (opt.dt > 0) {
+      // (A face erosion has just exposed: the node may have been behind it already, in
+      // the element that eroded; it pairs with its depth as allowance.)
+      if (opt.dt > 0 && fc.exposed == 0) {
         Vec3 c0, n0 = cross(
                      Vec3{(fc.x[2][0] - opt.dt * fc.v[2][0]) - (fc.x[0][0] - opt.dt * fc.v[0][0]),
                           (fc.x[2][1] - opt.dt * fc.v[2][1]) - (fc.x[0][1] - opt.dt * fc.v[0][1]),

@@ -49,6 +49,9 @@ struct ContactFaceItem {
   double offset;       // normal . centre, m
   double warp;         // largest distance of a corner from the mean plane, m
   double lo[3], hi[3]; // capture box, m
+  // 1 on the cycle erosion exposed the face (ContactPhase::set_eroded): a node already
+  // behind it may pair without having come through it this step.
+  std::int32_t exposed;
 };
 
 struct ContactPair {

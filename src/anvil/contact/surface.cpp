@@ -4,7 +4,8 @@
 
 namespace anvil {
 
-ExteriorFaces exterior_faces(const Mesh& mesh, const std::vector<bool>& selected) {
+ExteriorFaces exterior_faces(const Mesh& mesh, const std::vector<bool>& selected,
+                             const std::vector<bool>& erodible) {
   // Sort every face of every element by its sorted node ids; a key seen once is exterior.
   struct Key {
     std::array<std::int64_t, 4> sorted;
@@ -32,12 +33,25 @@ ExteriorFaces exterior_faces(const Mesh& mesh, const std::vector<bool>& selected
     return static_cast<std::size_t>(std::upper_bound(offsets.begin(), offsets.end(), el) -
                                     offsets.begin() - 1);
   };
-  std::vector<std::pair<std::int64_t, int>> exterior;
+  auto can_erode = [&](std::int64_t el) { return !erodible.empty() && erodible[block_of(el)]; };
+  struct Found {
+    std::int64_t element;
+    int side;
+    std::int64_t behind;
+    bool operator<(const Found& o) const {
+      return element != o.element ? element < o.element : side < o.side;
+    }
+  };
+  std::vector<Found> exterior;
   for (std::size_t i = 0; i < keys.size();) {
     std::size_t j = i + 1;
     while (j < keys.size() && keys[j].sorted == keys[i].sorted) ++j;
     if (j == i + 1 && selected[block_of(keys[i].element)])
-      exterior.emplace_back(keys[i].element, keys[i].side);
+      exterior.push_back({keys[i].element, keys[i].side, -1});
+    if (j == i + 2 && (can_erode(keys[i].element) || can_erode(keys[i + 1].element)))
+      for (std::size_t k = i; k < j; ++k)
+        if (selected[block_of(keys[k].element)])
+          exterior.push_back({keys[k].element, keys[k].side, keys[2 * i + 1 - k].element});
     i = j;
   }
   std::sort(exterior.begin(), exterior.end());
@@ -48,10 +62,11 @@ ExteriorFaces exterior_faces(const Mesh& mesh, const std::vector<bool>& selected
   for (const auto& b : mesh.blocks)
     for (const auto& h : b.elements) hex.push_back(&h);
   ExteriorFaces out;
-  for (const auto& [el, s] : exterior) {
-    const Hex& h = *hex[el];
+  for (const auto& [el, s, behind] : exterior) {
+    const Hex& h = *hex[static_cast<std::size_t>(el)];
     out.element.push_back(el);
     out.side.push_back(s);
+    out.behind.push_back(behind);
     out.nodes.push_back(
         {h[hex_faces[s][0]], h[hex_faces[s][1]], h[hex_faces[s][2]], h[hex_faces[s][3]]});
     for (int a = 0; a < 4; ++a) out.contact_nodes.push_back(out.nodes.back()[a]);

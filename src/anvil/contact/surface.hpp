@@ -17,13 +17,19 @@ struct ExteriorFaces {
   std::vector<std::int64_t> element;
   std::vector<int> side;
   std::vector<std::array<std::int64_t, 4>> nodes;
+  // The element across the face (global id): -1 for an exterior face; for a face that
+  // erosion may expose, the element whose erosion does.
+  std::vector<std::int64_t> behind;
   std::vector<std::int64_t> contact_nodes; // sorted, unique global ids of the faces' nodes
 
   std::size_t size() const { return element.size(); }
 };
 
 // Exterior faces of the blocks with `selected[b]` true. A face is exterior when no other
-// element of the whole mesh (any block) has the same four nodes.
-ExteriorFaces exterior_faces(const Mesh& mesh, const std::vector<bool>& selected);
+// element of the whole mesh (any block) has the same four nodes. With `erodible` (per
+// block; empty: none), also the faces between two elements of which one is erodible:
+// the faces erosion may expose (LS-DYNA's eroding contact), `behind` their neighbour.
+ExteriorFaces exterior_faces(const Mesh& mesh, const std::vector<bool>& selected,
+                             const std::vector<bool>& erodible = {});
 
 } // namespace anvil

@@ -235,6 +235,20 @@ void Simulation::locate_probes(const Mesh& mesh) {
   }
 }
 
+// Every rank's eroded elements to the contact surfaces (collective; on the cycles where
+// some element eroded, and after a restart).
+void Simulation::share_eroded() {
+  if (!contact_) return;
+  std::vector<std::int64_t> mine;
+  for (const auto& b : blocks_)
+    for (int e = 0; e < b.size(); ++e)
+      if (b.alive[static_cast<std::size_t>(e)] == 0.0)
+        mine.push_back(b.gid[static_cast<std::size_t>(e)]);
+  std::vector<std::int64_t> all = comm_.allgatherv(std::span<const std::int64_t>(mine));
+  std::sort(all.begin(), all.end());
+  contact_->set_eroded(all);
+}
+
 std::string Simulation::describe_element(std::int64_t gid) const {
   for (std::size_t b = 0; b + 1 < block_offsets_.size(); ++b)
     if (gid >= block_offsets_[b] && gid < block_offsets_[b + 1])
@@ -285,14 +299,15 @@ void Simulation::fe_forces() {
     const std::initializer_list<double*> corners = {
         corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()};
     corner_exchange_->start(corners);
-    // One reduction per cycle carries the stable step and the failure flags.
+    // One reduction per cycle carries the stable step and the failure and erosion flags.
     const double none = std::numeric_limits<double>::infinity();
-    double red[4] = {r.dt_stable, r.inverted_gid >= 0 ? static_cast<double>(r.inverted_gid) : none,
+    double red[5] = {r.dt_stable, r.inverted_gid >= 0 ? static_cast<double>(r.inverted_gid) : none,
                      r.nonfinite_gid >= 0 ? static_cast<double>(r.nonfinite_gid) : none,
-                     stop_local_ ? 0.0 : 1.0};
-    comm_.min(std::span<double>(red, 4));
+                     stop_local_ ? 0.0 : 1.0, r.eroded > 0 ? 0.0 : 1.0};
+    comm_.min(std::span<double>(red, 5));
     corner_exchange_->finish(corners);
-    stop_ = red[3] == 0.0; // a stop asked on any rank stops every rank after this cycle
+    stop_ = red[3] == 0.0;             // a stop asked on any rank stops every rank after this cycle
+    if (red[4] == 0.0) share_eroded(); // some element eroded somewhere
     if (red[1] != none)
       throw PhysicsError(describe_element(static_cast<std::int64_t>(red[1])), clock_.time,
                          "inverted element (non-positive volume)");
@@ -736,6 +751,7 @@ void Simulation::restore(const Checkpoint& c) {
     for (int e = 0; e < b.size(); ++e) b.eroded += b.alive[e] == 0.0 ? 1 : 0;
     eroded_ += b.eroded;
   }
+  share_eroded();
   // The padding lanes of each block repeat its last element (see HexBlock::init).
   for (auto& b : blocks_) {
     const int n = b.size();
