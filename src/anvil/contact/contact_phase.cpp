@@ -294,7 +294,7 @@ void ContactPhase::complete_item(const FaceMotion& m, std::size_t j) {
   it.exposed = m.exposed;
 }
 
-void ContactPhase::set_eroded(std::span<const std::int64_t> eroded) {
+void ContactPhase::set_eroded(std::span<const std::int64_t> eroded, bool exposing) {
   auto gone = [&](std::int64_t el) { return std::binary_search(eroded.begin(), eroded.end(), el); };
   bool changed = false;
   for (std::size_t f = 0; f < face_active_.size(); ++f) {
@@ -302,7 +302,7 @@ void ContactPhase::set_eroded(std::span<const std::int64_t> eroded) {
     const std::uint8_t a = !gone(my_face_element_[f].first) && (behind < 0 || gone(behind));
     if (a != face_active_[f]) {
       changed = true;
-      if (a != 0 && behind >= 0) {
+      if (a != 0 && behind >= 0 && exposing) {
         face_exposed_[f] = 1;
         exposed_age_ = 1;
       }

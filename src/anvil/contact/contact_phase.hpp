@@ -96,8 +96,10 @@ public:
   // The eroded elements of the whole mesh (global ids, ascending; every rank the same
   // list): their faces leave the surfaces, and the faces they covered join them, from the
   // next detect() on (LS-DYNA's eroding contact). Collective in effect: every rank calls
-  // it with the same list whenever an element has eroded anywhere.
-  void set_eroded(std::span<const std::int64_t> eroded);
+  // it with the same list whenever an element has eroded anywhere. `exposing`: the faces
+  // that join the surface were exposed this cycle (false after a restart: they were
+  // exposed before the checkpoint).
+  void set_eroded(std::span<const std::int64_t> eroded, bool exposing = true);
 
   const ContactStats& stats() const { return stats_; }
   // Local indices, ascending, of the nodes that a contact force can act on here: the

@@ -236,8 +236,8 @@ void Simulation::locate_probes(const Mesh& mesh) {
 }
 
 // Every rank's eroded elements to the contact surfaces (collective; on the cycles where
-// some element eroded, and after a restart).
-void Simulation::share_eroded() {
+// some element eroded, and after a restart: `exposing` false).
+void Simulation::share_eroded(bool exposing) {
   if (!contact_) return;
   std::vector<std::int64_t> mine;
   for (const auto& b : blocks_)
@@ -246,7 +246,7 @@ void Simulation::share_eroded() {
         mine.push_back(b.gid[static_cast<std::size_t>(e)]);
   std::vector<std::int64_t> all = comm_.allgatherv(std::span<const std::int64_t>(mine));
   std::sort(all.begin(), all.end());
-  contact_->set_eroded(all);
+  contact_->set_eroded(all, exposing);
 }
 
 std::string Simulation::describe_element(std::int64_t gid) const {
@@ -751,7 +751,7 @@ void Simulation::restore(const Checkpoint& c) {
     for (int e = 0; e < b.size(); ++e) b.eroded += b.alive[e] == 0.0 ? 1 : 0;
     eroded_ += b.eroded;
   }
-  share_eroded();
+  share_eroded(false);
   // The padding lanes of each block repeat its last element (see HexBlock::init).
   for (auto& b : blocks_) {
     const int n = b.size();

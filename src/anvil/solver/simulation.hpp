@@ -123,7 +123,7 @@ private:
   void predict();
   void detect_contacts();
   void correct();
-  void share_eroded();
+  void share_eroded(bool exposing = true);
   void apply_walls();             // the rigid walls' part of correct()
   void sample_probe_velocities(); // at the end of correct()
   ContactNodes contact_view();
