@@ -4,6 +4,10 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
 #include "anvil/io/deck.hpp"
 #include "test_support.hpp"
 
@@ -219,6 +223,25 @@ TEST(Deck, HugeGeneratedMeshesAreRejected) {
           << e.what();
     }
   }
+}
+
+} // namespace
+
+namespace {
+
+using namespace anvil;
+
+// QA D1: a '---' or '...' line ended the deck there, the rest (initial and boundary
+// conditions, unknown keys, even malformed YAML) dropped without a word.
+TEST(Deck, SecondYamlDocumentIsAnError) {
+  const std::string last = "output: {fields_every: 1.0e-5, history_every: 1.0e-7}";
+  expect_error(last, last + "\n---\nrigid_walls: [{point: [0, 0, 0], normal: [0, 0, 1]}]",
+               {"deck.yaml:22", "second one", "'---'"});
+  expect_error(last, last + "\n---\n", {"deck.yaml:22", "second one"});
+  expect_error(last, last + "\n...\ngarbage: [unclosed", {"deck.yaml:2", "YAML"});
+  // A marker at the start, and one at the end with nothing after it: one document.
+  const Config c = test::deck("---\n" + std::string(good) + "...\n# the end\n");
+  EXPECT_EQ(c.boundary_conditions.size(), 2u);
 }
 
 } // namespace

@@ -1,5 +1,6 @@
 #include "anvil/io/deck.hpp"
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -543,6 +544,17 @@ Selection parse_set_ref(const Node& n) {
   return s;
 }
 
+// The 1-based line of the last document marker ('---' or '...') at or before the 0-based
+// line `upto` (where yaml-cpp puts the next document), or `upto` + 1 if there is none.
+int separator_line(const std::string& text, int upto) {
+  std::istringstream in(text);
+  std::string l;
+  int found = upto + 1;
+  for (int i = 0; i <= upto && std::getline(in, l); ++i)
+    if (l.rfind("---", 0) == 0 || l.rfind("...", 0) == 0) found = i + 1;
+  return found;
+}
+
 } // namespace
 
 Config parse_deck(const std::string& text, const std::string& name, const std::string& base_dir) {
@@ -550,7 +562,17 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
   c.deck_file = name;
   YAML::Node root;
   try {
-    root = YAML::Load(text);
+    const std::vector<YAML::Node> docs = YAML::LoadAll(text);
+    // A second document would be dropped without a word: everything after a '---' or
+    // '...' line. It is reported at that line.
+    if (docs.size() > 1)
+      throw InputError({name, separator_line(text, docs[1].Mark().line), ""},
+                       "a deck holds one YAML document; a second one starts here (remove the "
+                       "'---' or '...' line)");
+    if (!docs.empty()) root = docs[0];
+  } catch (const YAML::DeepRecursion& e) {
+    throw InputError({name, e.mark.line >= 0 ? e.mark.line + 1 : 0, ""},
+                     "malformed YAML: nested too deep");
   } catch (const YAML::Exception& e) {
     throw InputError({name, e.mark.line >= 0 ? e.mark.line + 1 : 0, ""},
                      "malformed YAML: " + e.msg);
