@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -133,6 +134,17 @@ VtuPiece particle_piece(const Simulation& sim) {
                   std::move(stress), std::move(vm),   std::move(ep),  std::move(energy),
                   std::move(h),      std::move(rank), std::move(pid), std::move(set)};
   return p;
+}
+
+double next_output_time(double next, double every, double t) {
+  const double bound = t * (1 + 1e-12);
+  // A few intervals by repeated addition, as the series always advanced: an ordinary
+  // deck's output times keep their bits. Past that, a jump.
+  for (int i = 0; i < 16 && next <= bound; ++i) next += every;
+  if (next > bound) return next;
+  const double jump = (std::floor(bound / every) + 1) * every; // inf if every is subnormal
+  if (std::isfinite(jump) && jump > next) next = jump;
+  return next > bound ? next : std::nextafter(bound, std::numeric_limits<double>::infinity());
 }
 
 // Runs `write` on every rank; if it fails on any, every rank throws the InputError of the
@@ -288,11 +300,11 @@ void Outputs::after_step() {
     have_sample_ = true;
     write_history_row(last_sample_);
     if (c.history_every > 0)
-      while (next_history_ <= t_sample * (1 + 1e-12)) next_history_ += c.history_every;
+      next_history_ = next_output_time(next_history_, c.history_every, t_sample);
   }
   if (clk.time >= next_fields_ * (1 - 1e-12) || last) {
     write_fields();
-    while (next_fields_ <= clk.time * (1 + 1e-12)) next_fields_ += c.fields_every;
+    if (c.fields_every > 0) next_fields_ = next_output_time(next_fields_, c.fields_every, clk.time);
   }
   progress(last);
 }

@@ -18,6 +18,13 @@
 
 namespace anvil {
 
+// The next due time of a series written every `every` seconds (> 0), past the time `t`
+// just written: `next` advanced by whole intervals beyond t (1 + 1e-12). Bounded work
+// whatever the interval: an interval too small to advance t in floating point
+// (every = 1e-300) gives the next double past the bound, a row or field output per cycle.
+double next_output_time(double next, double every, double t);
+
+
 struct OutputOptions {
   std::string directory = "out";
   bool progress = true; // progress line on rank 0
