@@ -33,15 +33,16 @@ nlohmann::json per_rank(const Comm& comm, double local) {
 void write_decomposition(const Config& config, const std::string& outdir, const Comm& comm) {
   Simulation sim(config, comm);
   sim.decompose_now();
-  if (comm.rank() == 0) {
-    make_directories(outdir);
-  }
-  comm.barrier();
+  // Rank 0 creates the directory; a failure stops every rank (none waits for the others).
+  collective_write(comm, [&] {
+    if (comm.rank() == 0) make_directories(outdir);
+  });
 
   VtuPiece piece = fe_piece(sim);
   const std::string stem = "decomposition";
-  write_vtu(outdir + "/" + stem + "_r" + std::to_string(comm.rank()) + ".vtu", piece);
-  comm.barrier();
+  collective_write(comm, [&] {
+    write_vtu(outdir + "/" + stem + "_r" + std::to_string(comm.rank()) + ".vtu", piece);
+  });
 
   nlohmann::json j;
   j["ranks"] = comm.size();

@@ -147,41 +147,15 @@ double next_output_time(double next, double every, double t) {
   return next > bound ? next : std::nextafter(bound, std::numeric_limits<double>::infinity());
 }
 
-// Runs `write` on every rank; if it fails on any, every rank throws the InputError of the
-// lowest failing rank (a write error on one rank must not leave the others waiting).
-template <class F>
-void collective_write(const Comm& comm, F&& write) {
-  std::string err;
-  try {
-    write();
-  } catch (const InputError& e) {
-    err = e.what();
-  }
-  const std::int64_t failed = comm.min(err.empty() ? static_cast<std::int64_t>(comm.size())
-                                                   : static_cast<std::int64_t>(comm.rank()));
-  if (failed == comm.size()) return;
-  comm.broadcast(err, static_cast<int>(failed));
-  throw InputError(err);
-}
-
 Outputs::Outputs(const Simulation& sim, OutputOptions options)
     : sim_(sim), opt_(std::move(options)) {
   // Rank 0 creates the directories; the others wait for it.
-  std::int64_t ok = 1;
-  std::string err;
-  if (sim_.comm().rank() == 0) {
-    try {
-      make_directories(opt_.directory);
-      if (sim_.config().output_format != OutputFormat::exodus || sim_.sph())
-        make_directories(opt_.directory + "/fields");
-    } catch (const InputError& e) {
-      ok = 0;
-      err = e.what();
-    }
-  }
-  ok = sim_.comm().min(ok);
-  sim_.comm().broadcast(err, 0);
-  if (!ok) throw InputError(err);
+  collective_write(sim_.comm(), [&] {
+    if (sim_.comm().rank() != 0) return;
+    make_directories(opt_.directory);
+    if (sim_.config().output_format != OutputFormat::exodus || sim_.sph())
+      make_directories(opt_.directory + "/fields");
+  });
   // Under mpirun, OpenMPI gives rank 0 a pseudo-terminal whatever mpirun's own output is
   // (a log file too): there, periodic lines are the safe choice.
   tty_ = sim_.comm().rank() == 0 && ::isatty(STDOUT_FILENO) &&
