@@ -250,4 +250,18 @@ TEST(Cli, TinyOutputIntervalsDoNotHang) {
   EXPECT_TRUE(std::filesystem::exists(dir + "/checkpoint.anvil"));
 }
 
+// QA D4: a deck whose file name is not UTF-8 (Latin-1) ran to the end and then crashed
+// writing summary.json; the name is written with U+FFFD in place of the bad byte.
+TEST(Cli, NonUtf8DeckNameStillWritesTheSummary) {
+  std::string deck = small_deck;
+  deck.replace(deck.find("termination: {time: 2.0e-6}"), 27, "termination: {cycles: 2}");
+  const auto dir = (std::filesystem::temp_directory_path() / "anvil_cli_latin1").string();
+  std::filesystem::remove_all(dir);
+  const auto r = run("run " + write_temp("caf\xe9.yaml", deck) + " -o " + dir + " -q");
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::stringstream summary;
+  summary << std::ifstream(dir + "/summary.json").rdbuf();
+  EXPECT_NE(summary.str().find("caf\xef\xbf\xbd.yaml"), std::string::npos) << summary.str();
+}
+
 } // namespace

@@ -244,4 +244,17 @@ TEST(Deck, SecondYamlDocumentIsAnError) {
   EXPECT_EQ(c.boundary_conditions.size(), 2u);
 }
 
+// QA D4: a title or name that is not UTF-8 went through `check` and crashed the JSON of a
+// completed run; it is an error at the deck, naming file, line and key.
+TEST(Deck, TextMustBeUtf8) {
+  expect_error("title: bar", "title: caf\xe9", {"deck.yaml:1", "title", "UTF-8"});
+  expect_error("title: bar", "title: over\xc0\xaflong", {"deck.yaml:1", "title", "UTF-8"});
+  expect_error("title: bar", "title: \xed\xa0\x80surrogate", {"deck.yaml:1", "title", "UTF-8"});
+  expect_error("copper: {model", "copp\xe9r: {model", {"deck.yaml:5", "materials", "UTF-8"});
+  expect_error("  bar:\n", "  b\xe4r:\n", {"deck.yaml:8", "parts", "UTF-8"});
+  std::string text = good;
+  text.replace(text.find("title: bar"), 10, "title: caf\xc3\xa9 \xe2\x9c\x93 \xf0\x9f\x94\xa8");
+  EXPECT_EQ(test::deck(text).title, "caf\xc3\xa9 \xe2\x9c\x93 \xf0\x9f\x94\xa8");
+}
+
 } // namespace

@@ -208,7 +208,7 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
                            c.outputs.next_fields,
                            c.outputs.next_history};
   std::string s(magic, sizeof magic);
-  const std::string header = h.dump();
+  const std::string header = json_text(h);
   put(s, std::vector<char>(header.begin(), header.end()));
   put(s, std::vector<double>(exact, exact + 8));
   put(s, std::vector<double>{c.outputs.next_checkpoint});

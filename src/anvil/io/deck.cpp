@@ -29,6 +29,38 @@ int Config::particle_set(const std::string& name) const {
 
 namespace {
 
+// Whether `s` is well-formed UTF-8 (no overlong forms, surrogates or code points past
+// U+10FFFF): deck text is copied into JSON files, which must be UTF-8.
+bool is_utf8(std::string_view s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    int len = 0;
+    unsigned cp = 0, min = 0;
+    if (c < 0x80) {
+      ++i;
+      continue;
+    } else if ((c & 0xE0) == 0xC0) {
+      len = 2, cp = c & 0x1Fu, min = 0x80;
+    } else if ((c & 0xF0) == 0xE0) {
+      len = 3, cp = c & 0x0Fu, min = 0x800;
+    } else if ((c & 0xF8) == 0xF0) {
+      len = 4, cp = c & 0x07u, min = 0x10000;
+    } else {
+      return false;
+    }
+    if (i + static_cast<std::size_t>(len) > s.size()) return false;
+    for (int k = 1; k < len; ++k) {
+      const auto b = static_cast<unsigned char>(s[i + static_cast<std::size_t>(k)]);
+      if ((b & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (b & 0x3Fu);
+    }
+    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return false;
+    i += static_cast<std::size_t>(len);
+  }
+  return true;
+}
+
 // A YAML node together with the file and key path it was found at, so that every check
 // can say where the problem is.
 class Node {
@@ -62,6 +94,7 @@ public:
       if (!it->first.IsScalar())
         throw InputError({*file_, kline, path_}, "keys must be plain names");
       const std::string key = it->first.Scalar();
+      if (!is_utf8(key)) throw InputError({*file_, kline, path_}, "a key is not valid UTF-8 text");
       const std::string sub = path_.empty() ? key : path_ + "." + key;
       if (allowed.size() > 0 &&
           std::find(allowed.begin(), allowed.end(), std::string_view(key)) == allowed.end()) {
@@ -100,6 +133,7 @@ public:
 
   std::string str() const {
     if (!n_.IsScalar()) fail("expected a single value");
+    if (!is_utf8(n_.Scalar())) fail("not valid UTF-8 text (save the deck as UTF-8)");
     return n_.Scalar();
   }
   double number() const {

@@ -80,7 +80,7 @@ void write_decomposition(const Config& config, const std::string& outdir, const 
       pieces.push_back(stem + "_r" + std::to_string(r) + ".vtu");
     write_pvtu(outdir + "/" + stem + ".pvtu", pieces, piece);
     write_pvd(outdir + "/results.pvd", {{0.0, stem + ".pvtu"}});
-    write_file_atomic(outdir + "/decomposition.json", j.dump(2) + "\n");
+    write_file_atomic(outdir + "/decomposition.json", json_text(j, 2) + "\n");
   }
 }
 

@@ -7,6 +7,9 @@
 #include <filesystem>
 #include <system_error>
 
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
 #include "anvil/core/error.hpp"
 
 namespace anvil {
@@ -28,6 +31,10 @@ void write_file_atomic(const std::string& path, std::string_view content) {
   ::close(fd);
   if (std::rename(tmp.c_str(), path.c_str()) != 0)
     throw InputError("cannot rename '" + tmp + "' to '" + path + "'");
+}
+
+std::string json_text(const nlohmann::json& j, int indent) {
+  return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 void make_directories(const std::string& path) {

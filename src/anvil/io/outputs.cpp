@@ -500,7 +500,7 @@ void Outputs::write_summary(int status, const std::string& message) {
   for (std::size_t i = 0; i < sim_.config().parts.size(); ++i)
     masses[sim_.config().parts[i].name] = sim_.part_masses()[i];
   j["part_mass"] = masses;
-  write_file_atomic(opt_.directory + "/summary.json", j.dump(2) + "\n");
+  write_file_atomic(opt_.directory + "/summary.json", json_text(j, 2) + "\n");
 }
 
 } // namespace anvil
