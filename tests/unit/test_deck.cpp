@@ -257,4 +257,14 @@ TEST(Deck, TextMustBeUtf8) {
   EXPECT_EQ(test::deck(text).title, "caf\xc3\xa9 \xe2\x9c\x93 \xf0\x9f\x94\xa8");
 }
 
+// QA D5: a probe's name heads history.csv columns; a comma shifted every column after it.
+TEST(Deck, ProbeNamesArePlain) {
+  for (const char* bad : {"'a,b'", "''", "'tip top'", "'\"q\"'"})
+    expect_error("{name: tip,", fmt::format("{{name: {},", bad),
+                 {"deck.yaml:20", "probes[0].name", "plain name"});
+  std::string text = good;
+  text.replace(text.find("{name: tip,"), 11, "{name: Tip_1.z-2,");
+  EXPECT_EQ(test::deck(text).probes[0].name, "Tip_1.z-2");
+}
+
 } // namespace

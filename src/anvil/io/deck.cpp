@@ -826,6 +826,14 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
     for (const auto& n : top.child("probes").items()) {
       n.check_keys({"name", "at"});
       ProbeConfig p{n.required("name").str(), n.required("at").vec3(), n.where()};
+      // The name heads history.csv columns (NAME.ux): no commas, quotes or blanks.
+      const auto plain = [](char ch) {
+        return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
+               ch == '_' || ch == '.' || ch == '-';
+      };
+      if (p.name.empty() || !std::all_of(p.name.begin(), p.name.end(), plain))
+        n.child("name").fail(fmt::format(
+            "probe name '{}' must be a plain name: letters, digits, '_', '.' and '-'", p.name));
       if (!names.insert(p.name).second)
         n.child("name").fail(fmt::format("probe name '{}' is used twice", p.name));
       c.probes.push_back(p);
