@@ -267,4 +267,12 @@ TEST(Deck, ProbeNamesArePlain) {
   EXPECT_EQ(test::deck(text).probes[0].name, "Tip_1.z-2");
 }
 
+// QA D8: `fix: []` and `components: []` constrained nothing, silently.
+TEST(Deck, EmptyComponentListsAreErrors) {
+  expect_error("fix: [z]", "fix: []",
+               {"deck.yaml:17", "boundary_conditions[0].fix", "at least one"});
+  expect_error("components: [z]", "components: []",
+               {"deck.yaml:18", "boundary_conditions[1].components", "at least one"});
+}
+
 } // namespace

@@ -190,7 +190,9 @@ public:
   std::array<bool, 3> components() const {
     std::array<bool, 3> out{false, false, false};
     if (n_.IsScalar() && n_.Scalar() == "all") return {true, true, true};
-    for (const auto& c : items()) out[c.axis()] = true;
+    const auto list = items();
+    if (list.empty()) fail("give at least one of x, y, z, or all");
+    for (const auto& c : list) out[c.axis()] = true;
     return out;
   }
 
