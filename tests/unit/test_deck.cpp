@@ -275,4 +275,10 @@ TEST(Deck, EmptyComponentListsAreErrors) {
                {"deck.yaml:18", "boundary_conditions[1].components", "at least one"});
 }
 
+// QA D9: a deck set named like a generated one (bar.top) replaced it without a word.
+TEST(Deck, NodeSetNamesHaveNoDots) {
+  expect_error("  impact_face: {part", "  bar.top: {part",
+               {"deck.yaml:13", "node_sets.bar.top", "may not contain '.'"});
+}
+
 } // namespace

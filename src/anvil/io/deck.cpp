@@ -767,6 +767,9 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 
   if (top.has("node_sets")) {
     for (const auto& [sname, sn] : top.child("node_sets").entries()) {
+      // PART.SET names the sets of a part's mesh: a deck set so named would hide one.
+      if (sname.find('.') != std::string::npos)
+        sn.fail("node set names may not contain '.' (PART.SET names a set of a part's mesh)");
       Selection s = parse_inline_selection(sn);
       s.name.clear();
       check_part(s);
