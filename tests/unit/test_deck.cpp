@@ -281,4 +281,10 @@ TEST(Deck, NodeSetNamesHaveNoDots) {
                {"deck.yaml:13", "node_sets.bar.top", "may not contain '.'"});
 }
 
+// QA D10: the key of an initial condition's undefined part read `.part.part`.
+TEST(Deck, InitialConditionPartKey) {
+  expect_error("- {part: bar, velocity", "- {part: nope, velocity",
+               {"deck.yaml:15: initial_conditions[0].part: part 'nope'"});
+}
+
 } // namespace

@@ -785,7 +785,8 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
       if (n.has("part") == n.has("set")) n.fail("give exactly one of 'part' or 'set'");
       if (n.has("part")) {
         ic.nodes.part = n.child("part").str();
-        ic.nodes.where = n.child("part").where();
+        // The item's key: check_part and the model name the `part` key under it.
+        ic.nodes.where = {c.deck_file, n.child("part").line(), n.path()};
       } else {
         ic.nodes = parse_set_ref(n.child("set"));
       }
