@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <span>
 #include <vector>
 
@@ -182,6 +183,10 @@ int main(int argc, char** argv) {
   } catch (const anvil::PhysicsError& e) {
     if (root) std::fprintf(stderr, "anvil: run failed: %s\n", e.what());
     return anvil::exit_physics;
+  } catch (const std::bad_alloc&) {
+    // One rank may run out alone: the others cannot be told, hence the abort.
+    std::fprintf(stderr, "anvil: error: the model does not fit in memory (rank %d)\n", comm.rank());
+    comm.abort(anvil::exit_bad_input);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "anvil: internal error on rank %d: %s\n", comm.rank(), e.what());
     comm.abort(1);

@@ -264,4 +264,24 @@ TEST(Cli, NonUtf8DeckNameStillWritesTheSummary) {
   EXPECT_NE(summary.str().find("caf\xef\xbf\xbd.yaml"), std::string::npos) << summary.str();
 }
 
+// QA D7: a particle lattice that passes the deck's count check but does not fit in memory
+// ended in "internal error" (exit 1); it is bad input naming the particle set.
+TEST(Cli, ParticleLatticeTooLargeForMemory) {
+  const auto deck = write_temp("huge_lattice.yaml", R"(
+termination: {cycles: 5}
+materials:
+  water: {model: elastic, density: 1000, youngs_modulus: 1.0e3, poissons_ratio: 0.49}
+particles:
+  slug:
+    generate: {shape: box, min: [0, 0, 0], max: [0.004, 0.004, 0.004], spacing: 3.5e-6}
+    material: water
+)");
+  const auto r = run_command("ulimit -v 3000000; timeout -s KILL 120 " +
+                             std::string(anvil::test::anvil_binary()) + " check " + deck);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("particles.slug: the particle lattice does not fit in memory"),
+            std::string::npos)
+      << r.out;
+}
+
 } // namespace

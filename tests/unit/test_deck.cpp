@@ -287,4 +287,29 @@ TEST(Deck, InitialConditionPartKey) {
                {"deck.yaml:15: initial_conditions[0].part: part 'nope'"});
 }
 
+// QA D7 and D12: the deck file must be a regular file of sane size (/dev/zero was read
+// until memory ran out; a directory was "empty").
+TEST(Deck, DeckFileMustBeARegularFile) {
+  const auto dir = std::filesystem::temp_directory_path() / "anvil_deck_file_test";
+  std::filesystem::create_directories(dir);
+  auto message = [](const std::string& path) {
+    try {
+      read_deck(path);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(dir.string()).find("is a directory"), std::string::npos)
+      << message(dir.string());
+  EXPECT_NE(message("/dev/zero").find("not a regular file"), std::string::npos)
+      << message("/dev/zero");
+  EXPECT_NE(message((dir / "none.yaml").string()).find("cannot open"), std::string::npos);
+  const auto big = dir / "big.yaml";
+  { std::ofstream(big) << "title: x\n"; }
+  std::filesystem::resize_file(big, (std::uintmax_t{64} << 20) + 1); // sparse: no disk used
+  EXPECT_NE(message(big.string()).find("at most"), std::string::npos) << message(big.string());
+  std::filesystem::remove_all(dir);
+}
+
 } // namespace

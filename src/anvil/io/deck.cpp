@@ -6,12 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <span>
 #include <sstream>
 
 #include <fmt/format.h>
+
+#include "anvil/io/files.hpp"
 
 namespace anvil {
 
@@ -935,12 +936,11 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 }
 
 Config read_deck(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError({path, 0, ""}, "cannot open the deck file");
-  std::stringstream ss;
-  ss << in.rdbuf();
+  // A YAML deck holds no mesh: anything near this size is not a deck (/dev/zero, a log).
+  constexpr std::uintmax_t max_deck_bytes = std::uintmax_t{64} << 20;
+  const std::string text = read_input_file(path, max_deck_bytes);
   const auto dir = std::filesystem::path(path).parent_path();
-  return parse_deck(ss.str(), path, dir.empty() ? "." : dir.string());
+  return parse_deck(text, path, dir.empty() ? "." : dir.string());
 }
 
 } // namespace anvil
