@@ -208,6 +208,25 @@ boundary_conditions:
   EXPECT_NE(r.out.find("part block"), std::string::npos) << r.out;
 }
 
+// QA D11: an unknown subcommand or option was reported as "A subcommand is required";
+// --cycles -1 printed the 309 digits of the largest double, and a huge --cycles a line of a
+// deck the user never wrote.
+TEST(Cli, UnknownWordsAndBadCyclesAreNamed) {
+  auto r = run("frobnicate");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("unknown subcommand or option 'frobnicate'"), std::string::npos) << r.out;
+  r = run("--versoin");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("'--versoin'"), std::string::npos) << r.out;
+  for (const char* cycles : {"-1", "99999999999999999999"}) {
+    r = run(std::string("bench can-crush --cycles ") + cycles);
+    EXPECT_EQ(r.status, 2) << r.out;
+    EXPECT_NE(r.out.find("--cycles"), std::string::npos) << r.out;
+    EXPECT_LT(r.out.size(), 300u) << r.out;
+    EXPECT_EQ(r.out.find("termination.cycles"), std::string::npos) << r.out;
+  }
+}
+
 // QA D2: the next output time advances in bounded work: an interval that cannot move the
 // time in floating point gave an endless loop, a merely tiny one ~1e14 iterations.
 TEST(Outputs, NextOutputTime) {
