@@ -287,6 +287,26 @@ TEST(Deck, InitialConditionPartKey) {
                {"deck.yaml:15: initial_conditions[0].part: part 'nope'"});
 }
 
+// QA D12: a subnormal value is a number (it was "not finite"), a tiny wall normal is not
+// zero, and nesting beyond yaml-cpp's limit says so (it was "bad file").
+TEST(Deck, ExtremeButValidValues) {
+  std::string text = good;
+  text.replace(text.find("density: 8930"), 13, "density: 4e-320");
+  EXPECT_EQ(test::deck(text).materials[0].params.at("density"), 4e-320);
+  expect_error("density: 8930", "density: 1e400", {"deck.yaml:5", "density", "finite"});
+  const std::string last = "output: {fields_every: 1.0e-5, history_every: 1.0e-7}";
+  text = std::string(good) + "rigid_walls:\n  - {point: [0, 0, 0], normal: [1e-200, 0, 1e-200]}\n";
+  const Config c = test::deck(text);
+  EXPECT_NEAR(c.rigid_walls[0].normal.x, std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(c.rigid_walls[0].normal.z, std::sqrt(0.5), 1e-15);
+  expect_error(last, last + "\nrigid_walls:\n  - {point: [0, 0, 0], normal: [0, 0, 0]}",
+               {"deck.yaml:23", "rigid_walls[0].normal", "zero"});
+  expect_error("title: bar", "title: " + std::string(3000, '[') + std::string(3000, ']'),
+               {"deck.yaml", "nested too deep"});
+  expect_error("parts:\n", "  brass: {<<: {model: elastic}, density: 1}\nparts:\n",
+               {"materials.brass.model", "merge keys"});
+}
+
 // QA D7 and D12: the deck file must be a regular file of sane size (/dev/zero was read
 // until memory ran out; a directory was "empty").
 TEST(Deck, DeckFileMustBeARegularFile) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <set>
 #include <span>
@@ -121,7 +122,9 @@ public:
     if (!has(key))
       throw InputError({*file_, fallback_line_ > 0 ? fallback_line_ : line(),
                         path_.empty() ? key : path_ + "." + key},
-                       "required key is missing");
+                       has("<<") ? "required key is missing (YAML merge keys '<<' are not "
+                                   "supported: write the keys out)"
+                                 : "required key is missing");
     return child(key);
   }
   std::vector<Node> items() const {
@@ -140,14 +143,11 @@ public:
   double number() const {
     if (!n_.IsScalar()) fail("expected a number");
     const std::string& s = n_.Scalar();
-    double v = 0;
-    std::size_t used = 0;
-    try {
-      v = std::stod(s, &used);
-    } catch (...) {
-      used = 0;
-    }
-    if (used == 0 || used != s.size() || !std::isfinite(v))
+    // strtod, not stod (which throws on ERANGE): a value below the smallest normal double,
+    // 4e-320 say, underflows to a subnormal or to zero, and is a number all the same.
+    char* end = nullptr;
+    const double v = std::strtod(s.c_str(), &end);
+    if (s.empty() || end != s.c_str() + s.size() || !std::isfinite(v))
       fail(fmt::format("expected a finite number, got '{}'", s));
     return v;
   }
@@ -896,10 +896,12 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
       RigidWallConfig w;
       w.where = n.where();
       w.point = n.required("point").vec3();
-      const Vec3 nrm = n.required("normal").vec3();
-      const double len = norm(nrm);
-      if (!(len > 0)) n.child("normal").fail("the normal must not be zero");
-      w.normal = nrm * (1 / len);
+      Vec3 nrm = n.required("normal").vec3();
+      // Scaled by its largest component first: the norm of [1e-200, 0, 1e-200] underflows.
+      const double big = std::max({std::abs(nrm.x), std::abs(nrm.y), std::abs(nrm.z)});
+      if (!(big > 0)) n.child("normal").fail("the normal must not be zero");
+      nrm = {nrm.x / big, nrm.y / big, nrm.z / big};
+      w.normal = nrm * (1 / norm(nrm));
       if (n.has("friction")) {
         w.friction = n.child("friction").number();
         if (w.friction < 0) n.child("friction").fail("must not be negative");
