@@ -303,4 +303,33 @@ particles:
       << r.out;
 }
 
+// QA D6: `anvil decompose` left the SPH decomposition out: no particle counts or RCB
+// statistics in decomposition.json, no particle pieces (a particles-only deck gave an
+// empty FE decomposition).
+TEST(Cli, DecomposeWritesTheParticleDecomposition) {
+  const auto deck = write_temp("particles.yaml", R"(
+termination: {cycles: 5}
+materials:
+  water: {model: elastic, density: 1000, youngs_modulus: 1.0e3, poissons_ratio: 0.49}
+particles:
+  slug:
+    generate: {shape: box, min: [0, 0, 0], max: [0.004, 0.004, 0.004], spacing: 0.5e-3}
+    material: water
+)");
+  const auto dir = (std::filesystem::temp_directory_path() / "anvil_cli_decompose").string();
+  std::filesystem::remove_all(dir);
+  const auto r = run("decompose " + deck + " -o " + dir);
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::stringstream json;
+  json << std::ifstream(dir + "/decomposition.json").rdbuf();
+  for (const char* key : {"\"particles\": 512", "\"sph\"", "\"cuts\"", "\"boxes\""})
+    EXPECT_NE(json.str().find(key), std::string::npos) << key << "\n" << json.str();
+  EXPECT_EQ(json.str().find("\"fe\""), std::string::npos) << json.str(); // no elements
+  std::stringstream pvtu;
+  pvtu << std::ifstream(dir + "/particles_decomposition.pvtu").rdbuf();
+  EXPECT_NE(pvtu.str().find("sph_rank"), std::string::npos) << pvtu.str();
+  EXPECT_TRUE(std::filesystem::exists(dir + "/particles_decomposition_r0.vtu"));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/particles.pvd"));
+}
+
 } // namespace
