@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <span>
 #include <vector>
 
@@ -114,8 +115,9 @@ int main(int argc, char** argv) {
   can->add_option("--elements-per-rank", cc.elements_per_rank, "one-rank model size")
       ->capture_default_str()
       ->check(CLI::Range(200, 10000000));
+  // Bounded here: the deck's own limit, which would name a line of a generated deck.
   can->add_option("--cycles", cc.cycles, "stop after this many cycles (default: run to 3.2 ms)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0LL, 9000000000000000LL));
   can->add_option("-o,--output", bench_out, "output directory")->capture_default_str();
   std::string wall = "thick_shell";
   can->add_option("--wall", wall,
@@ -144,9 +146,14 @@ int main(int argc, char** argv) {
     if (root) app.exit(e);
     return 0;
   } catch (const CLI::ParseError& e) {
-    if (root) {
+    // `anvil frob` or `anvil --versoin`: CLI11 would only say that a subcommand is
+    // required; name the word it did not know.
+    const auto extra = app.remaining();
+    if (root && app.get_subcommands().empty() && !extra.empty())
+      std::fprintf(stderr, "anvil: error: unknown subcommand or option '%s' (see anvil --help)\n",
+                   extra.front().c_str());
+    else if (root)
       app.exit(e);
-    }
     return anvil::exit_bad_input;
   }
 
@@ -182,6 +189,10 @@ int main(int argc, char** argv) {
   } catch (const anvil::PhysicsError& e) {
     if (root) std::fprintf(stderr, "anvil: run failed: %s\n", e.what());
     return anvil::exit_physics;
+  } catch (const std::bad_alloc&) {
+    // One rank may run out alone: the others cannot be told, hence the abort.
+    std::fprintf(stderr, "anvil: error: the model does not fit in memory (rank %d)\n", comm.rank());
+    comm.abort(anvil::exit_bad_input);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "anvil: internal error on rank %d: %s\n", comm.rank(), e.what());
     comm.abort(1);

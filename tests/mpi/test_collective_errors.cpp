@@ -10,6 +10,7 @@
 
 #include "anvil/core/error.hpp"
 #include "anvil/io/checkpoint.hpp"
+#include "anvil/io/decompose.hpp"
 #include "anvil/parallel/comm.hpp"
 #include "anvil/solver/simulation.hpp"
 #include "test_support.hpp"
@@ -136,6 +137,27 @@ TEST(CollectiveErrors, CheckpointOfAnotherMeshIsRefused) {
   const Checkpoint c = two_cycles(world);
   // The same numbers of nodes and elements, another mesh.
   expect_refused(world, restart_deck(3, "[16, 4, 4]"), c, "was written for another mesh");
+}
+
+// QA D3: `anvil decompose -o DIR` where DIR cannot be created: rank 0 failed alone and
+// the other ranks waited in a barrier for ever. Every rank now throws rank 0's error.
+TEST(CollectiveErrors, DecomposeIntoAnImpossibleDirectoryStopsAllRanks) {
+  const Config c = test::deck(R"(
+termination: {cycles: 1}
+materials:
+  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+parts:
+  box:
+    mesh: {generate: box, min: [0, 0, 0], max: [1, 1, 1], divisions: [2, 2, 4]}
+    material: steel
+)");
+  try {
+    write_decomposition(c, "/proc/anvil_no_such_directory", Comm::world());
+    FAIL() << "no error for an output directory that cannot be created";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot create output directory"), std::string::npos)
+        << e.what();
+  }
 }
 
 } // namespace

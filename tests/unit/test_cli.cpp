@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "anvil/io/outputs.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -19,8 +20,9 @@ struct Result {
   std::string out; // stdout and stderr together
 };
 
-Result run(const std::string& args) {
-  const std::string cmd = std::string(anvil::test::anvil_binary()) + " " + args + " 2>&1";
+// Runs a shell command line.
+Result run_command(const std::string& command) {
+  const std::string cmd = command + " 2>&1";
   Result r;
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
@@ -29,6 +31,10 @@ Result run(const std::string& args) {
   const int st = pclose(p);
   r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
   return r;
+}
+
+Result run(const std::string& args) {
+  return run_command(std::string(anvil::test::anvil_binary()) + " " + args);
 }
 
 std::string write_temp(const std::string& name, const std::string& text) {
@@ -200,6 +206,130 @@ boundary_conditions:
   EXPECT_EQ(r.status, 3) << r.out;
   EXPECT_NE(r.out.find("time step collapsed"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("part block"), std::string::npos) << r.out;
+}
+
+// QA D11: an unknown subcommand or option was reported as "A subcommand is required";
+// --cycles -1 printed the 309 digits of the largest double, and a huge --cycles a line of a
+// deck the user never wrote.
+TEST(Cli, UnknownWordsAndBadCyclesAreNamed) {
+  auto r = run("frobnicate");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("unknown subcommand or option 'frobnicate'"), std::string::npos) << r.out;
+  r = run("--versoin");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("'--versoin'"), std::string::npos) << r.out;
+  for (const char* cycles : {"-1", "99999999999999999999"}) {
+    r = run(std::string("bench can-crush --cycles ") + cycles);
+    EXPECT_EQ(r.status, 2) << r.out;
+    EXPECT_NE(r.out.find("--cycles"), std::string::npos) << r.out;
+    EXPECT_LT(r.out.size(), 300u) << r.out;
+    EXPECT_EQ(r.out.find("termination.cycles"), std::string::npos) << r.out;
+  }
+}
+
+// QA D2: the next output time advances in bounded work: an interval that cannot move the
+// time in floating point gave an endless loop, a merely tiny one ~1e14 iterations.
+TEST(Outputs, NextOutputTime) {
+  // Ordinary intervals: exactly the repeated addition the series always used.
+  double next = 0.1, added = 0.1;
+  for (double t : {0.05, 0.1, 0.35, 0.36, 1.0}) {
+    next = anvil::next_output_time(next, 0.1, t);
+    while (added <= t * (1 + 1e-12)) added += 0.1;
+    EXPECT_EQ(next, added) << t;
+  }
+  // Tiny and subnormal intervals: past t, at once.
+  for (double every : {1e-300, 1e-20, 4e-320}) {
+    const double n = anvil::next_output_time(every, every, 1e-6);
+    EXPECT_GT(n, 1e-6 * (1 + 1e-12)) << every;
+    EXPECT_LT(n, 1.1e-6) << every;
+  }
+  // A large jump lands on the interval grid.
+  EXPECT_DOUBLE_EQ(anvil::next_output_time(1e-3, 1e-3, 1.0005), 1.001);
+}
+
+TEST(Cli, TinyOutputIntervalsDoNotHang) {
+  std::string deck = small_deck;
+  deck.replace(deck.find("termination: {time: 2.0e-6}"), 27, "termination: {cycles: 3}");
+  deck.replace(deck.find("output: {fields_every: 1.0e-6}"), 30,
+               "output: {fields_every: 1.0e-300, history_every: 1.0e-300}\n"
+               "checkpoint: {every: 1.0e-300}");
+  const auto dir = (std::filesystem::temp_directory_path() / "anvil_cli_tiny").string();
+  std::filesystem::remove_all(dir);
+  // SIGKILL: the run's SIGTERM handler is only looked at between cycles.
+  const auto r = run_command("timeout -s KILL 60 " + std::string(anvil::test::anvil_binary()) +
+                             " run " + write_temp("tiny.yaml", deck) + " -o " + dir + " -q");
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::ifstream h(dir + "/history.csv");
+  int rows = 0;
+  for (std::string line; std::getline(h, line);) ++rows;
+  EXPECT_EQ(rows, 4); // header, t = 0 and one per later cycle (the last row is cycle 2's)
+  std::stringstream pvd;
+  pvd << std::ifstream(dir + "/results.pvd").rdbuf();
+  EXPECT_NE(pvd.str().find("step_000003.pvtu"), std::string::npos) << pvd.str(); // every cycle
+  EXPECT_TRUE(std::filesystem::exists(dir + "/checkpoint.anvil"));
+}
+
+// QA D4: a deck whose file name is not UTF-8 (Latin-1) ran to the end and then crashed
+// writing summary.json; the name is written with U+FFFD in place of the bad byte.
+TEST(Cli, NonUtf8DeckNameStillWritesTheSummary) {
+  std::string deck = small_deck;
+  deck.replace(deck.find("termination: {time: 2.0e-6}"), 27, "termination: {cycles: 2}");
+  const auto dir = (std::filesystem::temp_directory_path() / "anvil_cli_latin1").string();
+  std::filesystem::remove_all(dir);
+  const auto r = run("run " + write_temp("caf\xe9.yaml", deck) + " -o " + dir + " -q");
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::stringstream summary;
+  summary << std::ifstream(dir + "/summary.json").rdbuf();
+  EXPECT_NE(summary.str().find("caf\xef\xbf\xbd.yaml"), std::string::npos) << summary.str();
+}
+
+// QA D7: a particle lattice that passes the deck's count check but does not fit in memory
+// ended in "internal error" (exit 1); it is bad input naming the particle set.
+TEST(Cli, ParticleLatticeTooLargeForMemory) {
+  const auto deck = write_temp("huge_lattice.yaml", R"(
+termination: {cycles: 5}
+materials:
+  water: {model: elastic, density: 1000, youngs_modulus: 1.0e3, poissons_ratio: 0.49}
+particles:
+  slug:
+    generate: {shape: box, min: [0, 0, 0], max: [0.004, 0.004, 0.004], spacing: 3.5e-6}
+    material: water
+)");
+  const auto r = run_command("ulimit -v 3000000; timeout -s KILL 120 " +
+                             std::string(anvil::test::anvil_binary()) + " check " + deck);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("particles.slug: the particle lattice does not fit in memory"),
+            std::string::npos)
+      << r.out;
+}
+
+// QA D6: `anvil decompose` left the SPH decomposition out: no particle counts or RCB
+// statistics in decomposition.json, no particle pieces (a particles-only deck gave an
+// empty FE decomposition).
+TEST(Cli, DecomposeWritesTheParticleDecomposition) {
+  const auto deck = write_temp("particles.yaml", R"(
+termination: {cycles: 5}
+materials:
+  water: {model: elastic, density: 1000, youngs_modulus: 1.0e3, poissons_ratio: 0.49}
+particles:
+  slug:
+    generate: {shape: box, min: [0, 0, 0], max: [0.004, 0.004, 0.004], spacing: 0.5e-3}
+    material: water
+)");
+  const auto dir = (std::filesystem::temp_directory_path() / "anvil_cli_decompose").string();
+  std::filesystem::remove_all(dir);
+  const auto r = run("decompose " + deck + " -o " + dir);
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::stringstream json;
+  json << std::ifstream(dir + "/decomposition.json").rdbuf();
+  for (const char* key : {"\"particles\": 512", "\"sph\"", "\"cuts\"", "\"boxes\""})
+    EXPECT_NE(json.str().find(key), std::string::npos) << key << "\n" << json.str();
+  EXPECT_EQ(json.str().find("\"fe\""), std::string::npos) << json.str(); // no elements
+  std::stringstream pvtu;
+  pvtu << std::ifstream(dir + "/particles_decomposition.pvtu").rdbuf();
+  EXPECT_NE(pvtu.str().find("sph_rank"), std::string::npos) << pvtu.str();
+  EXPECT_TRUE(std::filesystem::exists(dir + "/particles_decomposition_r0.vtu"));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/particles.pvd"));
 }
 
 } // namespace

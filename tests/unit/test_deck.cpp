@@ -4,6 +4,10 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
 #include "anvil/io/deck.hpp"
 #include "test_support.hpp"
 
@@ -219,6 +223,113 @@ TEST(Deck, HugeGeneratedMeshesAreRejected) {
           << e.what();
     }
   }
+}
+
+} // namespace
+
+namespace {
+
+using namespace anvil;
+
+// QA D1: a '---' or '...' line ended the deck there, the rest (initial and boundary
+// conditions, unknown keys, even malformed YAML) dropped without a word.
+TEST(Deck, SecondYamlDocumentIsAnError) {
+  const std::string last = "output: {fields_every: 1.0e-5, history_every: 1.0e-7}";
+  expect_error(last, last + "\n---\nrigid_walls: [{point: [0, 0, 0], normal: [0, 0, 1]}]",
+               {"deck.yaml:22", "second one", "'---'"});
+  expect_error(last, last + "\n---\n", {"deck.yaml:22", "second one"});
+  expect_error(last, last + "\n...\ngarbage: [unclosed", {"deck.yaml:2", "YAML"});
+  // A marker at the start, and one at the end with nothing after it: one document.
+  const Config c = test::deck("---\n" + std::string(good) + "...\n# the end\n");
+  EXPECT_EQ(c.boundary_conditions.size(), 2u);
+}
+
+// QA D4: a title or name that is not UTF-8 went through `check` and crashed the JSON of a
+// completed run; it is an error at the deck, naming file, line and key.
+TEST(Deck, TextMustBeUtf8) {
+  expect_error("title: bar", "title: caf\xe9", {"deck.yaml:1", "title", "UTF-8"});
+  expect_error("title: bar", "title: over\xc0\xaflong", {"deck.yaml:1", "title", "UTF-8"});
+  expect_error("title: bar", "title: \xed\xa0\x80surrogate", {"deck.yaml:1", "title", "UTF-8"});
+  expect_error("copper: {model", "copp\xe9r: {model", {"deck.yaml:5", "materials", "UTF-8"});
+  expect_error("  bar:\n", "  b\xe4r:\n", {"deck.yaml:8", "parts", "UTF-8"});
+  std::string text = good;
+  text.replace(text.find("title: bar"), 10, "title: caf\xc3\xa9 \xe2\x9c\x93 \xf0\x9f\x94\xa8");
+  EXPECT_EQ(test::deck(text).title, "caf\xc3\xa9 \xe2\x9c\x93 \xf0\x9f\x94\xa8");
+}
+
+// QA D5: a probe's name heads history.csv columns; a comma shifted every column after it.
+TEST(Deck, ProbeNamesArePlain) {
+  for (const char* bad : {"'a,b'", "''", "'tip top'", "'\"q\"'"})
+    expect_error("{name: tip,", fmt::format("{{name: {},", bad),
+                 {"deck.yaml:20", "probes[0].name", "plain name"});
+  std::string text = good;
+  text.replace(text.find("{name: tip,"), 11, "{name: Tip_1.z-2,");
+  EXPECT_EQ(test::deck(text).probes[0].name, "Tip_1.z-2");
+}
+
+// QA D8: `fix: []` and `components: []` constrained nothing, silently.
+TEST(Deck, EmptyComponentListsAreErrors) {
+  expect_error("fix: [z]", "fix: []",
+               {"deck.yaml:17", "boundary_conditions[0].fix", "at least one"});
+  expect_error("components: [z]", "components: []",
+               {"deck.yaml:18", "boundary_conditions[1].components", "at least one"});
+}
+
+// QA D9: a deck set named like a generated one (bar.top) replaced it without a word.
+TEST(Deck, NodeSetNamesHaveNoDots) {
+  expect_error("  impact_face: {part", "  bar.top: {part",
+               {"deck.yaml:13", "node_sets.bar.top", "may not contain '.'"});
+}
+
+// QA D10: the key of an initial condition's undefined part read `.part.part`.
+TEST(Deck, InitialConditionPartKey) {
+  expect_error("- {part: bar, velocity", "- {part: nope, velocity",
+               {"deck.yaml:15: initial_conditions[0].part: part 'nope'"});
+}
+
+// QA D12: a subnormal value is a number (it was "not finite"), a tiny wall normal is not
+// zero, and nesting beyond yaml-cpp's limit says so (it was "bad file").
+TEST(Deck, ExtremeButValidValues) {
+  std::string text = good;
+  text.replace(text.find("density: 8930"), 13, "density: 4e-320");
+  EXPECT_EQ(test::deck(text).materials[0].params.at("density"), 4e-320);
+  expect_error("density: 8930", "density: 1e400", {"deck.yaml:5", "density", "finite"});
+  const std::string last = "output: {fields_every: 1.0e-5, history_every: 1.0e-7}";
+  text = std::string(good) + "rigid_walls:\n  - {point: [0, 0, 0], normal: [1e-200, 0, 1e-200]}\n";
+  const Config c = test::deck(text);
+  EXPECT_NEAR(c.rigid_walls[0].normal.x, std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(c.rigid_walls[0].normal.z, std::sqrt(0.5), 1e-15);
+  expect_error(last, last + "\nrigid_walls:\n  - {point: [0, 0, 0], normal: [0, 0, 0]}",
+               {"deck.yaml:23", "rigid_walls[0].normal", "zero"});
+  expect_error("title: bar", "title: " + std::string(3000, '[') + std::string(3000, ']'),
+               {"deck.yaml", "nested too deep"});
+  expect_error("parts:\n", "  brass: {<<: {model: elastic}, density: 1}\nparts:\n",
+               {"materials.brass.model", "merge keys"});
+}
+
+// QA D7 and D12: the deck file must be a regular file of sane size (/dev/zero was read
+// until memory ran out; a directory was "empty").
+TEST(Deck, DeckFileMustBeARegularFile) {
+  const auto dir = std::filesystem::temp_directory_path() / "anvil_deck_file_test";
+  std::filesystem::create_directories(dir);
+  auto message = [](const std::string& path) {
+    try {
+      read_deck(path);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(dir.string()).find("is a directory"), std::string::npos)
+      << message(dir.string());
+  EXPECT_NE(message("/dev/zero").find("not a regular file"), std::string::npos)
+      << message("/dev/zero");
+  EXPECT_NE(message((dir / "none.yaml").string()).find("cannot open"), std::string::npos);
+  const auto big = dir / "big.yaml";
+  { std::ofstream(big) << "title: x\n"; }
+  std::filesystem::resize_file(big, (std::uintmax_t{64} << 20) + 1); // sparse: no disk used
+  EXPECT_NE(message(big.string()).find("at most"), std::string::npos) << message(big.string());
+  std::filesystem::remove_all(dir);
 }
 
 } // namespace

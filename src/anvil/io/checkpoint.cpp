@@ -213,7 +213,7 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
                            c.outputs.next_history};
   std::string s(payload_start, '\0');
   std::memcpy(s.data(), magic, sizeof magic);
-  const std::string header = h.dump();
+  const std::string header = json_text(h);
   put(s, std::vector<char>(header.begin(), header.end()));
   put(s, std::vector<double>(exact, exact + 8));
   put(s, std::vector<double>{c.outputs.next_checkpoint});

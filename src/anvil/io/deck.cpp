@@ -1,16 +1,19 @@
 #include "anvil/io/deck.hpp"
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <span>
 #include <sstream>
 
 #include <fmt/format.h>
+
+#include "anvil/io/files.hpp"
 
 namespace anvil {
 
@@ -27,6 +30,38 @@ int Config::particle_set(const std::string& name) const {
 }
 
 namespace {
+
+// Whether `s` is well-formed UTF-8 (no overlong forms, surrogates or code points past
+// U+10FFFF): deck text is copied into JSON files, which must be UTF-8.
+bool is_utf8(std::string_view s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    int len = 0;
+    unsigned cp = 0, min = 0;
+    if (c < 0x80) {
+      ++i;
+      continue;
+    } else if ((c & 0xE0) == 0xC0) {
+      len = 2, cp = c & 0x1Fu, min = 0x80;
+    } else if ((c & 0xF0) == 0xE0) {
+      len = 3, cp = c & 0x0Fu, min = 0x800;
+    } else if ((c & 0xF8) == 0xF0) {
+      len = 4, cp = c & 0x07u, min = 0x10000;
+    } else {
+      return false;
+    }
+    if (i + static_cast<std::size_t>(len) > s.size()) return false;
+    for (int k = 1; k < len; ++k) {
+      const auto b = static_cast<unsigned char>(s[i + static_cast<std::size_t>(k)]);
+      if ((b & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (b & 0x3Fu);
+    }
+    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return false;
+    i += static_cast<std::size_t>(len);
+  }
+  return true;
+}
 
 // A YAML node together with the file and key path it was found at, so that every check
 // can say where the problem is.
@@ -61,6 +96,7 @@ public:
       if (!it->first.IsScalar())
         throw InputError({*file_, kline, path_}, "keys must be plain names");
       const std::string key = it->first.Scalar();
+      if (!is_utf8(key)) throw InputError({*file_, kline, path_}, "a key is not valid UTF-8 text");
       const std::string sub = path_.empty() ? key : path_ + "." + key;
       if (allowed.size() > 0 &&
           std::find(allowed.begin(), allowed.end(), std::string_view(key)) == allowed.end()) {
@@ -86,7 +122,9 @@ public:
     if (!has(key))
       throw InputError({*file_, fallback_line_ > 0 ? fallback_line_ : line(),
                         path_.empty() ? key : path_ + "." + key},
-                       "required key is missing");
+                       has("<<") ? "required key is missing (YAML merge keys '<<' are not "
+                                   "supported: write the keys out)"
+                                 : "required key is missing");
     return child(key);
   }
   std::vector<Node> items() const {
@@ -99,19 +137,17 @@ public:
 
   std::string str() const {
     if (!n_.IsScalar()) fail("expected a single value");
+    if (!is_utf8(n_.Scalar())) fail("not valid UTF-8 text (save the deck as UTF-8)");
     return n_.Scalar();
   }
   double number() const {
     if (!n_.IsScalar()) fail("expected a number");
     const std::string& s = n_.Scalar();
-    double v = 0;
-    std::size_t used = 0;
-    try {
-      v = std::stod(s, &used);
-    } catch (...) {
-      used = 0;
-    }
-    if (used == 0 || used != s.size() || !std::isfinite(v))
+    // strtod, not stod (which throws on ERANGE): a value below the smallest normal double,
+    // 4e-320 say, underflows to a subnormal or to zero, and is a number all the same.
+    char* end = nullptr;
+    const double v = std::strtod(s.c_str(), &end);
+    if (s.empty() || end != s.c_str() + s.size() || !std::isfinite(v))
       fail(fmt::format("expected a finite number, got '{}'", s));
     return v;
   }
@@ -155,7 +191,9 @@ public:
   std::array<bool, 3> components() const {
     std::array<bool, 3> out{false, false, false};
     if (n_.IsScalar() && n_.Scalar() == "all") return {true, true, true};
-    for (const auto& c : items()) out[c.axis()] = true;
+    const auto list = items();
+    if (list.empty()) fail("give at least one of x, y, z, or all");
+    for (const auto& c : list) out[c.axis()] = true;
     return out;
   }
 
@@ -543,6 +581,17 @@ Selection parse_set_ref(const Node& n) {
   return s;
 }
 
+// The 1-based line of the last document marker ('---' or '...') at or before the 0-based
+// line `upto` (where yaml-cpp puts the next document), or `upto` + 1 if there is none.
+int separator_line(const std::string& text, int upto) {
+  std::istringstream in(text);
+  std::string l;
+  int found = upto + 1;
+  for (int i = 0; i <= upto && std::getline(in, l); ++i)
+    if (l.rfind("---", 0) == 0 || l.rfind("...", 0) == 0) found = i + 1;
+  return found;
+}
+
 } // namespace
 
 Config parse_deck(const std::string& text, const std::string& name, const std::string& base_dir) {
@@ -550,7 +599,17 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
   c.deck_file = name;
   YAML::Node root;
   try {
-    root = YAML::Load(text);
+    const std::vector<YAML::Node> docs = YAML::LoadAll(text);
+    // A second document would be dropped without a word: everything after a '---' or
+    // '...' line. It is reported at that line.
+    if (docs.size() > 1)
+      throw InputError({name, separator_line(text, docs[1].Mark().line), ""},
+                       "a deck holds one YAML document; a second one starts here (remove the "
+                       "'---' or '...' line)");
+    if (!docs.empty()) root = docs[0];
+  } catch (const YAML::DeepRecursion& e) {
+    throw InputError({name, e.mark.line >= 0 ? e.mark.line + 1 : 0, ""},
+                     "malformed YAML: nested too deep");
   } catch (const YAML::Exception& e) {
     throw InputError({name, e.mark.line >= 0 ? e.mark.line + 1 : 0, ""},
                      "malformed YAML: " + e.msg);
@@ -709,6 +768,9 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 
   if (top.has("node_sets")) {
     for (const auto& [sname, sn] : top.child("node_sets").entries()) {
+      // PART.SET names the sets of a part's mesh: a deck set so named would hide one.
+      if (sname.find('.') != std::string::npos)
+        sn.fail("node set names may not contain '.' (PART.SET names a set of a part's mesh)");
       Selection s = parse_inline_selection(sn);
       s.name.clear();
       check_part(s);
@@ -724,7 +786,8 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
       if (n.has("part") == n.has("set")) n.fail("give exactly one of 'part' or 'set'");
       if (n.has("part")) {
         ic.nodes.part = n.child("part").str();
-        ic.nodes.where = n.child("part").where();
+        // The item's key: check_part and the model name the `part` key under it.
+        ic.nodes.where = {c.deck_file, n.child("part").line(), n.path()};
       } else {
         ic.nodes = parse_set_ref(n.child("set"));
       }
@@ -770,6 +833,14 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
     for (const auto& n : top.child("probes").items()) {
       n.check_keys({"name", "at"});
       ProbeConfig p{n.required("name").str(), n.required("at").vec3(), n.where()};
+      // The name heads history.csv columns (NAME.ux): no commas, quotes or blanks.
+      const auto plain = [](char ch) {
+        return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
+               ch == '_' || ch == '.' || ch == '-';
+      };
+      if (p.name.empty() || !std::all_of(p.name.begin(), p.name.end(), plain))
+        n.child("name").fail(fmt::format(
+            "probe name '{}' must be a plain name: letters, digits, '_', '.' and '-'", p.name));
       if (!names.insert(p.name).second)
         n.child("name").fail(fmt::format("probe name '{}' is used twice", p.name));
       c.probes.push_back(p);
@@ -825,10 +896,12 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
       RigidWallConfig w;
       w.where = n.where();
       w.point = n.required("point").vec3();
-      const Vec3 nrm = n.required("normal").vec3();
-      const double len = norm(nrm);
-      if (!(len > 0)) n.child("normal").fail("the normal must not be zero");
-      w.normal = nrm * (1 / len);
+      Vec3 nrm = n.required("normal").vec3();
+      // Scaled by its largest component first: the norm of [1e-200, 0, 1e-200] underflows.
+      const double big = std::max({std::abs(nrm.x), std::abs(nrm.y), std::abs(nrm.z)});
+      if (!(big > 0)) n.child("normal").fail("the normal must not be zero");
+      nrm = {nrm.x / big, nrm.y / big, nrm.z / big};
+      w.normal = nrm * (1 / norm(nrm));
       if (n.has("friction")) {
         w.friction = n.child("friction").number();
         if (w.friction < 0) n.child("friction").fail("must not be negative");
@@ -865,12 +938,11 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 }
 
 Config read_deck(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError({path, 0, ""}, "cannot open the deck file");
-  std::stringstream ss;
-  ss << in.rdbuf();
+  // A YAML deck holds no mesh: anything near this size is not a deck (/dev/zero, a log).
+  constexpr std::uintmax_t max_deck_bytes = std::uintmax_t{64} << 20;
+  const std::string text = read_input_file(path, max_deck_bytes);
   const auto dir = std::filesystem::path(path).parent_path();
-  return parse_deck(ss.str(), path, dir.empty() ? "." : dir.string());
+  return parse_deck(text, path, dir.empty() ? "." : dir.string());
 }
 
 } // namespace anvil

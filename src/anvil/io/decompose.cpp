@@ -28,59 +28,79 @@ nlohmann::json per_rank(const Comm& comm, double local) {
   return {{"per_rank", all}, {"total", sum}, {"imbalance", mean > 0 ? mx / mean : 1.0}};
 }
 
+// A series of one step, at t = 0: a .vtu piece per rank, the .pvtu joining them and a
+// .pvd naming it, as a run writes results.pvd and particles.pvd. Collective.
+void write_series(const Comm& comm, const std::string& outdir, const std::string& stem,
+                  const std::string& pvd, const VtuPiece& piece) {
+  collective_write(comm, [&] {
+    write_vtu(outdir + "/" + stem + "_r" + std::to_string(comm.rank()) + ".vtu", piece);
+  });
+  collective_write(comm, [&] {
+    if (comm.rank() != 0) return;
+    std::vector<std::string> pieces;
+    for (int r = 0; r < comm.size(); ++r)
+      pieces.push_back(stem + "_r" + std::to_string(r) + ".vtu");
+    write_pvtu(outdir + "/" + stem + ".pvtu", pieces, piece);
+    write_pvd(outdir + "/" + pvd, {{0.0, stem + ".pvtu"}});
+  });
+}
+
 } // namespace
 
 void write_decomposition(const Config& config, const std::string& outdir, const Comm& comm) {
   Simulation sim(config, comm);
   sim.decompose_now();
-  if (comm.rank() == 0) {
-    make_directories(outdir);
-  }
-  comm.barrier();
+  // Rank 0 creates the directory; a failure stops every rank (none waits for the others).
+  collective_write(comm, [&] {
+    if (comm.rank() == 0) make_directories(outdir);
+  });
 
-  VtuPiece piece = fe_piece(sim);
-  const std::string stem = "decomposition";
-  write_vtu(outdir + "/" + stem + "_r" + std::to_string(comm.rank()) + ".vtu", piece);
-  comm.barrier();
+  // The elements (a deck of particles only has none) and the particles, each with the
+  // rank of its decomposition.
+  const bool elements = sim.global_elements() > 0;
+  if (elements) write_series(comm, outdir, "decomposition", "results.pvd", fe_piece(sim));
+  if (sim.sph())
+    write_series(comm, outdir, "particles_decomposition", "particles.pvd", particle_piece(sim));
 
   nlohmann::json j;
   j["ranks"] = comm.size();
   j["elements"] = sim.global_elements();
   j["nodes"] = sim.global_nodes();
-  nlohmann::json fe;
-  fe["elements"] = per_rank(comm, static_cast<double>(sim.fe().num_elements()));
-  // The work the partition balances: each element weighted by its formulation's cost.
-  double cost = 0;
-  for (std::size_t b = 0; b < sim.fe().blocks.size(); ++b)
-    cost += static_cast<double>(sim.fe().blocks[b].gid.size()) *
-            element_cost(config.parts[b].hourglass, config.parts[b].thick_shell);
-  fe["cost"] = per_rank(comm, cost);
-  fe["owned_nodes"] = per_rank(comm, static_cast<double>(sim.fe().num_owned_nodes()));
-  fe["held_nodes"] = per_rank(comm, static_cast<double>(sim.fe().node_gid.size()));
-  double shared = 0;
-  for (const auto& nb : sim.fe().neighbors) shared += static_cast<double>(nb.shared.size());
-  fe["shared_node_copies"] = per_rank(comm, shared);
-  fe["neighbours"] = per_rank(comm, static_cast<double>(sim.fe().neighbors.size()));
-  {
+  j["particles"] = sim.sph() ? sim.sph()->global_count() : 0;
+  if (elements) {
+    nlohmann::json fe;
+    fe["elements"] = per_rank(comm, static_cast<double>(sim.fe().num_elements()));
+    // The work the partition balances: each element weighted by its formulation's cost.
+    double cost = 0;
+    for (std::size_t b = 0; b < sim.fe().blocks.size(); ++b)
+      cost += static_cast<double>(sim.fe().blocks[b].gid.size()) *
+              element_cost(config.parts[b].hourglass, config.parts[b].thick_shell);
+    fe["cost"] = per_rank(comm, cost);
+    fe["owned_nodes"] = per_rank(comm, static_cast<double>(sim.fe().num_owned_nodes()));
+    fe["held_nodes"] = per_rank(comm, static_cast<double>(sim.fe().node_gid.size()));
+    double shared = 0;
+    for (const auto& nb : sim.fe().neighbors) shared += static_cast<double>(nb.shared.size());
+    fe["shared_node_copies"] = per_rank(comm, shared);
+    fe["neighbours"] = per_rank(comm, static_cast<double>(sim.fe().neighbors.size()));
     const Mesh mesh = build_mesh(config);
     const std::vector<int> owner = partition_model(mesh, config, comm); // collective
     if (comm.rank() == 0) fe["edge_cut"] = partition_cut(mesh, owner);
+    j["fe"] = fe;
   }
-  j["fe"] = fe;
   if (const ContactPhase* cp = sim.contact()) {
     nlohmann::json c = rcb_statistics(cp->rcb());
     c["nodes_held"] = per_rank(comm, static_cast<double>(cp->nodes_held()));
     c["faces_held"] = per_rank(comm, static_cast<double>(cp->faces_held()));
     j["contact"] = c;
   }
-  if (comm.rank() == 0) {
-    std::vector<std::string> pieces;
-    for (int r = 0; r < comm.size(); ++r)
-      pieces.push_back(stem + "_r" + std::to_string(r) + ".vtu");
-    write_pvtu(outdir + "/" + stem + ".pvtu", pieces, piece);
-    write_pvd(outdir + "/results.pvd", {{0.0, stem + ".pvtu"}});
-    write_file_atomic(outdir + "/decomposition.json", j.dump(2) + "\n");
+  if (const auto* sph = sim.sph()) {
+    nlohmann::json p = rcb_statistics(sph->rcb());
+    p["particles"] = per_rank(comm, static_cast<double>(sph->particles().size()));
+    j["sph"] = p;
   }
+  collective_write(comm, [&] {
+    if (comm.rank() == 0) write_file_atomic(outdir + "/decomposition.json", json_text(j, 2) + "\n");
+  });
 }
 
 } // namespace anvil

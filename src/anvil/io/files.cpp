@@ -5,7 +5,12 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <system_error>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "anvil/core/error.hpp"
 
@@ -28,6 +33,33 @@ void write_file_atomic(const std::string& path, std::string_view content) {
   ::close(fd);
   if (std::rename(tmp.c_str(), path.c_str()) != 0)
     throw InputError("cannot rename '" + tmp + "' to '" + path + "'");
+}
+
+std::string json_text(const nlohmann::json& j, int indent) {
+  return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const auto st = fs::status(path, ec);
+  if (!fs::exists(st))
+    throw InputError({path, 0, ""},
+                     "cannot open the deck file" + (ec ? ": " + ec.message() : std::string()));
+  if (fs::is_directory(st)) throw InputError({path, 0, ""}, "is a directory, not a deck file");
+  if (!fs::is_regular_file(st))
+    throw InputError({path, 0, ""}, "is not a regular file (a device or a pipe?)");
+  const auto size = fs::file_size(path, ec);
+  if (!ec && size > max_bytes)
+    throw InputError(
+        {path, 0, ""},
+        fmt::format("the file holds {} bytes; a deck may hold at most {}", size, max_bytes));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError({path, 0, ""}, "cannot open the deck file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw InputError({path, 0, ""}, "cannot read the deck file");
+  return ss.str();
 }
 
 void make_directories(const std::string& path) {

@@ -23,6 +23,8 @@
 
 #include <fmt/format.h>
 
+#include "anvil/io/files.hpp"
+
 namespace anvil {
 
 namespace fs = std::filesystem;
@@ -1795,15 +1797,9 @@ auto guarded(const std::string& name, F&& f) {
   }
 }
 
+// No size limit: a keyword deck may hold its mesh.
 std::string slurp(const std::string& path) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    throw InputError({path, 0, ""}, fs::exists(path, ec) ? "not a file" : "cannot open the deck");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError({path, 0, ""}, "cannot open the deck");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  return read_input_file(path, std::numeric_limits<std::uintmax_t>::max());
 }
 
 std::string dir_of(const std::string& path) {

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -135,41 +136,26 @@ VtuPiece particle_piece(const Simulation& sim) {
   return p;
 }
 
-// Runs `write` on every rank; if it fails on any, every rank throws the InputError of the
-// lowest failing rank (a write error on one rank must not leave the others waiting).
-template <class F>
-void collective_write(const Comm& comm, F&& write) {
-  std::string err;
-  try {
-    write();
-  } catch (const InputError& e) {
-    err = e.what();
-  }
-  const std::int64_t failed = comm.min(err.empty() ? static_cast<std::int64_t>(comm.size())
-                                                   : static_cast<std::int64_t>(comm.rank()));
-  if (failed == comm.size()) return;
-  comm.broadcast(err, static_cast<int>(failed));
-  throw InputError(err);
+double next_output_time(double next, double every, double t) {
+  const double bound = t * (1 + 1e-12);
+  // A few intervals by repeated addition, as the series always advanced: an ordinary
+  // deck's output times keep their bits. Past that, a jump.
+  for (int i = 0; i < 16 && next <= bound; ++i) next += every;
+  if (next > bound) return next;
+  const double jump = (std::floor(bound / every) + 1) * every; // inf if every is subnormal
+  if (std::isfinite(jump) && jump > next) next = jump;
+  return next > bound ? next : std::nextafter(bound, std::numeric_limits<double>::infinity());
 }
 
 Outputs::Outputs(const Simulation& sim, OutputOptions options)
     : sim_(sim), opt_(std::move(options)) {
   // Rank 0 creates the directories; the others wait for it.
-  std::int64_t ok = 1;
-  std::string err;
-  if (sim_.comm().rank() == 0) {
-    try {
-      make_directories(opt_.directory);
-      if (sim_.config().output_format != OutputFormat::exodus || sim_.sph())
-        make_directories(opt_.directory + "/fields");
-    } catch (const InputError& e) {
-      ok = 0;
-      err = e.what();
-    }
-  }
-  ok = sim_.comm().min(ok);
-  sim_.comm().broadcast(err, 0);
-  if (!ok) throw InputError(err);
+  collective_write(sim_.comm(), [&] {
+    if (sim_.comm().rank() != 0) return;
+    make_directories(opt_.directory);
+    if (sim_.config().output_format != OutputFormat::exodus || sim_.sph())
+      make_directories(opt_.directory + "/fields");
+  });
   // Under mpirun, OpenMPI gives rank 0 a pseudo-terminal whatever mpirun's own output is
   // (a log file too): there, periodic lines are the safe choice.
   tty_ = sim_.comm().rank() == 0 && ::isatty(STDOUT_FILENO) &&
@@ -288,11 +274,11 @@ void Outputs::after_step() {
     have_sample_ = true;
     write_history_row(last_sample_);
     if (c.history_every > 0)
-      while (next_history_ <= t_sample * (1 + 1e-12)) next_history_ += c.history_every;
+      next_history_ = next_output_time(next_history_, c.history_every, t_sample);
   }
   if (clk.time >= next_fields_ * (1 - 1e-12) || last) {
     write_fields();
-    while (next_fields_ <= clk.time * (1 + 1e-12)) next_fields_ += c.fields_every;
+    if (c.fields_every > 0) next_fields_ = next_output_time(next_fields_, c.fields_every, clk.time);
   }
   progress(last);
 }
@@ -514,7 +500,7 @@ void Outputs::write_summary(int status, const std::string& message) {
   for (std::size_t i = 0; i < sim_.config().parts.size(); ++i)
     masses[sim_.config().parts[i].name] = sim_.part_masses()[i];
   j["part_mass"] = masses;
-  write_file_atomic(opt_.directory + "/summary.json", j.dump(2) + "\n");
+  write_file_atomic(opt_.directory + "/summary.json", json_text(j, 2) + "\n");
 }
 
 } // namespace anvil

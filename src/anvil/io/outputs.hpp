@@ -11,12 +11,37 @@
 #include <utility>
 #include <vector>
 
+#include "anvil/core/error.hpp"
 #include "anvil/io/checkpoint.hpp"
 #include "anvil/io/exodus.hpp"
 #include "anvil/io/vtu.hpp"
+#include "anvil/parallel/comm.hpp"
 #include "anvil/solver/simulation.hpp"
 
 namespace anvil {
+
+// The next due time of a series written every `every` seconds (> 0), past the time `t`
+// just written: `next` advanced by whole intervals beyond t (1 + 1e-12). Bounded work
+// whatever the interval: an interval too small to advance t in floating point
+// (every = 1e-300) gives the next double past the bound, a row or field output per cycle.
+double next_output_time(double next, double every, double t);
+
+// Runs `write` on every rank; if it fails on any, every rank throws the InputError of the
+// lowest failing rank (a write error on one rank must not leave the others waiting).
+template <class F>
+void collective_write(const Comm& comm, F&& write) {
+  std::string err;
+  try {
+    write();
+  } catch (const InputError& e) {
+    err = e.what();
+  }
+  const std::int64_t failed = comm.min(err.empty() ? static_cast<std::int64_t>(comm.size())
+                                                   : static_cast<std::int64_t>(comm.rank()));
+  if (failed == comm.size()) return;
+  comm.broadcast(err, static_cast<int>(failed));
+  throw InputError(err);
+}
 
 struct OutputOptions {
   std::string directory = "out";

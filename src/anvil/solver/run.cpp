@@ -82,8 +82,8 @@ int run(const Config& config, const RunOptions& options, const Comm& comm) {
       sim.step();
       out.after_step();
       if (sim.clock().time >= next_checkpoint * (1 - 1e-12) && !sim.finished()) {
-        while (next_checkpoint <= sim.clock().time * (1 + 1e-12))
-          next_checkpoint += config.checkpoint_every;
+        next_checkpoint =
+            next_output_time(next_checkpoint, config.checkpoint_every, sim.clock().time);
         checkpoint();
       }
       if (sim.stop_requested() && !sim.finished()) {

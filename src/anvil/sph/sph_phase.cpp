@@ -41,7 +41,13 @@ SphPhase::SphPhase(const Config& config, const std::function<const Material*(int
       throw InputError(psets[s].where, "a one-dimensional particle model takes boxes only");
     if (config.sph.dimensions == 2 && ls.shape == LatticeSpec::Shape::cylinder && ls.axis != 2)
       throw InputError(psets[s].where, "in two dimensions a cylinder's axis must be z");
-    lattices.push_back(generate_lattice(ls, config.sph.dimensions));
+    try {
+      lattices.push_back(generate_lattice(ls, config.sph.dimensions));
+    } catch (const std::bad_alloc&) {
+      throw InputError(psets[s].where, "the particle lattice does not fit in memory");
+    } catch (const std::length_error&) {
+      throw InputError(psets[s].where, "the particle lattice does not fit in memory");
+    }
     if (lattices.back().points.empty())
       throw InputError(psets[s].where, "the particle set's shape holds no lattice point: "
                                        "make the spacing smaller than the shape");
