@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Restart reproduces the uninterrupted run bit for bit, on another number of ranks:
 #  1. the can crush (contact, self-contact, prescribed block) runs uninterrupted on 1 rank;
-#  2. on 2 ranks it is stopped at cycle 700 (the path SIGTERM takes) and restarted on 3;
+#  2. on 2 ranks it is stopped at cycle 700 (the path SIGTERM takes) and restarted on 3,
+#     into another output directory (whose history and field series must continue the
+#     stopped run's: the same rows as the uninterrupted run, every series entry readable);
 #  3. on 2 ranks it is killed with a real SIGTERM while running, restarted on 4;
 # the final checkpoints of 2 and 3 must hold the same state as 1's, bit for bit.
 set -euo pipefail
@@ -21,8 +23,19 @@ run 2 "$anvil" run deck.yaml -o stopped -q --stop-at-cycle 700 2>/dev/null
 status=$?
 set -e
 [ "$status" -ne 0 ] || { echo "a stopped run must not exit 0"; exit 1; }
-run 3 "$anvil" run deck.yaml -o stopped -q --restart stopped/checkpoint.anvil
-"$compare" full/checkpoint.anvil stopped/checkpoint.anvil
+run 3 "$anvil" run deck.yaml -o elsewhere -q --restart stopped/checkpoint.anvil
+"$compare" full/checkpoint.anvil elsewhere/checkpoint.anvil
+/usr/bin/python3 - full elsewhere <<'PY'
+import csv, os, re, sys
+full, other = sys.argv[1], sys.argv[2]
+rows = lambda d: [r[:2] for r in csv.reader(open(os.path.join(d, "history.csv")))]
+assert rows(full) == rows(other), "the restarted history's (time, cycle) rows differ"
+pvd = open(os.path.join(other, "results.pvd")).read()
+files = re.findall(r'file="([^"]+)"', pvd)
+assert len(files) == len(re.findall(r'file="', open(os.path.join(full, "results.pvd")).read()))
+missing = [f for f in files if not os.path.isfile(os.path.join(other, f))]
+assert not missing, missing
+PY
 
 # A real SIGTERM, mid-run: mpirun passes it to the ranks, which checkpoint and stop.
 # mpirun itself goes to the background, not the `run` function: a function in the
@@ -52,7 +65,7 @@ fi
 grep -q '"status": "completed"' killed/summary.json
 grep -q 'step_' killed/results.pvd
 # Each phase's seconds per rank: one entry for each of the restarted run's 3 or 4 ranks.
-for d in stopped killed; do
+for d in elsewhere killed; do
   [ -f "$d/summary.json" ] || continue
   /usr/bin/python3 - "$d/summary.json" <<'PY'
 import json, sys
@@ -64,4 +77,4 @@ for phase, seconds in by_rank.items():
     assert max(seconds) == s["timers"][phase], (phase, seconds, s["timers"][phase])
 PY
 done
-echo "restart: identical state after stop/restart on 2 -> 3 and SIGTERM/restart on 2 -> 4 ranks"
+echo "restart: identical state after stop/restart on 2 -> 3 (another directory) and SIGTERM/restart on 2 -> 4 ranks"

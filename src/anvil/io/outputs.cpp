@@ -198,13 +198,27 @@ void Outputs::begin() {
   next_history_ = c.history_every;
 }
 
-void Outputs::resume(const OutputState& state) {
+void Outputs::resume(const OutputState& state, const std::string& from) {
   start_wall_ = last_progress_wall_ = wall_seconds();
   next_fields_ = state.next_fields;
   next_history_ = state.next_history;
   field_count_ = state.field_count;
   pvd_ = state.pvd;
   particle_pvd_ = state.particle_pvd;
+  // Restarted into another directory: the series' earlier entries are the checkpoint
+  // directory's files, referenced from here.
+  namespace fs = std::filesystem;
+  const fs::path from_dir = from.empty() ? fs::path(".") : fs::path(from);
+  std::error_code e1, e2, e3;
+  fs::path old_dir = fs::weakly_canonical(from_dir, e1);
+  const fs::path new_dir = fs::weakly_canonical(opt_.directory, e2);
+  if (e1) old_dir = from_dir;
+  if (!e1 && !e2 && old_dir != new_dir) {
+    const fs::path up = fs::relative(old_dir, new_dir, e3);
+    if (!e3)
+      for (auto* series : {&pvd_, &particle_pvd_})
+        for (auto& [t, file] : *series) file = (up / file).generic_string();
+  }
   last_field_cycle_ = sim_.clock().cycle; // the fields at the checkpoint were written then
   start_cycle_ = sim_.clock().cycle;
   start_fraction_ = last_progress_fraction_ = fraction_done();
@@ -220,8 +234,9 @@ void Outputs::resume(const OutputState& state) {
   // Keep the history rows before the restart time (a killed run may have written rows past
   // its last checkpoint), then append.
   const std::string path = opt_.directory + "/history.csv";
+  const std::string old_path = (old_dir / "history.csv").string();
   std::vector<std::string> keep;
-  if (std::FILE* in = std::fopen(path.c_str(), "r")) {
+  if (std::FILE* in = std::fopen(old_path.c_str(), "r")) {
     char* line = nullptr;
     std::size_t cap = 0;
     bool header = true;

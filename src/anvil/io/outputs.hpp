@@ -55,8 +55,10 @@ public:
 
   // Writes the initial fields (t = 0) and opens the history.
   void begin();
-  // Continues the series of a checkpointed run instead of begin().
-  void resume(const OutputState& state);
+  // Continues the series of a checkpointed run instead of begin(); `from` is the
+  // directory the checkpoint was written in (its history and field series; when it is
+  // not this run's, they are copied and referenced from here).
+  void resume(const OutputState& state, const std::string& from);
   // Where the series stands (for checkpoints; next_checkpoint is the run loop's).
   OutputState state() const;
   // After each step: history row and fields when due, progress line.

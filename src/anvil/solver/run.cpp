@@ -2,6 +2,7 @@
 
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 
 #include "anvil/io/checkpoint.hpp"
@@ -52,7 +53,7 @@ int run(const Config& config, const RunOptions& options, const Comm& comm) {
   if (!options.restart.empty()) {
     const Checkpoint c = read_checkpoint(options.restart); // every rank reads it
     sim.restore(c);
-    out.resume(c.outputs);
+    out.resume(c.outputs, std::filesystem::path(options.restart).parent_path().string());
     if (config.checkpoint_every > 0) next_checkpoint = c.outputs.next_checkpoint;
   } else {
     out.begin();
