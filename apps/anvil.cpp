@@ -30,6 +30,8 @@ int check(const std::string& deck, const anvil::Comm& comm) {
   const anvil::Config config = anvil::read_input(deck);
   print_warnings(config, comm);
   anvil::Simulation sim(config, comm);
+  if (comm.rank() == 0)
+    for (const auto& w : sim.warnings()) std::fprintf(stderr, "anvil: warning: %s\n", w.c_str());
   const double dt = sim.stable_time_step();
   // Particle sets: mass per set (a reduction: before rank 0 prints alone).
   std::vector<double> set_mass(config.particles.size(), 0.0);

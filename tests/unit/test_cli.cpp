@@ -114,6 +114,24 @@ TEST(Cli, CheckPrintsCountsMassAndTimeStep) {
   EXPECT_NE(r.out.find("stable dt"), std::string::npos) << r.out;
 }
 
+// Nodes that start behind a rigid wall: check (and run) warn, naming the wall's line and
+// the count; a wall the block only touches gives no warning.
+TEST(Cli, NodesBehindAWallAreWarnedOf) {
+  std::string deck = small_deck;
+  deck += "rigid_walls:\n  - {point: [0, 0, 0.001], normal: [0, 0, 1]}\n";
+  auto r = run("check " + write_temp("behind_wall.yaml", deck));
+  EXPECT_EQ(r.status, 0) << r.out;
+  // The block's nodes at z = 0 (16 of them) lie 1 mm behind the wall.
+  EXPECT_NE(r.out.find("behind_wall.yaml:18"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("16 nodes or particles start behind rigid wall 0"), std::string::npos)
+      << r.out;
+  deck = small_deck;
+  deck += "rigid_walls:\n  - {point: [0, 0, 0], normal: [0, 0, 1]}\n";
+  r = run("check " + write_temp("on_wall.yaml", deck));
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(r.out.find("behind rigid wall"), std::string::npos) << r.out;
+}
+
 TEST(Cli, RunWritesTheOutputs) {
   const auto dir = (std::filesystem::temp_directory_path() / "anvil_cli_run").string();
   std::filesystem::remove_all(dir);

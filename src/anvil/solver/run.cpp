@@ -46,6 +46,8 @@ private:
 
 int run(const Config& config, const RunOptions& options, const Comm& comm) {
   Simulation sim(config, comm);
+  if (comm.rank() == 0 && options.restart.empty())
+    for (const auto& w : sim.warnings()) std::fprintf(stderr, "anvil: warning: %s\n", w.c_str());
   Outputs out(sim, {options.output_dir, options.progress});
   const std::string checkpoint_path = options.output_dir + "/checkpoint.anvil";
   double next_checkpoint = config.checkpoint_every > 0 ? config.checkpoint_every

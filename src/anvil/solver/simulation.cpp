@@ -137,6 +137,42 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
   initial_energy_ = ke_given + comm_.sum(particle_internal_energy());
   const double ke_kept = comm_.sum(kinetic_local_);
   if (comm_.rank() == 0) external_work_ = ke_kept - ke_given; // counted once, on rank 0
+  warn_behind_walls();
+}
+
+// Nodes and particles that start behind a rigid wall: the first step puts them on it, with
+// whatever velocity that takes (a warning: a deck may mean it, a wall cutting a corner).
+void Simulation::warn_behind_walls() {
+  const auto& walls = config_.rigid_walls;
+  if (walls.empty()) return;
+  double extent = 0; // tolerance 1e-9 of the model's size
+  for (int i = 0; i < 3; ++i)
+    for (std::size_t n = 0; n < nodes_.size(); ++n)
+      extent = std::max(extent, std::abs(nodes_.x[i][n]));
+  const sph::Particles* pt = sph_ ? &sph_->particles() : nullptr;
+  if (pt)
+    for (int i = 0; i < 3; ++i)
+      for (std::size_t k = 0; k < pt->size(); ++k) extent = std::max(extent, std::abs(pt->x[i][k]));
+  const double tol = 1e-9 * comm_.max(extent);
+  std::vector<std::int64_t> behind(walls.size(), 0);
+  for (std::size_t w = 0; w < walls.size(); ++w) {
+    auto gap = [&](double x, double y, double z) {
+      return dot(Vec3{x, y, z} - walls[w].point, walls[w].normal);
+    };
+    for (std::size_t n = 0; n < nodes_.size(); ++n)
+      if (fe_.node_owned[n] && gap(nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]) < -tol)
+        ++behind[w];
+    if (pt)
+      for (std::size_t k = 0; k < pt->size(); ++k)
+        if (gap(pt->x[0][k], pt->x[1][k], pt->x[2][k]) < -tol) ++behind[w];
+  }
+  comm_.sum(std::span<std::int64_t>(behind));
+  for (std::size_t w = 0; w < walls.size(); ++w)
+    if (behind[w] > 0)
+      warnings_.push_back(fmt::format(
+          "{}: {} nodes or particles start behind rigid wall {}; the first step moves them "
+          "onto it (with the velocity that takes; its impulse is external work)",
+          walls[w].where.str(), behind[w], w));
 }
 
 double Simulation::owned_kinetic_energy() const {

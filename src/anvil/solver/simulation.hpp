@@ -116,6 +116,8 @@ public:
   const std::vector<double>& part_masses() const { return part_mass_; }
   // Global element id -> part name (for messages).
   std::string describe_element(std::int64_t gid) const;
+  // What the setup found questionable (the same on every rank), for the user.
+  const std::vector<std::string>& warnings() const { return warnings_; }
 
 private:
   void fe_forces();
@@ -124,6 +126,7 @@ private:
   void detect_contacts();
   void correct();
   void share_eroded(bool exposing = true);
+  void warn_behind_walls();
   void apply_walls();             // the rigid walls' part of correct()
   void sample_probe_velocities(); // at the end of correct()
   ContactNodes contact_view();
@@ -215,6 +218,7 @@ private:
   double dt_stable_local_ = 0;
   std::int64_t stable_gid_local_ = -1;
   std::int64_t global_nodes_ = 0, global_elements_ = 0;
+  std::vector<std::string> warnings_;
   std::uint64_t mesh_fingerprint_ = 0;
   std::vector<std::int64_t> block_offsets_;
   std::vector<double> part_mass_;
