@@ -17,6 +17,7 @@
 
 #include "anvil/core/error.hpp"
 #include "anvil/io/checkpoint.hpp"
+#include "anvil/io/files.hpp"
 
 namespace {
 
@@ -127,6 +128,19 @@ TEST(Checkpoint, InconsistentParticleCountNamesTheFile) {
   } catch (const anvil::InputError& e) {
     EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
   }
+}
+
+// A write that fails leaves no temporary behind (and the previous file as it was): here
+// the rename fails, the target being a directory.
+TEST(Checkpoint, FailedAtomicWriteLeavesNoTemporary) {
+  const auto dir = std::filesystem::temp_directory_path() / "anvil_atomic_write_test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "target");
+  const std::string target = (dir / "target").string();
+  EXPECT_THROW(anvil::write_file_atomic(target, "content"), anvil::InputError);
+  EXPECT_FALSE(std::filesystem::exists(target + ".tmp"));
+  EXPECT_TRUE(std::filesystem::is_directory(target));
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Checkpoint, UnknownVersionIsRefused) {

@@ -25,14 +25,17 @@ void write_file_atomic(const std::string& path, std::string_view content) {
     const auto n = ::write(fd, content.data() + done, content.size() - done);
     if (n <= 0) {
       ::close(fd);
+      std::remove(tmp.c_str()); // (a partial file is no use; the previous one stays)
       throw InputError("cannot write '" + tmp + "' (disk full?)");
     }
     done += static_cast<std::size_t>(n);
   }
   ::fsync(fd);
   ::close(fd);
-  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
     throw InputError("cannot rename '" + tmp + "' to '" + path + "'");
+  }
 }
 
 std::string json_text(const nlohmann::json& j, int indent) {
