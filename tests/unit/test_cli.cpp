@@ -130,6 +130,17 @@ TEST(Cli, NodesBehindAWallAreWarnedOf) {
   r = run("check " + write_temp("on_wall.yaml", deck));
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_EQ(r.out.find("behind rigid wall"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("outside the model"), std::string::npos) << r.out; // probe on the top
+}
+
+// A probe far from the model takes the nearest node silently; check warns.
+TEST(Cli, ProbeOutsideTheModelIsWarnedOf) {
+  std::string deck = small_deck;
+  deck.replace(deck.find("at: [0, 0, 0.02]"), 16, "at: [1.0, 0, 0.02]");
+  const auto r = run("check " + write_temp("far_probe.yaml", deck));
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("probe top at [1, 0, 0.02] lies outside the model"), std::string::npos)
+      << r.out;
 }
 
 TEST(Cli, RunWritesTheOutputs) {

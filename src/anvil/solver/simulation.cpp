@@ -137,28 +137,43 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
   initial_energy_ = ke_given + comm_.sum(particle_internal_energy());
   const double ke_kept = comm_.sum(kinetic_local_);
   if (comm_.rank() == 0) external_work_ = ke_kept - ke_given; // counted once, on rank 0
-  warn_behind_walls();
+  warn_of_setup();
 }
 
-// Nodes and particles that start behind a rigid wall: the first step puts them on it, with
-// whatever velocity that takes (a warning: a deck may mean it, a wall cutting a corner).
-void Simulation::warn_behind_walls() {
-  const auto& walls = config_.rigid_walls;
-  if (walls.empty()) return;
-  double extent = 0; // tolerance 1e-9 of the model's size
-  for (int i = 0; i < 3; ++i)
-    for (std::size_t n = 0; n < nodes_.size(); ++n)
-      extent = std::max(extent, std::abs(nodes_.x[i][n]));
+// What the setup finds questionable, for the user: nodes and particles that start behind
+// a rigid wall (the first step puts them on it, with whatever velocity that takes: a deck
+// may mean it, or a wall cuts a corner), and probes outside the model (each takes the
+// nearest node or particle, wherever that is). Collective.
+void Simulation::warn_of_setup() {
+  // The model's bounding box, for the tolerances.
+  Vec3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+          std::numeric_limits<double>::infinity()};
+  Vec3 hi = -1.0 * lo;
+  auto extend = [&](double x, double y, double z) {
+    const Vec3 q{x, y, z};
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = std::min(lo[i], q[i]);
+      hi[i] = std::max(hi[i], q[i]);
+    }
+  };
+  for (std::size_t n = 0; n < nodes_.size(); ++n)
+    extend(nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]);
   const sph::Particles* pt = sph_ ? &sph_->particles() : nullptr;
   if (pt)
-    for (int i = 0; i < 3; ++i)
-      for (std::size_t k = 0; k < pt->size(); ++k) extent = std::max(extent, std::abs(pt->x[i][k]));
-  const double tol = 1e-9 * comm_.max(extent);
+    for (std::size_t k = 0; k < pt->size(); ++k) extend(pt->x[0][k], pt->x[1][k], pt->x[2][k]);
+  double box[6] = {lo.x, lo.y, lo.z, -hi.x, -hi.y, -hi.z};
+  comm_.min(std::span<double>(box, 6));
+  lo = {box[0], box[1], box[2]};
+  hi = {-box[3], -box[4], -box[5]};
+  const double size = std::isfinite(lo.x) ? norm(hi - lo) : 0.0;
+
+  const auto& walls = config_.rigid_walls;
   std::vector<std::int64_t> behind(walls.size(), 0);
   for (std::size_t w = 0; w < walls.size(); ++w) {
     auto gap = [&](double x, double y, double z) {
       return dot(Vec3{x, y, z} - walls[w].point, walls[w].normal);
     };
+    const double tol = 1e-9 * size;
     for (std::size_t n = 0; n < nodes_.size(); ++n)
       if (fe_.node_owned[n] && gap(nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]) < -tol)
         ++behind[w];
@@ -173,6 +188,17 @@ void Simulation::warn_behind_walls() {
           "{}: {} nodes or particles start behind rigid wall {}; the first step moves them "
           "onto it (with the velocity that takes; its impulse is external work)",
           walls[w].where.str(), behind[w], w));
+  for (const auto& probe : config_.probes) {
+    const double margin = 0.01 * size;
+    bool outside = false;
+    for (int i = 0; i < 3; ++i)
+      outside |= probe.at[i] < lo[i] - margin || probe.at[i] > hi[i] + margin;
+    if (outside)
+      warnings_.push_back(fmt::format("{}: probe {} at [{:g}, {:g}, {:g}] lies outside the model "
+                                      "(its bounding box); it follows the nearest node or particle",
+                                      probe.where.str(), probe.name, probe.at.x, probe.at.y,
+                                      probe.at.z));
+  }
 }
 
 double Simulation::owned_kinetic_energy() const {

@@ -126,7 +126,7 @@ private:
   void detect_contacts();
   void correct();
   void share_eroded(bool exposing = true);
-  void warn_behind_walls();
+  void warn_of_setup();
   void apply_walls();             // the rigid walls' part of correct()
   void sample_probe_velocities(); // at the end of correct()
   ContactNodes contact_view();
