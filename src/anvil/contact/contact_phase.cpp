@@ -1404,6 +1404,7 @@ ContactPhase::element_contact_rank(const std::vector<HexBlock>& blocks) const {
   for (std::size_t b = 0; b < blocks.size(); ++b)
     out[b].assign(static_cast<std::size_t>(blocks[b].size()), -1);
   for (std::size_t f = 0; f < my_face_gid_.size(); ++f) {
+    if (!active(f)) continue; // (a face erosion has not exposed has no contact rank)
     const auto [el, side] = my_face_element_[f];
     for (std::size_t b = 0; b < blocks.size(); ++b) {
       const auto& g = blocks[b].gid;

@@ -121,7 +121,7 @@ public:
   std::size_t nodes_held() const { return search_nodes_->size(); }
   std::size_t faces_held() const { return search_faces_->size(); }
   // RCB owner rank of each face of each owned element, -1 where the element has none
-  // (first exterior face by side), per block and element (for the contact_rank field).
+  // (first active face by side), per block and element (for the contact_rank field).
   std::vector<std::vector<int>> element_contact_rank(const std::vector<HexBlock>& blocks) const;
 
 private:
