@@ -1,6 +1,7 @@
 #include "anvil/io/deck.hpp"
 
 #include <yaml-cpp/depthguard.h>
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -592,6 +593,47 @@ int separator_line(const std::string& text, int upto) {
   return found;
 }
 
+// A name the deck defines (part, particle set, node set): not empty, and without '.'
+// (PART.SET names a set of a part's mesh: a name with a dot could hide one).
+void check_defined_name(const Node& n, const std::string& name, const char* what) {
+  if (name.empty()) n.fail(fmt::format("{} names may not be empty", what));
+  if (name.find('.') != std::string::npos)
+    n.fail(
+        fmt::format("{} names may not contain '.' (PART.SET names a set of a part's mesh)", what));
+}
+
+// Sees the documents of a YAML stream: where the second starts, and whether it holds
+// anything (a lone '---' at the end holds nothing).
+class SecondDocument : public YAML::EventHandler {
+public:
+  int line = -1;        // 0-based line of the second document's start
+  bool content = false; // it holds a node
+  void OnDocumentStart(const YAML::Mark& m) override {
+    if (++docs_ == 2) line = m.line;
+  }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override { seen(); }
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                const std::string&) override {
+    seen();
+  }
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    seen();
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    seen();
+  }
+  void OnMapEnd() override {}
+
+private:
+  int docs_ = 0;
+  void seen() { content |= docs_ == 2; }
+};
+
 } // namespace
 
 Config parse_deck(const std::string& text, const std::string& name, const std::string& base_dir) {
@@ -599,14 +641,17 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
   c.deck_file = name;
   YAML::Node root;
   try {
-    const std::vector<YAML::Node> docs = YAML::LoadAll(text);
+    root = YAML::Load(text); // the first document
     // A second document would be dropped without a word: everything after a '---' or
-    // '...' line. It is reported at that line.
-    if (docs.size() > 1)
-      throw InputError({name, separator_line(text, docs[1].Mark().line), ""},
+    // '...' line. It is reported at that line. (The parser is asked for two documents at
+    // most: YAML::LoadAll did not return on some malformed input, found by fuzzing.)
+    std::istringstream in(text);
+    YAML::Parser parser(in);
+    SecondDocument second;
+    if (parser.HandleNextDocument(second) && parser.HandleNextDocument(second) && second.content)
+      throw InputError({name, separator_line(text, second.line), ""},
                        "a deck holds one YAML document; a second one starts here (remove the "
                        "'---' or '...' line)");
-    if (!docs.empty()) root = docs[0];
   } catch (const YAML::DeepRecursion& e) {
     throw InputError({name, e.mark.line >= 0 ? e.mark.line + 1 : 0, ""},
                      "malformed YAML: nested too deep");
@@ -656,7 +701,7 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
   // Finite-element parts; a deck of particles only needs none.
   if (top.has("parts") || !top.has("particles")) {
     for (const auto& [pname, pn] : top.required("parts").entries()) {
-      if (pname.find('.') != std::string::npos) pn.fail("part names may not contain '.'");
+      check_defined_name(pn, pname, "part");
       PartConfig p = parse_part(pname, pn, base_dir);
       const MaterialConfig* mat = c.material(p.material);
       if (!mat)
@@ -676,7 +721,7 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 
   if (top.has("particles")) {
     for (const auto& [pname, pn] : top.child("particles").entries()) {
-      if (pname.find('.') != std::string::npos) pn.fail("particle set names may not contain '.'");
+      check_defined_name(pn, pname, "particle set");
       if (std::any_of(c.parts.begin(), c.parts.end(),
                       [&pname = pname](const PartConfig& p) { return p.name == pname; }))
         pn.fail(fmt::format("'{}' is already the name of a part", pname));
@@ -768,9 +813,7 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 
   if (top.has("node_sets")) {
     for (const auto& [sname, sn] : top.child("node_sets").entries()) {
-      // PART.SET names the sets of a part's mesh: a deck set so named would hide one.
-      if (sname.find('.') != std::string::npos)
-        sn.fail("node set names may not contain '.' (PART.SET names a set of a part's mesh)");
+      check_defined_name(sn, sname, "node set");
       Selection s = parse_inline_selection(sn);
       s.name.clear();
       check_part(s);
