@@ -17,8 +17,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <set>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -105,6 +107,55 @@ contact:
   EXPECT_GT(eroded, 16); // more than the first layer's elements under the projectile
   EXPECT_LT(deepest, 1e-4);
   EXPECT_GT(lowest_tip, -0.004);
+}
+
+// An `erosion` key that never erodes changes nothing: the faces between the part's
+// elements stay dormant and the nodes inside it are searched for no pair until an
+// element of theirs erodes. Reference: the same deck without the key; tolerance: the same
+// bits (positions and velocities of every node after 141 cycles). Before the nodes inside
+// were dormant, one of them paired with the projectile's face at cycle 86 (QA, 0.5 mm
+// elements, 400 m/s).
+TEST(ErosionContact, ErosionThatNeverHappensChangesNothing) {
+  const std::string deck = R"(
+termination: {time: 4.0e-6}
+materials:
+  tgt: {model: j2_plasticity, density: 7800, youngs_modulus: 200.0e9, poissons_ratio: 0.3,
+        yield_stress: 3.0e8, hardening_modulus: 1.0e9}
+  wc: {model: elastic, density: 15000, youngs_modulus: 600.0e9, poissons_ratio: 0.22}
+parts:
+  target:
+    mesh: {generate: box, min: [-0.004, -0.004, -0.004], max: [0.004, 0.004, 0.0], divisions: [16, 16, 8]}
+    material: tgt
+  proj:
+    mesh: {generate: box, min: [-0.001, -0.001, 0.0001], max: [0.001, 0.001, 0.0041], divisions: [4, 4, 8]}
+    material: wc
+initial_conditions:
+  - {part: proj, velocity: [0, 0, -400.0]}
+boundary_conditions:
+  - {set: target.zmin, fix: all}
+contact:
+  - {type: general, parts: all, penalty_scale: 0.1}
+)";
+  std::string eroding = deck;
+  const std::string at = "    material: tgt\n";
+  eroding.insert(eroding.find(at) + at.size(), "    erosion: {plastic_strain: 100.0}\n");
+  const Comm world = Comm::world();
+  auto final_state = [&](const std::string& text) {
+    Simulation sim(test::deck(text), world);
+    while (!sim.finished()) sim.step();
+    std::vector<double> state;
+    for (int i = 0; i < 3; ++i) {
+      state.insert(state.end(), sim.nodes().x[i].begin(), sim.nodes().x[i].end());
+      state.insert(state.end(), sim.nodes().v[i].begin(), sim.nodes().v[i].end());
+    }
+    return state;
+  };
+  const std::vector<double> a = final_state(deck), b = final_state(eroding);
+  ASSERT_EQ(a.size(), b.size());
+  std::size_t differing = 0;
+  for (std::size_t k = 0; k < a.size(); ++k)
+    differing += std::memcmp(&a[k], &b[k], sizeof(double)) != 0;
+  EXPECT_EQ(differing, 0u);
 }
 
 } // namespace

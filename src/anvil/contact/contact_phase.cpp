@@ -98,6 +98,44 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
   }
   std::sort(force_nodes_.begin(), force_nodes_.end());
   history_set_.reserve(force_nodes_.size()); // a node is the slave of one pair at most
+  // Nodes on no exterior face (inside an eroding part) are dormant, searched for no pair,
+  // until an element they belong to erodes (set_eroded): the elements of each.
+  {
+    std::vector<std::int64_t> exterior;
+    for (std::size_t f = 0; f < surf.size(); ++f)
+      if (surf.behind[f] < 0)
+        exterior.insert(exterior.end(), surf.nodes[f].begin(), surf.nodes[f].end());
+    std::sort(exterior.begin(), exterior.end());
+    node_dormant_.assign(my_nodes_.size(), 0);
+    std::vector<std::pair<std::int64_t, std::size_t>> inner; // (gid, k) of dormant nodes
+    for (std::size_t k = 0; k < my_nodes_.size(); ++k) {
+      const std::int64_t g = fe.node_gid[static_cast<std::size_t>(my_nodes_[k])];
+      if (!std::binary_search(exterior.begin(), exterior.end(), g)) {
+        node_dormant_[k] = 1;
+        inner.emplace_back(g, k);
+      }
+    }
+    std::vector<std::pair<std::size_t, std::int64_t>> adj; // (k, element gid)
+    if (!inner.empty()) {
+      std::int64_t el = 0;
+      for (const auto& b : mesh.blocks)
+        for (const auto& h : b.elements) {
+          for (const std::int64_t g : h) {
+            const auto it =
+                std::lower_bound(inner.begin(), inner.end(), std::make_pair(g, std::size_t{0}));
+            if (it != inner.end() && it->first == g) adj.emplace_back(it->second, el);
+          }
+          ++el;
+        }
+      std::sort(adj.begin(), adj.end());
+      adj.erase(std::unique(adj.begin(), adj.end()), adj.end());
+    }
+    dormant_start_.assign(my_nodes_.size() + 1, 0);
+    for (const auto& [k, e] : adj) ++dormant_start_[k + 1];
+    for (std::size_t k = 0; k < my_nodes_.size(); ++k) dormant_start_[k + 1] += dormant_start_[k];
+    dormant_elements_.resize(adj.size());
+    for (std::size_t j = 0; j < adj.size(); ++j) dormant_elements_[j] = adj[j].second;
+  }
   // Faces of owned elements, with the penalty stiffness k = scale K A^2 / V and the
   // contact depth fraction V / A of their element, from the initial geometry.
   const auto offsets = mesh.block_offsets();
@@ -269,6 +307,7 @@ void ContactPhase::pack_cycle(std::size_t f, const ContactNodes& nd, Item& it) c
   it.mass = nd.mass[l];
   it.last_face = last_face_[l];
   it.allowance = allowance_[l];
+  it.dormant = node_dormant_[k];
 }
 
 void ContactPhase::unpack_motion(const FaceMotion& m, std::size_t j) {
@@ -297,6 +336,22 @@ void ContactPhase::complete_item(const FaceMotion& m, std::size_t j) {
 void ContactPhase::set_eroded(std::span<const std::int64_t> eroded, bool exposing) {
   auto gone = [&](std::int64_t el) { return std::binary_search(eroded.begin(), eroded.end(), el); };
   bool changed = false;
+  // The marks of last cycle's exposures go now (a restart after that cycle has none).
+  if (exposed_age_ != 0) {
+    std::fill(face_exposed_.begin(), face_exposed_.end(), 0);
+    exposed_age_ = 0;
+    changed = true;
+  }
+  // A node inside an eroding part wakes when an element it belongs to erodes.
+  for (std::size_t k = 0; k + 1 < dormant_start_.size(); ++k) {
+    if (dormant_start_[k] == dormant_start_[k + 1]) continue; // (an exterior node)
+    bool woken = false;
+    for (std::size_t j = dormant_start_[k]; j < dormant_start_[k + 1]; ++j)
+      woken |= gone(dormant_elements_[j]);
+    const std::uint8_t d = woken ? 0 : 1;
+    changed |= d != node_dormant_[k];
+    node_dormant_[k] = d;
+  }
   for (std::size_t f = 0; f < face_active_.size(); ++f) {
     const std::int64_t behind = my_face_behind_[f];
     const std::uint8_t a = !gone(my_face_element_[f].first) && (behind < 0 || gone(behind));

@@ -155,6 +155,11 @@ private:
   std::vector<std::int64_t> my_face_behind_;                  // ExteriorFaces::behind of each face
   std::vector<std::uint8_t> face_active_;  // its element alive, and exterior or exposed
   std::vector<std::uint8_t> face_exposed_; // 1 on the cycle erosion exposed it
+  // Per owned contact node (my_nodes_): 1 while it is on no active face's element that
+  // eroded (inside an eroding part); the elements it belongs to, for those that can be.
+  std::vector<std::uint8_t> node_dormant_;
+  std::vector<std::size_t> dormant_start_; // node k's elements: [start[k], start[k + 1])
+  std::vector<std::int64_t> dormant_elements_;
   int exposed_age_ = 0;               // 1: set_eroded() exposed faces this cycle; 2: last cycle
   std::vector<int> my_face_rank_;     // contact rank of the centroid, last cycle
   std::size_t live_ = 0;              // faces active (face_active_)

@@ -208,6 +208,7 @@ void build_lists(const std::vector<ContactNodeItem>& nodes,
                                w.entry_box[3].data(), w.entry_box[4].data(), w.entry_box[5].data()};
   for (std::size_t n = 0; n < nodes.size(); ++n) {
     const auto& nd = nodes[n];
+    if (nd.dormant != 0) continue; // (no list: it cannot pair before the next build)
     const std::size_t c =
         (static_cast<std::size_t>(index(2, nd.x[2])) * dims[1] + index(1, nd.x[1])) * dims[0] +
         index(0, nd.x[0]);

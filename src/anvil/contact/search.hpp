@@ -25,6 +25,7 @@ namespace anvil {
 struct ContactNodeItem {
   std::int64_t gid;       // global node id
   int holders;            // FE ranks that hold the node (FeDecomposition's holder group)
+  std::int32_t dormant;   // 1: inside an eroding part, no exposed face yet: never paired
   double x[3];            // predicted position x* = x(n) + dt v(n+1/2)
   double v[3];            // predicted velocity v(n+1/2)
   double mass;            // lumped nodal mass
