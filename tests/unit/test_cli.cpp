@@ -118,10 +118,11 @@ TEST(Cli, CheckPrintsCountsMassAndTimeStep) {
 // the count; a wall the block only touches gives no warning.
 TEST(Cli, NodesBehindAWallAreWarnedOf) {
   std::string deck = small_deck;
-  deck += "rigid_walls:\n  - {point: [0, 0, 0.001], normal: [0, 0, 1]}\n";
+  deck += "rigid_walls:\n  - {point: [0, 0, 0.005], normal: [0, 0, 1]}\n";
   auto r = run("check " + write_temp("behind_wall.yaml", deck));
   EXPECT_EQ(r.status, 0) << r.out;
-  // The block's nodes at z = 0 (16 of them) lie 1 mm behind the wall.
+  // Two layers of 16 nodes lie behind the wall, at z = 0 and 3.3 mm; those at z = 0 have
+  // z fixed, and the wall leaves them alone: 16.
   EXPECT_NE(r.out.find("behind_wall.yaml:18"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("16 nodes or particles start behind rigid wall 0"), std::string::npos)
       << r.out;

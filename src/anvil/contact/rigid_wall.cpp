@@ -5,6 +5,18 @@
 
 namespace anvil {
 
+Vec3 free_part(const Vec3& n, unsigned fixed) {
+  Vec3 nf = n;
+  for (int i = 0; i < 3; ++i)
+    if (fixed & (1u << i)) nf[i] = 0.0;
+  return nf;
+}
+
+bool wall_can_move(const Vec3& n, unsigned fixed) {
+  const Vec3 nf = free_part(n, fixed);
+  return dot(nf, nf) > 1e-6;
+}
+
 WallResult apply_rigid_walls(const std::vector<RigidWallConfig>& walls, double dt, WallNodes nd,
                              std::vector<WallHit>& hits) {
   WallResult r;
@@ -14,7 +26,7 @@ WallResult apply_rigid_walls(const std::vector<RigidWallConfig>& walls, double d
     const double mu = walls[w].friction;
     for (std::size_t k = 0; k < nd.size; ++k) {
       const unsigned fixed = nd.constrained[k];
-      if (fixed == 7u) continue;
+      if (!wall_can_move(n, fixed)) continue;
       const Vec3 v{nd.v[0][k], nd.v[1][k], nd.v[2][k]};
       const Vec3 xs = Vec3{nd.x[0][k], nd.x[1][k], nd.x[2][k]} + dt * v;
       const double gap = dot(xs - p, n);
@@ -30,17 +42,11 @@ WallResult apply_rigid_walls(const std::vector<RigidWallConfig>& walls, double d
         // Constrained components keep their prescribed value; the free ones alone bring
         // the node onto the wall: the rest of the normal change along n's free part
         // n_f, which moves the node along n by |n_f|^2 per unit (a wedge: a node driven
-        // into an oblique wall slides along it). A wall nearly square to every free
-        // direction cannot move the node: it is left alone, as a fully fixed one.
-        Vec3 nf = n;
+        // into an oblique wall slides along it).
+        const Vec3 nf = free_part(n, fixed);
         for (int i = 0; i < 3; ++i)
-          if (fixed & (1u << i)) {
-            vn[i] = v[i];
-            nf[i] = 0.0;
-          }
-        const double nf2 = dot(nf, nf);
-        if (!(nf2 > 1e-6)) continue;
-        vn += ((dvn - dot(vn - v, n)) / nf2) * nf;
+          if (fixed & (1u << i)) vn[i] = v[i];
+        vn += ((dvn - dot(vn - v, n)) / dot(nf, nf)) * nf;
       }
       for (int i = 0; i < 3; ++i) nd.v[i][k] = vn[i];
       if (nd.owned[k]) {

@@ -40,6 +40,12 @@ struct WallResult {
   double kinetic = 0; // change of 1/2 m |v(n)|^2, v(n) the mean of v(n-1/2) and v(n+1/2) (J)
 };
 
+// The wall normal n without the constrained components (bit i of `fixed`): the directions
+// a wall can move a node in. A wall nearly square to all of them (|n_f|^2 <= 1e-6; a
+// fully fixed node) leaves the node alone.
+Vec3 free_part(const Vec3& n, unsigned fixed);
+bool wall_can_move(const Vec3& n, unsigned fixed);
+
 // Corrects the velocities; appends to `hits` each owned node a wall acted on. A wall's
 // force is the sum of its hits in ascending key over every rank (wall_forces), the same
 // bits on any number of ranks.

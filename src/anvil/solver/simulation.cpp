@@ -174,12 +174,17 @@ void Simulation::warn_of_setup() {
       return dot(Vec3{x, y, z} - walls[w].point, walls[w].normal);
     };
     const double tol = 1e-9 * size;
+    // (Those the wall leaves alone, fixed in every direction it could move them, aside.)
+    const Vec3 nrm = walls[w].normal;
     for (std::size_t n = 0; n < nodes_.size(); ++n)
-      if (fe_.node_owned[n] && gap(nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]) < -tol)
+      if (fe_.node_owned[n] && wall_can_move(nrm, constrained_[n]) &&
+          gap(nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]) < -tol)
         ++behind[w];
     if (pt)
       for (std::size_t k = 0; k < pt->size(); ++k)
-        if (gap(pt->x[0][k], pt->x[1][k], pt->x[2][k]) < -tol) ++behind[w];
+        if (wall_can_move(nrm, pt->constrained[k]) &&
+            gap(pt->x[0][k], pt->x[1][k], pt->x[2][k]) < -tol)
+          ++behind[w];
   }
   comm_.sum(std::span<std::int64_t>(behind));
   for (std::size_t w = 0; w < walls.size(); ++w)
