@@ -36,6 +36,17 @@ assert len(files) == len(re.findall(r'file="', open(os.path.join(full, "results.
 missing = [f for f in files if not os.path.isfile(os.path.join(other, f))]
 assert not missing, missing
 PY
+# A checkpoint copied alone elsewhere: the restart says what it lacks, and lists only
+# field files that exist.
+mkdir lone && cp stopped/checkpoint.anvil lone/
+run 2 "$anvil" run deck.yaml -o lone_out -q --restart lone/checkpoint.anvil 2> lone.err
+grep -q "history.csv starts at the checkpoint" lone.err || { cat lone.err; exit 1; }
+grep -q "results.pvd's outputs before the checkpoint are not in" lone.err
+/usr/bin/python3 - lone_out <<'PY'
+import os, re, sys
+files = re.findall(r'file="([^"]+)"', open(os.path.join(sys.argv[1], "results.pvd")).read())
+assert files and all(os.path.isfile(os.path.join(sys.argv[1], f)) for f in files), files
+PY
 
 # A real SIGTERM, mid-run: mpirun passes it to the ranks, which checkpoint and stop.
 # mpirun itself goes to the background, not the `run` function: a function in the

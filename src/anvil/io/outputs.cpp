@@ -236,6 +236,21 @@ void Outputs::resume(const OutputState& state, const std::string& from) {
   const std::string path = opt_.directory + "/history.csv";
   const std::string old_path = (old_dir / "history.csv").string();
   std::vector<std::string> keep;
+  // What the checkpoint's directory lacks (a checkpoint copied alone elsewhere) is said,
+  // and left out of the series.
+  auto warn = [](const std::string& w) { std::fprintf(stderr, "anvil: warning: %s\n", w.c_str()); };
+  if (!fs::exists(old_path) && sim_.clock().cycle > 0)
+    warn(fmt::format("restart: {} does not exist; history.csv starts at the checkpoint", old_path));
+  for (auto [series, name] : {std::pair{&pvd_, "results.pvd"}, {&particle_pvd_, "particles.pvd"}}) {
+    const auto n = series->size();
+    std::erase_if(*series, [&](const auto& entry) {
+      return !fs::exists(fs::path(opt_.directory) / entry.second);
+    });
+    if (series->size() < n)
+      warn(fmt::format("restart: {} of {}'s outputs before the checkpoint are not in {}; it "
+                       "lists those that are",
+                       n - series->size(), name, old_dir.string()));
+  }
   if (std::FILE* in = std::fopen(old_path.c_str(), "r")) {
     char* line = nullptr;
     std::size_t cap = 0;
