@@ -86,6 +86,9 @@ def parse_args(argv=None):
     p.add_argument("--cut", metavar="AXIS=VALUE",
                    help="cutaway: keep only cells whose centroid has AXIS <= VALUE [m] "
                    "(e.g. y=0 shows the interior on the plane y = 0)")
+    p.add_argument("--show-eroded", action="store_true",
+                   help="draw eroded elements too (cell field eroded = 1; hidden by default, "
+                   "so the faces erosion exposed show)")
     p.add_argument("--elev", type=float, default=20.0, help="view elevation [deg] (default 20)")
     p.add_argument("--azim", type=float, default=-60.0, help="view azimuth [deg] (default -60)")
     p.add_argument("--clim", type=float, nargs=2, metavar=("MIN", "MAX"),
@@ -383,14 +386,21 @@ class Surface:
     points: np.ndarray
 
 
-def exterior_surface(grid, field, undeformed=False, cut=None, where="input"):
+def exterior_surface(grid, field, undeformed=False, cut=None, where="input",
+                     show_eroded=False):
     """Exterior faces of `grid`'s hexahedra coloured by `field` (see face_values).
 
     undeformed: subtract the displacement point field; cut: (axis index, value) keeps only
-    cells whose centroid has coordinate <= value.  `where` names the input in errors."""
+    cells whose centroid has coordinate <= value; eroded cells (cell field eroded) are left
+    out unless show_eroded.  `where` names the input in errors."""
     conn, hex_cells = grid.hex_connectivity()
     if len(conn) == 0:
         raise ResultsError(f"{where}: no hexahedral cells to draw")
+    if not show_eroded and "eroded" in grid.cell_data:
+        live = np.asarray(grid.cell_data["eroded"]).reshape(-1)[hex_cells] == 0
+        if not live.any():
+            raise ResultsError(f"{where}: every element has eroded (--show-eroded draws them)")
+        conn, hex_cells = conn[live], hex_cells[live]
     points = grid.points
     if undeformed:
         if "displacement" not in grid.point_data:
@@ -417,7 +427,8 @@ def main(argv=None):
     """Entry point: read one field output, draw, write the PNG and print its path."""
     args = parse_args(argv)
     entry, grid = load_output(args.outdir, step=args.step, time=args.time)
-    surf = exterior_surface(grid, args.field, args.undeformed, args.cut, entry.path)
+    surf = exterior_surface(grid, args.field, args.undeformed, args.cut, entry.path,
+                            args.show_eroded)
     front = front_faces(surf, args.elev, args.azim)  # orthographic view: back faces hidden
     rgba, legend = face_colors(surf.values, surf.is_int, args)
 

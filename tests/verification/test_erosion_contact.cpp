@@ -3,7 +3,7 @@
 // the faces it covered join the contact surface, so a penetrator meets the material
 // behind the eroded layer instead of passing through it. A tungsten-carbide block
 // (2 x 2 x 4 mm, elastic) strikes a steel target (8 x 8 x 4 mm, J2, erosion at 8%
-// plastic strain, base clamped) at 400 m/s.
+// plastic strain, base clamped) at 400 m/s: examples/eroding_penetration.yaml.
 // Reference: the contact condition itself, as for the can crush (DESIGN.md section 5): no
 // projectile node penetrates a live target element deeper than a tenth of the element
 // size (0.1 mm), behind all six of the element's face planes, every cycle; and the
@@ -18,7 +18,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -35,30 +37,14 @@ namespace {
 using namespace anvil;
 
 TEST(ErosionContact, ExposedFacesStopThePenetrator) {
-  const char* deck = R"(
-termination: {time: 1.5e-5}
-materials:
-  tgt: {model: j2_plasticity, density: 7800, youngs_modulus: 200.0e9, poissons_ratio: 0.3,
-        yield_stress: 3.0e8, hardening_modulus: 1.0e9}
-  wc: {model: elastic, density: 15000, youngs_modulus: 600.0e9, poissons_ratio: 0.22}
-parts:
-  target:
-    mesh: {generate: box, min: [-0.004, -0.004, -0.004], max: [0.004, 0.004, 0.0], divisions: [8, 8, 4]}
-    material: tgt
-    erosion: {plastic_strain: 0.08}
-  proj:
-    mesh: {generate: box, min: [-0.001, -0.001, 0.0001], max: [0.001, 0.001, 0.0041], divisions: [2, 2, 4]}
-    material: wc
-initial_conditions:
-  - {part: proj, velocity: [0, 0, -400.0]}
-boundary_conditions:
-  - {set: target.zmin, fix: all}
-contact:
-  - {type: general, parts: all, penalty_scale: 1.0}
-)";
+  // The deck is examples/eroding_penetration.yaml.
+  std::stringstream deck;
+  deck << std::ifstream(std::string(test::source_dir()) + "/examples/eroding_penetration.yaml")
+              .rdbuf();
+  ASSERT_FALSE(deck.str().empty());
   const Comm world = Comm::world();
   ASSERT_EQ(world.size(), 1) << "the check reads every element and node on one rank";
-  Simulation sim(test::deck(deck), world);
+  Simulation sim(test::deck(deck.str()), world);
   const auto& blocks = sim.blocks();
   ASSERT_EQ(blocks.size(), 2u);
   const HexBlock& target = blocks[0];
