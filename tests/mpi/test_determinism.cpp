@@ -7,6 +7,7 @@
 #include <cstring>
 #include <map>
 
+#include "anvil/io/deck.hpp"
 #include "anvil/parallel/comm.hpp"
 #include "anvil/solver/can_crush.hpp"
 #include "anvil/solver/simulation.hpp"
@@ -213,33 +214,14 @@ TEST(Determinism, SameBitsOnAnyRankCount) {
   EXPECT_GT(max_ep, 0.01);
 }
 
-// Eroding contact: elements erode on every rank's part of the target and the faces they
-// covered join the contact surfaces (ContactPhase::set_eroded); the same bits as on one
-// rank, exactly.
+// Eroding contact (examples/eroding_penetration.yaml to 12 us): elements erode on every
+// rank's part of the target and the faces they covered join the contact surfaces
+// (ContactPhase::set_eroded); the same bits as on one rank, exactly.
 TEST(Determinism, ErodingContactSameBitsOnAnyRankCount) {
-  const char* deck = R"(
-termination: {time: 1.2e-5}
-materials:
-  tgt: {model: j2_plasticity, density: 7800, youngs_modulus: 200.0e9, poissons_ratio: 0.3,
-        yield_stress: 3.0e8, hardening_modulus: 1.0e9}
-  wc: {model: elastic, density: 15000, youngs_modulus: 600.0e9, poissons_ratio: 0.22}
-parts:
-  target:
-    mesh: {generate: box, min: [-0.004, -0.004, -0.004], max: [0.004, 0.004, 0.0], divisions: [8, 8, 4]}
-    material: tgt
-    erosion: {plastic_strain: 0.08}
-  proj:
-    mesh: {generate: box, min: [-0.001, -0.001, 0.0001], max: [0.001, 0.001, 0.0041], divisions: [2, 2, 4]}
-    material: wc
-initial_conditions:
-  - {part: proj, velocity: [0, 0, -400.0]}
-boundary_conditions:
-  - {set: target.zmin, fix: all}
-contact:
-  - {type: general, parts: all, penalty_scale: 1.0}
-)";
+  Config config = read_deck(std::string(test::source_dir()) + "/examples/eroding_penetration.yaml");
+  config.end_time = 1.2e-5;
   double max_ep = 0;
-  const std::int64_t differing = compare_with_serial(test::deck(deck), &max_ep);
+  const std::int64_t differing = compare_with_serial(config, &max_ep);
   EXPECT_EQ(differing, 0) << "values differing from the 1-rank run on " << Comm::world().size()
                           << " ranks";
   if (Comm::world().rank() == 0) EXPECT_GT(max_ep, 0.08); // elements eroded

@@ -313,6 +313,20 @@ TEST(Cli, NonUtf8DeckNameStillWritesTheSummary) {
   EXPECT_NE(summary.str().find("caf\xef\xbf\xbd.yaml"), std::string::npos) << summary.str();
 }
 
+// A 4 mm block of particles at the given spacing, 5 cycles.
+std::string water_block_deck(const std::string& spacing) {
+  return R"(
+termination: {cycles: 5}
+materials:
+  water: {model: elastic, density: 1000, youngs_modulus: 1.0e3, poissons_ratio: 0.49}
+particles:
+  slug:
+    generate: {shape: box, min: [0, 0, 0], max: [0.004, 0.004, 0.004], spacing: )" +
+         spacing + R"(}
+    material: water
+)";
+}
+
 // Built with AddressSanitizer (tools/ci_extra.sh): its shadow memory does not fit under
 // the address-space limit the test below sets.
 #if defined(__SANITIZE_ADDRESS__)
@@ -331,15 +345,7 @@ constexpr bool address_sanitizer = false;
 // ended in "internal error" (exit 1); it is bad input naming the particle set.
 TEST(Cli, ParticleLatticeTooLargeForMemory) {
   if (address_sanitizer) GTEST_SKIP() << "ulimit -v leaves AddressSanitizer no shadow memory";
-  const auto deck = write_temp("huge_lattice.yaml", R"(
-termination: {cycles: 5}
-materials:
-  water: {model: elastic, density: 1000, youngs_modulus: 1.0e3, poissons_ratio: 0.49}
-particles:
-  slug:
-    generate: {shape: box, min: [0, 0, 0], max: [0.004, 0.004, 0.004], spacing: 3.5e-6}
-    material: water
-)");
+  const auto deck = write_temp("huge_lattice.yaml", water_block_deck("3.5e-6"));
   const auto r = run_command("ulimit -v 3000000; timeout -s KILL 120 " +
                              std::string(anvil::test::anvil_binary()) + " check " + deck);
   EXPECT_EQ(r.status, 2) << r.out;
@@ -352,15 +358,7 @@ particles:
 // statistics in decomposition.json, no particle pieces (a particles-only deck gave an
 // empty FE decomposition).
 TEST(Cli, DecomposeWritesTheParticleDecomposition) {
-  const auto deck = write_temp("particles.yaml", R"(
-termination: {cycles: 5}
-materials:
-  water: {model: elastic, density: 1000, youngs_modulus: 1.0e3, poissons_ratio: 0.49}
-particles:
-  slug:
-    generate: {shape: box, min: [0, 0, 0], max: [0.004, 0.004, 0.004], spacing: 0.5e-3}
-    material: water
-)");
+  const auto deck = write_temp("particles.yaml", water_block_deck("0.5e-3"));
   const auto dir = (std::filesystem::temp_directory_path() / "anvil_cli_decompose").string();
   std::filesystem::remove_all(dir);
   const auto r = run("decompose " + deck + " -o " + dir);

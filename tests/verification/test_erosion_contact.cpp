@@ -27,6 +27,7 @@
 #include <fmt/format.h>
 
 #include "anvil/core/vec3.hpp"
+#include "anvil/io/deck.hpp"
 #include "anvil/mesh/mesh.hpp"
 #include "anvil/parallel/comm.hpp"
 #include "anvil/solver/simulation.hpp"
@@ -37,14 +38,10 @@ namespace {
 using namespace anvil;
 
 TEST(ErosionContact, ExposedFacesStopThePenetrator) {
-  // The deck is examples/eroding_penetration.yaml.
-  std::stringstream deck;
-  deck << std::ifstream(std::string(test::source_dir()) + "/examples/eroding_penetration.yaml")
-              .rdbuf();
-  ASSERT_FALSE(deck.str().empty());
   const Comm world = Comm::world();
   ASSERT_EQ(world.size(), 1) << "the check reads every element and node on one rank";
-  Simulation sim(test::deck(deck.str()), world);
+  Simulation sim(read_deck(std::string(test::source_dir()) + "/examples/eroding_penetration.yaml"),
+                 world);
   const auto& blocks = sim.blocks();
   ASSERT_EQ(blocks.size(), 2u);
   const HexBlock& target = blocks[0];
