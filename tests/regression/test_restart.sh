@@ -19,10 +19,12 @@ run() { mpirun --oversubscribe -np "$@"; }
 
 run 1 "$anvil" run deck.yaml -o full -q
 set +e
-run 2 "$anvil" run deck.yaml -o stopped -q --stop-at-cycle 700 2>/dev/null
+run 2 "$anvil" run deck.yaml -o stopped -q --stop-at-cycle 700 2>stopped.err
 status=$?
 set -e
 [ "$status" -ne 0 ] || { echo "a stopped run must not exit 0"; exit 1; }
+# It stops once cycle 700 is done, not one cycle later.
+grep -q "(cycle 700)" stopped.err || { cat stopped.err; exit 1; }
 run 3 "$anvil" run deck.yaml -o elsewhere -q --restart stopped/checkpoint.anvil
 "$compare" full/checkpoint.anvil elsewhere/checkpoint.anvil
 /usr/bin/python3 - full elsewhere <<'PY'

@@ -81,7 +81,11 @@ int run(const Config& config, const RunOptions& options, const Comm& comm) {
   StopSignals signals;
   try {
     while (!sim.finished()) {
-      if (stop_signal != 0 || sim.clock().cycle == options.stop_at_cycle) sim.request_stop();
+      // The request travels with the coming step's reduction, so --stop-at-cycle N asks
+      // before the step that completes cycle N (N = 0 stops after the first cycle).
+      const bool stop_here =
+          options.stop_at_cycle >= 0 && sim.clock().cycle + 1 >= options.stop_at_cycle;
+      if (stop_signal != 0 || stop_here) sim.request_stop();
       sim.step();
       out.after_step();
       if (sim.clock().time >= next_checkpoint * (1 - 1e-12) && !sim.finished()) {

@@ -12,7 +12,7 @@ struct RunOptions {
   std::string output_dir = "out";
   bool progress = true;
   std::string restart;          // checkpoint to continue from (empty: start at t = 0)
-  long long stop_at_cycle = -1; // behave as if SIGTERM arrived at this cycle (testing)
+  long long stop_at_cycle = -1; // stop as if by SIGTERM once cycle N is done (testing)
 };
 
 // Runs the model to its termination time or cycle count, writing the outputs. Returns
