@@ -5,7 +5,8 @@
 #  - damaged (one flipped bit in a velocity), truncated, or followed by extra bytes;
 #  - of a deck whose thick-shell part has other points through the thickness (found on
 #    the ranks holding that part only: this hung on 2 ranks);
-#  - of another mesh with the same numbers of nodes and elements.
+#  - of another mesh with the same numbers of nodes and elements;
+# and a checkpoint that cannot be written stops the run with exit 2 and a failed summary.
 set -euo pipefail
 anvil=$1
 work=$(mktemp -d)
@@ -64,6 +65,19 @@ sed -e 's/points: 3/points: 5/' deck.yaml > points5.yaml
 refused points5.yaml first/checkpoint.anvil "lacks the 5 thick-shell points of element 257"
 sed -e 's/divisions: \[4, 4, 16\]/divisions: [16, 4, 4]/' deck.yaml > other_mesh.yaml
 refused other_mesh.yaml first/checkpoint.anvil "was written for another mesh"
+
+# A checkpoint that cannot be written (its path taken by a directory) stops the run
+# with exit 2 naming it, and the summary says so.
+mkdir -p blocked/checkpoint.anvil
+set +e
+run 2 "$anvil" run deck.yaml -o blocked -q --stop-at-cycle 20 2> err.txt
+status=$?
+set -e
+if [ "$status" -ne 2 ] || ! grep -q "checkpoint.anvil" err.txt; then
+  echo "unwritable checkpoint: exit $status (expected 2 naming the file):"; cat err.txt; exit 1
+fi
+grep -q '"status": "failed"' blocked/summary.json
+grep -q 'checkpoint.anvil' blocked/summary.json
 
 # The checkpoint itself still continues the run.
 run 2 "$anvil" run deck.yaml -o first -q --restart first/checkpoint.anvil

@@ -75,7 +75,15 @@ int run(const Config& config, const RunOptions& options, const Comm& comm) {
       }
     }
     comm.broadcast(error, 0);
-    if (!error.empty()) throw InputError(error);
+    if (error.empty()) return;
+    // The run stops, but its outputs say why: the last fields and a failed summary.
+    try {
+      out.finish(exit_bad_input, error);
+    } catch (const InputError&) {
+      // The outputs could not be written either (a full disk): the checkpoint's error
+      // is the one to report.
+    }
+    throw InputError(error);
   };
 
   StopSignals signals;
