@@ -35,6 +35,18 @@ void put_box_and_plane(std::vector<double> (&box)[12], std::size_t j, const Face
   box[10][j] = c.warp[f];
 }
 
+// Orders (element gid, index) pairs by element, for equal_range on an element gid.
+struct ByElement {
+  template <class T>
+  bool operator()(const std::pair<std::int64_t, T>& a, std::int64_t el) const {
+    return a.first < el;
+  }
+  template <class T>
+  bool operator()(std::int64_t el, const std::pair<std::int64_t, T>& a) const {
+    return el < a.first;
+  }
+};
+
 // The bound of a face's capture box (derived above set_lazy_reference()):
 // its sides move by at most m = delta (1 + A (B + 4 delta)) when no corner has moved more
 // than delta since the reference, with A and B from the reference geometry (len = |D1 x
@@ -115,7 +127,7 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
         inner.emplace_back(g, k);
       }
     }
-    std::vector<std::pair<std::size_t, std::int64_t>> adj; // (k, element gid)
+    auto& adj = dormant_by_element_;
     if (!inner.empty()) {
       std::int64_t el = 0;
       for (const auto& b : mesh.blocks)
@@ -123,18 +135,13 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
           for (const std::int64_t g : h) {
             const auto it =
                 std::lower_bound(inner.begin(), inner.end(), std::make_pair(g, std::size_t{0}));
-            if (it != inner.end() && it->first == g) adj.emplace_back(it->second, el);
+            if (it != inner.end() && it->first == g) adj.emplace_back(el, it->second);
           }
           ++el;
         }
       std::sort(adj.begin(), adj.end());
       adj.erase(std::unique(adj.begin(), adj.end()), adj.end());
     }
-    dormant_start_.assign(my_nodes_.size() + 1, 0);
-    for (const auto& [k, e] : adj) ++dormant_start_[k + 1];
-    for (std::size_t k = 0; k < my_nodes_.size(); ++k) dormant_start_[k + 1] += dormant_start_[k];
-    dormant_elements_.resize(adj.size());
-    for (std::size_t j = 0; j < adj.size(); ++j) dormant_elements_[j] = adj[j].second;
   }
   // Faces of owned elements, with the penalty stiffness k = scale K A^2 / V and the
   // contact depth fraction V / A of their element, from the initial geometry.
@@ -172,7 +179,12 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
   }
   face_active_.resize(my_face_gid_.size());
   face_exposed_.assign(my_face_gid_.size(), 0);
-  for (std::size_t f = 0; f < face_active_.size(); ++f) face_active_[f] = my_face_behind_[f] < 0;
+  for (std::size_t f = 0; f < face_active_.size(); ++f) {
+    face_active_[f] = my_face_behind_[f] < 0;
+    faces_by_element_.emplace_back(my_face_element_[f].first, f);
+    if (my_face_behind_[f] >= 0) faces_by_element_.emplace_back(my_face_behind_[f], f);
+  }
+  std::sort(faces_by_element_.begin(), faces_by_element_.end());
   live_ = static_cast<std::size_t>(std::count(face_active_.begin(), face_active_.end(), 1));
   my_face_rank_.assign(my_face_gid_.size(), comm.rank());
   const std::size_t nf_all = my_face_gid_.size();
@@ -333,8 +345,14 @@ void ContactPhase::complete_item(const FaceMotion& m, std::size_t j) {
   it.exposed = m.exposed;
 }
 
-void ContactPhase::set_eroded(std::span<const std::int64_t> eroded, bool exposing) {
-  auto gone = [&](std::int64_t el) { return std::binary_search(eroded.begin(), eroded.end(), el); };
+void ContactPhase::set_eroded(std::span<const std::int64_t> fresh, bool exposing) {
+  const std::size_t before = eroded_.size();
+  eroded_.insert(eroded_.end(), fresh.begin(), fresh.end());
+  std::inplace_merge(eroded_.begin(), eroded_.begin() + static_cast<std::ptrdiff_t>(before),
+                     eroded_.end());
+  auto gone = [&](std::int64_t el) {
+    return std::binary_search(eroded_.begin(), eroded_.end(), el);
+  };
   bool changed = false;
   // The marks of last cycle's exposures go now (a restart after that cycle has none).
   if (exposed_age_ != 0) {
@@ -342,30 +360,31 @@ void ContactPhase::set_eroded(std::span<const std::int64_t> eroded, bool exposin
     exposed_age_ = 0;
     changed = true;
   }
-  // A node inside an eroding part wakes when an element it belongs to erodes.
-  for (std::size_t k = 0; k + 1 < dormant_start_.size(); ++k) {
-    if (dormant_start_[k] == dormant_start_[k + 1]) continue; // (an exterior node)
-    bool woken = false;
-    for (std::size_t j = dormant_start_[k]; j < dormant_start_[k + 1]; ++j)
-      woken |= gone(dormant_elements_[j]);
-    const std::uint8_t d = woken ? 0 : 1;
-    changed |= d != node_dormant_[k];
-    node_dormant_[k] = d;
-  }
-  for (std::size_t f = 0; f < face_active_.size(); ++f) {
-    const std::int64_t behind = my_face_behind_[f];
-    const std::uint8_t a = !gone(my_face_element_[f].first) && (behind < 0 || gone(behind));
-    if (a != face_active_[f]) {
+  // Of each fresh element: its dormant nodes wake, and the faces of it and behind it are
+  // looked at again (a face is active while its element lives, exterior or exposed).
+  auto of = [](const auto& pairs, std::int64_t el) {
+    return std::equal_range(pairs.begin(), pairs.end(), el, ByElement{});
+  };
+  for (const std::int64_t el : fresh) {
+    for (auto [it, end] = of(dormant_by_element_, el); it != end; ++it) {
+      changed |= node_dormant_[it->second] != 0;
+      node_dormant_[it->second] = 0;
+    }
+    for (auto [it, end] = of(faces_by_element_, el); it != end; ++it) {
+      const std::size_t f = it->second;
+      const std::int64_t behind = my_face_behind_[f];
+      const std::uint8_t a = !gone(my_face_element_[f].first) && (behind < 0 || gone(behind));
+      if (a == face_active_[f]) continue;
       changed = true;
       if (a != 0 && behind >= 0 && exposing) {
         face_exposed_[f] = 1;
         exposed_age_ = 1;
       }
+      face_active_[f] = a;
+      live_ = a != 0 ? live_ + 1 : live_ - 1;
     }
-    face_active_[f] = a;
   }
   if (!changed) return;
-  live_ = static_cast<std::size_t>(std::count(face_active_.begin(), face_active_.end(), 1));
   ++surface_version_;
 }
 

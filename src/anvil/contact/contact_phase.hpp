@@ -93,13 +93,14 @@ public:
   std::span<const std::array<double, 3>> extra_forces() const { return extra_force_; }
   std::span<const std::int64_t> extra_faces() const { return extra_face_; }
 
-  // The eroded elements of the whole mesh (global ids, ascending; every rank the same
-  // list): their faces leave the surfaces, and the faces they covered join them, from the
-  // next detect() on (LS-DYNA's eroding contact). Collective in effect: every rank calls
-  // it with the same list whenever an element has eroded anywhere. `exposing`: the faces
-  // that join the surface were exposed this cycle (false after a restart: they were
-  // exposed before the checkpoint).
-  void set_eroded(std::span<const std::int64_t> eroded, bool exposing = true);
+  // The elements of the whole mesh eroded since the last call (global ids, ascending;
+  // every rank the same list): their faces leave the surfaces, and the faces they covered
+  // join them, from the next detect() on (LS-DYNA's eroding contact). Collective in effect:
+  // every rank calls it with the same list whenever an element has eroded anywhere (after
+  // a restart, once with every eroded element). Only the faces and nodes of those elements
+  // are looked at. `exposing`: the faces that join the surface were exposed this cycle
+  // (false after a restart: they were exposed before the checkpoint).
+  void set_eroded(std::span<const std::int64_t> fresh, bool exposing = true);
 
   const ContactStats& stats() const { return stats_; }
   // Local indices, ascending, of the nodes that a contact force can act on here: the
@@ -155,11 +156,13 @@ private:
   std::vector<std::int64_t> my_face_behind_;                  // ExteriorFaces::behind of each face
   std::vector<std::uint8_t> face_active_;  // its element alive, and exterior or exposed
   std::vector<std::uint8_t> face_exposed_; // 1 on the cycle erosion exposed it
-  // Per owned contact node (my_nodes_): 1 while it is on no active face's element that
-  // eroded (inside an eroding part); the elements it belongs to, for those that can be.
+  // Per owned contact node (my_nodes_): 1 while no element it belongs to has eroded
+  // (inside an eroding part).
   std::vector<std::uint8_t> node_dormant_;
-  std::vector<std::size_t> dormant_start_; // node k's elements: [start[k], start[k + 1])
-  std::vector<std::int64_t> dormant_elements_;
+  // (element gid, owned node k) of the dormant nodes, and (element gid, face f) of each
+  // face's element and of the element behind it, ascending: what an erosion changes.
+  std::vector<std::pair<std::int64_t, std::size_t>> dormant_by_element_, faces_by_element_;
+  std::vector<std::int64_t> eroded_;  // every element eroded so far (ascending)
   int exposed_age_ = 0;               // 1: set_eroded() exposed faces this cycle; 2: last cycle
   std::vector<int> my_face_rank_;     // contact rank of the centroid, last cycle
   std::size_t live_ = 0;              // faces active (face_active_)

@@ -306,14 +306,22 @@ void Simulation::locate_probes(const Mesh& mesh) {
 // some element eroded, and after a restart: `exposing` false).
 void Simulation::share_eroded(bool exposing) {
   if (!contact_) return;
+  // The elements eroded here since the last call (each told once), from every rank.
   std::vector<std::int64_t> mine;
-  for (const auto& b : blocks_)
-    for (int e = 0; e < b.size(); ++e)
-      if (b.alive[static_cast<std::size_t>(e)] == 0.0)
-        mine.push_back(b.gid[static_cast<std::size_t>(e)]);
-  std::vector<std::int64_t> all = comm_.allgatherv(std::span<const std::int64_t>(mine));
-  std::sort(all.begin(), all.end());
-  contact_->set_eroded(all, exposing);
+  erosion_shared_.resize(blocks_.size());
+  for (std::size_t b = 0; b < blocks_.size(); ++b) {
+    const HexBlock& blk = blocks_[b];
+    auto& told = erosion_shared_[b];
+    told.resize(static_cast<std::size_t>(blk.size()), 0);
+    for (std::size_t e = 0; e < told.size(); ++e)
+      if (blk.alive[e] == 0.0 && told[e] == 0) {
+        told[e] = 1;
+        mine.push_back(blk.gid[e]);
+      }
+  }
+  std::vector<std::int64_t> fresh = comm_.allgatherv(std::span<const std::int64_t>(mine));
+  std::sort(fresh.begin(), fresh.end());
+  contact_->set_eroded(fresh, exposing);
 }
 
 std::string Simulation::describe_element(std::int64_t gid) const {

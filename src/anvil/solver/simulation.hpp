@@ -213,6 +213,8 @@ private:
   double dt_stable_ = 0; // from the last fe_forces
   bool stop_local_ = false, stop_ = false;
   std::int64_t eroded_ = 0; // elements this rank has eroded
+  // Per block and element: 1 once share_eroded() has told the contact phase it eroded.
+  std::vector<std::vector<std::uint8_t>> erosion_shared_;
   // This rank's smallest element step and its element: the controlling element is found
   // from them (one more reduction) only when a message needs it.
   double dt_stable_local_ = 0;
