@@ -189,9 +189,10 @@ void Outputs::begin() {
     std::fprintf(history_, "%s\n", history_header().c_str());
     std::fflush(history_);
   }
-  // The first row is the state the deck gave, at t = 0 (collective).
-  const Sample initial = sim_.sample();
-  write_history_row(initial);
+  // The t = 0 row is written once the first step has completed it (after_step()); the
+  // state the deck gave stands in if no step completes (collective).
+  initial_ = sim_.sample();
+  initial_row_due_ = true;
   if (c.output_format != OutputFormat::vtu) open_exodus("results");
   write_fields();
   next_fields_ = c.fields_every > 0 ? c.fields_every : std::numeric_limits<double>::infinity();
@@ -298,8 +299,16 @@ void Outputs::after_step() {
   const Clock& clk = sim_.clock();
   const double t_sample = clk.time - clk.dt; // the step's forces were at t(n)
   const bool last = sim_.finished();
-  // The first step's forces are at t = 0, already written by begin().
-  if (clk.cycle > 1 && (t_sample >= next_history_ * (1 - 1e-12) || last)) {
+  // A step completes the sample of the time it started from, t(n): velocities are the
+  // mean of v(n-1/2) and the corrected v(n+1/2), and the walls' forces and the energies
+  // include the impulses of that step. So the first step gives the t = 0 row (a body
+  // that starts on a wall is stopped by it there, and the row holds that impulse).
+  if (initial_row_due_) {
+    initial_row_due_ = false;
+    last_sample_ = sim_.sample();
+    have_sample_ = true;
+    write_history_row(last_sample_);
+  } else if (t_sample >= next_history_ * (1 - 1e-12) || last) {
     last_sample_ = sim_.sample();
     have_sample_ = true;
     write_history_row(last_sample_);
@@ -406,6 +415,10 @@ void Outputs::progress(bool last) {
 }
 
 void Outputs::finish(int status, const std::string& message) {
+  if (initial_row_due_) { // no step completed: the state the deck gave
+    initial_row_due_ = false;
+    write_history_row(initial_);
+  }
   {
     ScopedPhase t(output_timer_, Phase::output);
     write_fields();

@@ -96,6 +96,10 @@ private:
   PhaseTimers output_timer_;
   Sample last_sample_;
   bool have_sample_ = false;
+  // The state the deck gave, for the t = 0 row of a run that stops before its first step
+  // completes (the row is otherwise the first step's sample: see after_step()).
+  Sample initial_;
+  bool initial_row_due_ = false;
 };
 
 // The field piece of this rank: points, hexahedra and their nodal and element fields.
