@@ -29,8 +29,8 @@ struct HourglassControl {
 };
 
 // Artificial bulk viscosity q = rho l (quadratic l |tr D| - linear c) tr D when the
-// element compresses (tr D < 0), l = V^(1/3) (von Neumann-Richtmyer plus Landshoff, with
-// LS-DYNA's default coefficients).
+// element compresses (tr D < -1e-12 c / l: not by round-off), l = V^(1/3) (von
+// Neumann-Richtmyer plus Landshoff, with LS-DYNA's default coefficients).
 struct BulkViscosity {
   double quadratic = 1.5;
   double linear = 0.06;
