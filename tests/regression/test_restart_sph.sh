@@ -7,8 +7,8 @@
 #     is continued on 3 ranks and, separately, on 1;
 # the final checkpoints (nodes, elements, particles), the history's times, steps and
 # probe columns, results.pvd and particles.pvd must equal the uninterrupted run's.
-# Last, a deck with another number of particles must refuse the checkpoint (exit 2,
-# naming the file).
+# Last, a deck with another number of particles, or the same number elsewhere, must
+# refuse the checkpoint (exit 2, naming the file).
 set -euo pipefail
 anvil=$1
 compare=$2
@@ -48,4 +48,15 @@ fail() { echo "$1"; cat other.err; exit 1; }
 [ "$status" -eq 2 ] || fail "a mismatched checkpoint gave exit $status, not 2:"
 grep -q "stopped1/checkpoint.anvil" other.err || fail "the error does not name the file:"
 grep -q "particles" other.err || fail "the error does not mention particles:"
+# So must its particles: the same count, the lattice moved (QA round 5: the run went on
+# from the checkpoint's particles, the probes jumping by the move at the restart).
+sed -e 's/center: \[0, 0, 0.0032\], radius: 3.0e-3/center: [0, 0, 0.0033], radius: 3.0e-3/' \
+  deck.yaml > moved.yaml
+cmp -s deck.yaml moved.yaml && { echo "the deck edit did not apply"; exit 1; }
+set +e
+run 2 "$anvil" run moved.yaml -o moved -q --restart stopped1/checkpoint.anvil 2> other.err
+status=$?
+set -e
+[ "$status" -eq 2 ] || fail "a checkpoint of other particles gave exit $status, not 2:"
+grep -q "written for other particles" other.err || fail "the error does not say why:"
 echo "restart with particles: identical state after stop/restart on 2 -> 3 and 2 -> 1 ranks"

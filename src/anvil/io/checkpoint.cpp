@@ -21,9 +21,9 @@ namespace anvil {
 namespace {
 
 // The format's version is the magic's last character. Version 5 put the payload's length
-// and its FNV-1a checksum after the magic and the mesh's fingerprint in the header; files
-// of versions 1 to 4 (no checksum) are refused: rerun to write a new one.
-constexpr char magic[8] = {'A', 'N', 'V', 'I', 'L', 'C', 'K', '5'};
+// and its FNV-1a checksum after the magic and the mesh's fingerprint in the header;
+// version 6 the particles' fingerprint. Older files are refused: rerun to write a new one.
+constexpr char magic[8] = {'A', 'N', 'V', 'I', 'L', 'C', 'K', '6'};
 constexpr std::size_t magic_version = 7;
 constexpr std::size_t payload_start = sizeof magic + 2 * sizeof(std::uint64_t); // length, sum
 static_assert(Checkpoint::point_values == 8 * ThickShell::max_points);
@@ -105,6 +105,7 @@ Checkpoint capture(const Simulation& sim, const OutputState& outputs) {
   c.model_nodes = sim.global_nodes();
   c.model_elements = sim.global_elements();
   c.mesh_fingerprint = sim.mesh_fingerprint();
+  c.particle_fingerprint = sim.particle_fingerprint();
   double diag[2] = {sim.external_work_local(), sim.contact_energy_local()};
   comm.sum(std::span<double>(diag, 2));
   c.external_work = diag[0];
@@ -196,6 +197,7 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
   h["model_elements"] = c.model_elements;
   h["model_particles"] = c.model_particles;
   h["mesh_fingerprint"] = c.mesh_fingerprint;
+  h["particle_fingerprint"] = c.particle_fingerprint;
   h["next_fields"] = c.outputs.next_fields;
   h["next_history"] = c.outputs.next_history;
   h["next_checkpoint"] = c.outputs.next_checkpoint;
@@ -269,8 +271,8 @@ Checkpoint read_checkpoint(const std::string& path) {
   const char version = s[magic_version];
   if (version >= '1' && version < magic[magic_version])
     throw InputError(fmt::format("checkpoint '{}' was written by an older anvil (format version "
-                                 "{}, without a checksum); this anvil reads version {} only: run "
-                                 "the deck again to write a new checkpoint",
+                                 "{}); this anvil reads version {} only: run the deck again to "
+                                 "write a new checkpoint",
                                  path, version, magic[magic_version]));
   if (version != magic[magic_version])
     throw InputError(
@@ -318,6 +320,7 @@ Checkpoint read_checkpoint(const std::string& path) {
     c.model_elements = h.at("model_elements").get<std::int64_t>();
     c.model_particles = h.at("model_particles").get<std::int64_t>();
     c.mesh_fingerprint = h.at("mesh_fingerprint").get<std::uint64_t>();
+    c.particle_fingerprint = h.at("particle_fingerprint").get<std::uint64_t>();
     c.outputs.field_count = h.at("field_count").get<int>();
     c.outputs.pvd = h.at("pvd").get<std::vector<std::pair<double, std::string>>>();
     c.outputs.particle_pvd =

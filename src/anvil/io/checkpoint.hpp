@@ -55,7 +55,8 @@ struct Checkpoint {
   std::vector<std::int64_t> point_count;            // points through each one's thickness
   std::int64_t model_nodes = 0, model_elements = 0; // sizes of the model, for validation
   std::int64_t model_particles = 0;
-  std::uint64_t mesh_fingerprint = 0; // mesh_fingerprint() of the model's initial mesh
+  std::uint64_t mesh_fingerprint = 0;     // mesh_fingerprint() of the model's initial mesh
+  std::uint64_t particle_fingerprint = 0; // Simulation::particle_fingerprint()
 };
 
 // Gathers the state of `sim` on rank 0 (collective); other ranks get an empty checkpoint.

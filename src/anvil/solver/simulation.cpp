@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "anvil/contact/rigid_wall.hpp"
+#include "anvil/core/hash.hpp"
 #include "anvil/core/simd.hpp"
 #include "anvil/io/checkpoint.hpp"
 #include "anvil/solver/model.hpp"
@@ -104,6 +105,23 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
           return material_of(config_.particles[static_cast<std::size_t>(set)].material);
         },
         comm_);
+    // The particles' fingerprint, as the mesh's: of each particle's id, set, mass and
+    // reference position, summed over the particles (in two 32-bit halves, so that the
+    // sums neither overflow nor depend on which rank holds which particle).
+    {
+      const sph::Particles& pt = sph_->particles();
+      std::int64_t halves[2] = {0, 0};
+      for (std::size_t q = 0; q < pt.size(); ++q) {
+        Fnv1a h;
+        h.bytes(&pt.gid[q], sizeof pt.gid[q]).bytes(&pt.set[q], sizeof pt.set[q]);
+        h.bytes(&pt.mass[q], sizeof pt.mass[q]);
+        for (int i = 0; i < 3; ++i) h.bytes(&pt.x0[i][q], sizeof(double));
+        halves[0] += static_cast<std::int64_t>(h.value() & 0xffffffffu);
+        halves[1] += static_cast<std::int64_t>(h.value() >> 32);
+      }
+      comm_.sum(std::span<std::int64_t>(halves, 2));
+      particle_fingerprint_ = Fnv1a().bytes(halves, sizeof halves).value();
+    }
     // Particle sets in contact: all of them with `parts: all`, else those listed.
     sph_contact_set_.assign(config_.particles.size(), 0);
     if (contact_)
@@ -746,6 +764,11 @@ void Simulation::restore(const Checkpoint& c) {
   if (c.model_particles != particles)
     throw InputError(fmt::format("{} holds {} particles, this model has {}", from,
                                  c.model_particles, particles));
+  if (c.particle_fingerprint != particle_fingerprint_)
+    throw InputError(fmt::format("{} was written for other particles: the deck's particle sets "
+                                 "(their order, lattices, spacing or density) differ from those "
+                                 "of the run that wrote it (restart with the deck it came from)",
+                                 from));
   if (c.mesh_fingerprint != mesh_fingerprint_)
     throw InputError(fmt::format("{} was written for another mesh: the deck's node coordinates "
                                  "or element connectivity differ from those of the run that "

@@ -113,6 +113,8 @@ public:
   std::int64_t global_elements() const { return global_elements_; }
   // mesh_fingerprint() of the initial global mesh (the same on every rank).
   std::uint64_t mesh_fingerprint() const { return mesh_fingerprint_; }
+  // Of the initial particles (ids, sets, masses, reference positions; 0 without any).
+  std::uint64_t particle_fingerprint() const { return particle_fingerprint_; }
   const std::vector<double>& part_masses() const { return part_mass_; }
   // Global element id -> part name (for messages).
   std::string describe_element(std::int64_t gid) const;
@@ -222,6 +224,7 @@ private:
   std::int64_t global_nodes_ = 0, global_elements_ = 0;
   std::vector<std::string> warnings_;
   std::uint64_t mesh_fingerprint_ = 0;
+  std::uint64_t particle_fingerprint_ = 0;
   std::vector<std::int64_t> block_offsets_;
   std::vector<double> part_mass_;
 };
