@@ -132,7 +132,7 @@ ExodusWriter::ExodusWriter(const std::string& path, const Simulation& sim, const
     }
     cell += static_cast<std::size_t>(count);
   }
-  {
+  if (!blocks.empty()) {
     std::vector<std::string> names;
     for (std::size_t b = 0; b < blocks.size(); ++b)
       names.push_back(b < parts.size() ? parts[b].name : fmt::format("block_{}", b + 1));
@@ -170,6 +170,9 @@ ExodusWriter::ExodusWriter(const std::string& path, const Simulation& sim, const
       element_names.push_back(names[k]);
     }
   }
+  // A rank that holds no node (fewer elements than ranks) has no nodal variables to
+  // declare: Exodus defines them over the nodes.
+  if (nn == 0) nodal_.clear();
   if (!nodal_.empty()) {
     check(ex_put_variable_param(id_, EX_NODAL, static_cast<int>(nodal_.size())), "nodal variables");
     NameList list(nodal_names);

@@ -229,7 +229,8 @@ void Outputs::resume(const OutputState& state, const std::string& from) {
   if (sim_.config().output_format != OutputFormat::vtu) {
     open_exodus(fmt::format("results-s{:06d}", sim_.clock().cycle));
     VtuPiece piece = fe_piece(sim_);
-    collective_write(sim_.comm(), [&] { exodus_->write_step(sim_.clock().time, piece); });
+    if (exodus_)
+      collective_write(sim_.comm(), [&] { exodus_->write_step(sim_.clock().time, piece); });
   }
   if (sim_.comm().rank() != 0) return;
   // Keep the history rows before the restart time (a killed run may have written rows past
@@ -323,6 +324,13 @@ void Outputs::after_step() {
 }
 
 void Outputs::open_exodus(const std::string& stem) {
+  // Exodus holds the mesh; particles go to particles.pvd whatever the format.
+  if (sim_.global_elements() == 0) {
+    if (sim_.comm().rank() == 0)
+      std::fprintf(stderr, "anvil: warning: the model has no elements, so no Exodus II file is "
+                           "written (the particles are in particles.pvd)\n");
+    return;
+  }
   const VtuPiece layout = fe_piece(sim_); // collective: every rank lists the same arrays
   collective_write(sim_.comm(), [&] {
     exodus_ = std::make_unique<ExodusWriter>(
