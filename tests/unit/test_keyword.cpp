@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -504,6 +505,37 @@ TEST(Keyword, ErrorsNameFileLineAndField) {
                     "*INITIAL_VELOCITY_GENERATION\n         1         7"),
                {"*INITIAL_VELOCITY_GENERATION.STYP"});
   expect_error(with(good, "*TITLE", "two bricks\n*TITLE"), {"model.k:2", "data without a keyword"});
+}
+
+// LS-DYNA manual, *BOUNDARY_SPC_{NODE|SET}_ID: the ID card (ID, HEADING) comes once after
+// the keyword, then any number of NID (NSID) cards. Every second constraint was taken as
+// a heading and dropped (QA round 5, item 1).
+TEST(Keyword, SpcIdCardComesOnceBeforeTheConstraints) {
+  const Config c = kw(with(good, "*END", R"(*BOUNDARY_SPC_NODE_ID
+        43clamp three nodes
+        10         0         1         1         1
+        11         0         1         1         1
+        12         0         1         1         1
+*SET_NODE_LIST
+         8
+         9
+*SET_NODE_LIST
+         9
+        10
+*BOUNDARY_SPC_SET_ID
+         5two sets
+         8         0         1         0         0
+         9         0         1         0         0
+*END)"));
+  const Mesh m = build_mesh(c);
+  EXPECT_EQ(m.node_sets.at("spc_xyz"), (std::vector<std::int64_t>{9, 10, 11}));
+  std::vector<std::string> sets;
+  for (const auto& bc : c.boundary_conditions) sets.push_back(bc.nodes.name);
+  EXPECT_EQ(sets, (std::vector<std::string>{"nodeset_7", "nodeset_8", "nodeset_9", "spc_xyz"}));
+  // Two data cards: the second is a constraint, not an ID card (it was read as NID = 0).
+  EXPECT_NO_THROW(kw(with(good, "*END",
+                          "*BOUNDARY_SPC_NODE_ID\n         1\n        11         0         1\n"
+                          "        12         0         1\n*END")));
 }
 
 // Fuzz-style: deterministic damage to the valid deck (bytes, digits, truncation, lines

@@ -1034,9 +1034,10 @@ private:
 
   void spc(const Block& b, bool set) {
     Cursor c(b);
-    const bool with_id = ends_with(b.name, "_ID");
+    // The _ID option adds one card (ID, HEADING) to the keyword, not one per constraint:
+    // any number of NID/NSID cards follow it (LS-DYNA manual, *BOUNDARY_SPC).
+    if (ends_with(b.name, "_ID")) c.next();
     while (!c.done()) {
-      if (with_id) c.next(); // ID and HEADING
       const Line l = c.next();
       const Card card(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
       const char* what = set ? "NSID" : "NID";
