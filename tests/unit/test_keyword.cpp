@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -504,6 +505,232 @@ TEST(Keyword, ErrorsNameFileLineAndField) {
                     "*INITIAL_VELOCITY_GENERATION\n         1         7"),
                {"*INITIAL_VELOCITY_GENERATION.STYP"});
   expect_error(with(good, "*TITLE", "two bricks\n*TITLE"), {"model.k:2", "data without a keyword"});
+}
+
+// The 1-based line of the first line of `text` holding `fragment`.
+int line_of(const std::string& text, const std::string& fragment) {
+  const auto pos = text.find(fragment);
+  EXPECT_NE(pos, std::string::npos) << fragment;
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + pos, '\n'));
+}
+
+// LS-DYNA manual, *BOUNDARY_SPC_{NODE|SET}_ID: the ID card (ID, HEADING) comes once after
+// the keyword, then any number of NID (NSID) cards. Every second constraint was taken as
+// a heading and dropped (QA round 5, item 1).
+TEST(Keyword, SpcIdCardComesOnceBeforeTheConstraints) {
+  const Config c = kw(with(good, "*END", R"(*BOUNDARY_SPC_NODE_ID
+        43clamp three nodes
+        10         0         1         1         1
+        11         0         1         1         1
+        12         0         1         1         1
+*SET_NODE_LIST
+         8
+         9
+*SET_NODE_LIST
+         9
+        10
+*BOUNDARY_SPC_SET_ID
+         5two sets
+         8         0         1         0         0
+         9         0         1         0         0
+*END)"));
+  const Mesh m = build_mesh(c);
+  EXPECT_EQ(m.node_sets.at("spc_xyz"), (std::vector<std::int64_t>{9, 10, 11}));
+  std::vector<std::string> sets;
+  for (const auto& bc : c.boundary_conditions) sets.push_back(bc.nodes.name);
+  EXPECT_EQ(sets, (std::vector<std::string>{"nodeset_7", "nodeset_8", "nodeset_9", "spc_xyz"}));
+  // Two data cards: the second is a constraint, not an ID card (it was read as NID = 0).
+  EXPECT_NO_THROW(kw(with(good, "*END",
+                          "*BOUNDARY_SPC_NODE_ID\n         1\n        11         0         1\n"
+                          "        12         0         1\n*END")));
+}
+
+// keyword.md: *MAT_JOHNSON_COOK with G alone takes the bulk modulus rho C^2 of the part's
+// *EOS_GRUNEISEN (LS-DYNA's EOSID is on *PART). Two parts sharing the material with two
+// EOS got the first part's; the answer depended on part order (QA round 5, item 2).
+TEST(Keyword, JohnsonCookWithGOnlyTakesEachPartsEquationOfState) {
+  const std::string jc = R"(*MAT_JOHNSON_COOK
+         1    7830.0   77.0E+9
+   792.0E6   510.0E6      0.26     0.014      1.03    1793.0     293.0       1.0
+     477.0
+*EOS_GRUNEISEN
+         1    4570.0
+*EOS_GRUNEISEN
+         2    6000.0
+)";
+  const std::string two_parts =
+      with(with(good, "*MAT_ELASTIC\n         1    7850.0   2.0E+11       0.3\n", jc),
+           "       2       1       5", "       2       2       5");
+  const std::string p1 = "steel\n         1         1         1         1\n",
+                    p2 = "other\n         2         1         1         2\n";
+  auto nu = [](double C) {
+    const double K = 7830.0 * C * C, G = 77e9;
+    return (3 * K - 2 * G) / (2 * (3 * K + G));
+  };
+  for (const bool swapped : {false, true}) {
+    SCOPED_TRACE(swapped ? "part 2 first" : "part 1 first");
+    const Config c =
+        kw(with(two_parts, "steel\n         1         1         1\n", swapped ? p2 + p1 : p1 + p2));
+    ASSERT_EQ(c.parts.size(), 2u);
+    for (const auto& part : c.parts) {
+      const bool first = part.name == "part1";
+      EXPECT_EQ(part.material, first ? "mat1_eos1" : "mat1_eos2");
+      const auto m = std::find_if(c.materials.begin(), c.materials.end(),
+                                  [&](const MaterialConfig& x) { return x.name == part.material; });
+      ASSERT_NE(m, c.materials.end());
+      EXPECT_NEAR(m->params.at("poissons_ratio"), nu(first ? 4570.0 : 6000.0), 1e-12);
+    }
+    int about_eos = 0;
+    for (const auto& w : c.warnings) {
+      if (w.find("EOS_GRUNEISEN") == std::string::npos) continue;
+      ++about_eos;
+      EXPECT_EQ(w.find("(E, PR)"), std::string::npos) << w; // the deck gives neither
+      EXPECT_NE(w.find("rho C^2"), std::string::npos) << w;
+    }
+    EXPECT_EQ(about_eos, 2);
+    // A part without EOSID has no bulk modulus, whichever part comes first.
+    expect_error(with(two_parts, "steel\n         1         1         1\n",
+                      swapped ? "other\n         2         1         1\n" + p1
+                              : p1 + "other\n         2         1         1\n"),
+                 {"*MAT_JOHNSON_COOK.PR", "only the shear modulus", "part 2 (at model.k:"});
+  }
+  // One EOS for both parts: one material, named as before.
+  const Config one = kw(with(two_parts, "steel\n         1         1         1\n",
+                             p1 + "other\n         2         1         1         1\n"));
+  ASSERT_EQ(one.materials.size(), 1u);
+  EXPECT_EQ(one.materials[0].name, "mat1");
+}
+
+// keyword.md: "never fields dropped silently". A card more than a keyword takes (a second
+// wall in one *RIGIDWALL_PLANAR, a second *CONTROL_TERMINATION card) was ignored; it is an
+// error at its line naming the keyword (QA round 5, item 3).
+TEST(Keyword, ACardMoreThanAKeywordTakesIsAnError) {
+  const std::string two_walls = with(good, "*END", R"(*RIGIDWALL_PLANAR
+         0
+       0.0       0.0      -0.1       0.0       0.0       1.0
+         0
+       0.0       0.0       2.1       0.0       0.0       1.0
+*END)");
+  expect_error(two_walls, {fmt::format("model.k:{}: *RIGIDWALL_PLANAR:",
+                                       line_of(two_walls, "       0.0       0.0       2.1") - 1),
+                           "one data card more than *RIGIDWALL_PLANAR takes", "2 cards"});
+  const std::string term = with(good, "   1.0E-04\n", "   1.0E-04\n   2.0E-05       100\n");
+  expect_error(term, {"model.k:6: *CONTROL_TERMINATION:", "1 card here (from line 5)"});
+  expect_error(with(good, "   2.0E+11       0.3\n", "   2.0E+11       0.3\n         2\n"),
+               {"model.k:15: *MAT_ELASTIC:", "one data card more"});
+  expect_error(with(good, "*TITLE\ntwo bricks\n", "*TITLE\ntwo bricks\nmore title\n"),
+               {"model.k:4: *TITLE:"});
+  // Blank lines at the end of a block are layout, not cards.
+  EXPECT_NO_THROW(kw(with(good, "   1.0E-04\n", "   1.0E-04\n\n\n")));
+  // Optional cards that LS-DYNA allows are taken: silently when they set nothing, else
+  // with a warning naming them.
+  const std::string contact = R"(*CONTACT_AUTOMATIC_SINGLE_SURFACE
+         0
+      0.25
+       2.0
+         0         0         0
+         0         2
+*END)";
+  const Config c = kw(with(good, "*END", contact));
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("an optional card of *CONTACT_AUTOMATIC_SINGLE_SURFACE is "
+                               "ignored"),
+            std::string::npos)
+      << c.warnings[0];
+  EXPECT_NO_THROW(kw(with(good, "       0.0       0.8\n", "       0.0       0.8\n0,0,0\n")));
+  expect_error(with(good, "   1.0E-05\n", "   1.0E-05\n\n         1\n"),
+               {"*DATABASE_BINARY_D3PLOT:", "one data card more"});
+}
+
+// keyword.md: ignored keywords "are listed in one warning ... Read that warning before
+// trusting a run". It was lost when an error stopped the read, though the ignored
+// *PART_CONTACT was the cause of the error (QA round 5, item 4).
+TEST(Keyword, TheIgnoredKeywordsWarningComesWithAnError) {
+  const std::string text = with(with(good, "*END", "*PART_CONTACT\nother\n2,1,1\n0.2\n*END"),
+                                "       2       1       5", "       2       2       5");
+  expect_error(text, {"model.k:31: *ELEMENT_SOLID.PID: element 2 belongs to part 2",
+                      "\nanvil: warning: model.k: 1 keyword is not supported by anvil and "
+                      "ignored: *PART_CONTACT (1x, first at model.k:"});
+  try {
+    kw(text);
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where().line, 31); // the error keeps its location
+  }
+}
+
+// History output that anvil supports is read, and the rest is listed, never silently
+// dropped; an *INCLUDE variant whose file would be left out is an error (QA round 5,
+// item 5). LS-DYNA manual: *DATABASE_HISTORY_NODE_SET cards hold node set ids (8 per
+// card), *DATABASE_HISTORY_NODE_ID one ID and HEADING per card.
+TEST(Keyword, HistoryNodeSetsAndIncludeVariants) {
+  Config c = kw(with(good, "*END",
+                     "*DATABASE_HISTORY_NODE_SET\n         7\n*DATABASE_HISTORY_NODE_ID\n"
+                     "        11top corner\n*END"));
+  std::vector<std::string> names;
+  for (const auto& p : c.probes) names.push_back(p.name);
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"node12", "node1", "node2", "node3", "node4", "node11"}));
+  EXPECT_TRUE(c.warnings.empty());
+  expect_error(with(good, "*END", "*DATABASE_HISTORY_NODE_SET\n         8\n*END"),
+               {"*DATABASE_HISTORY_NODE_SET.ID", "node set 8 is not defined"});
+  c = kw(with(good, "*END", "*DATABASE_HISTORY_SOLID\n         1\n*END"));
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("*DATABASE_HISTORY_SOLID (1x"), std::string::npos) << c.warnings[0];
+  const std::string tr = with(good, "*END", "*INCLUDE_TRANSFORM\npart2.k\n0,0,0\n*END");
+  expect_error(tr,
+               {fmt::format("model.k:{}: *INCLUDE_TRANSFORM:", line_of(tr, "*INCLUDE_TRANSFORM")),
+                "('part2.k') is not supported"});
+  try {
+    parse_keyword_mesh(tr, "mesh.k", ".");
+    ADD_FAILURE() << "no error for *INCLUDE_TRANSFORM in a mesh file";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("*INCLUDE_TRANSFORM"), std::string::npos) << e.what();
+  }
+}
+
+// A node no element uses is in no rank's model (docs/meshes.md): a history probe there
+// followed another node. It is an error naming the node and the line (QA round 5, item 6).
+TEST(Keyword, AProbeOnANodeNoElementUsesIsAnError) {
+  std::string text = with(good, "      12             0.0             1.0             2.0\n",
+                          "      12             0.0             1.0             2.0\n"
+                          "     777             5.0             5.0             5.0\n");
+  text = with(text, "*DATABASE_HISTORY_NODE\n        12\n", "*DATABASE_HISTORY_NODE\n12,777\n");
+  expect_error(text, {fmt::format("model.k:{}: *DATABASE_HISTORY_NODE.ID", line_of(text, "12,777")),
+                      "history node 777 belongs to no solid element"});
+  // The same node in a history node set: skipped, with a warning.
+  text = with(with(text, "12,777\n", "12\n"), "*END",
+              "*SET_NODE_LIST\n         8\n         1       777\n*DATABASE_HISTORY_NODE_SET\n"
+              "         8\n*END");
+  const Config c = kw(text);
+  EXPECT_EQ(c.probes.size(), 2u);
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("node 777"), std::string::npos) << c.warnings[0];
+}
+
+// Message nits (QA round 5, item 7): the failure warnings do not deny anvil's erosion
+// (deck.md documents it); a blank EID is called blank; a UTF-8 byte-order mark is skipped;
+// a D3PLOT LCDT curve and a repeated control keyword are warned of (keyword.md says why).
+TEST(Keyword, MessageNits) {
+  const Config pk = kw(with(good, "*MAT_ELASTIC\n         1    7850.0   2.0E+11       0.3\n",
+                            "*MAT_003\n1,8930.0,117.0E+9,0.35,0.4E+9,1.0E+8,1.0\n0,0,0.8\n"));
+  ASSERT_EQ(pk.warnings.size(), 1u);
+  EXPECT_EQ(pk.warnings[0].find("does not erode"), std::string::npos) << pk.warnings[0];
+  EXPECT_NE(pk.warnings[0].find("erosion"), std::string::npos) << pk.warnings[0];
+  expect_error(
+      with(good, "       1       1       1       2", "                 1       1       1       2"),
+      {"model.k:30: *ELEMENT_SOLID.EID", "EID is blank", "I10=Y"});
+  const Config bom = kw("\xEF\xBB\xBF" + good);
+  EXPECT_EQ(bom.title, "two bricks");
+  const Config lcdt = kw(with(good, "   1.0E-05\n", "   1.0E-05         3\n"));
+  ASSERT_EQ(lcdt.warnings.size(), 1u);
+  EXPECT_NE(lcdt.warnings[0].find("LCDT"), std::string::npos) << lcdt.warnings[0];
+  const Config twice = kw(with(good, "*END", "*CONTROL_TERMINATION\n   2.0E-04\n*END"));
+  EXPECT_EQ(twice.end_time, 2e-4);
+  ASSERT_EQ(twice.warnings.size(), 1u);
+  EXPECT_NE(twice.warnings[0].find("*CONTROL_TERMINATION repeats the one at model.k:4; the "
+                                   "later one is used"),
+            std::string::npos)
+      << twice.warnings[0];
 }
 
 // Fuzz-style: deterministic damage to the valid deck (bytes, digits, truncation, lines

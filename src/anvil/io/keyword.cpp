@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -85,6 +86,10 @@ struct Block {
   bool long_format = false;
   bool i10 = false;
   std::vector<Line> lines;
+  // How far a reader's Cursor got: the lines it took, or all of them when it skips the
+  // rest on purpose (a keyword anvil only lists). The reader checks it after each keyword
+  // so that no card is dropped silently (KeywordReader::read).
+  mutable std::optional<std::size_t> taken;
   std::string key(std::string_view field) const { return fmt::format("*{}.{}", name, field); }
 };
 
@@ -106,6 +111,8 @@ private:
   void lex(std::string_view text, const std::string* file, const fs::path& dir,
            std::vector<std::string>& stack, bool main_file) {
     std::size_t pos = 0;
+    // A UTF-8 byte-order mark, as some Windows editors write it, is no part of the deck.
+    if (starts_with(text, "\xEF\xBB\xBF")) pos = 3;
     int line_no = 0;
     std::optional<std::size_t> current; // index of the block taking data lines
     bool in_include = false;
@@ -170,7 +177,7 @@ private:
           in_include = true;
           continue;
         }
-        blocks_.push_back(Block{name, ln, long_format, i10, {}});
+        blocks_.push_back(Block{name, ln, long_format, i10, {}, std::nullopt});
         current = blocks_.size() - 1;
         continue;
       }
@@ -419,32 +426,60 @@ std::string text_card(const Line& l) {
 }
 
 // Reads the lines of a block in order; cards past the end are blank (their defaults).
+// Every line it hands out is marked taken in the block (Block::taken).
 class Cursor {
 public:
   explicit Cursor(const Block& b) : b_(b) {
     // Blank lines at the end of a block are layout, not cards with defaults.
     end_ = b.lines.size();
     while (end_ > 0 && trim(b.lines[end_ - 1].text).empty()) --end_;
+    b_.taken = 0;
   }
   bool done() const { return i_ >= end_; }
   // The next line, or a blank one at the keyword's line when the block has run out.
   Line next() {
-    if (i_ < end_) return b_.lines[i_++];
+    if (i_ < end_) return take(b_.lines[i_++]);
     return Line{std::string_view(), b_.head.file, b_.head.line};
   }
   // The next non-blank line (list keywords skip blank lines).
   std::optional<Line> next_record() {
     while (i_ < end_) {
-      const Line& l = b_.lines[i_++];
+      const Line& l = take(b_.lines[i_++]);
       if (!trim(l.text).empty()) return l;
     }
     return std::nullopt;
   }
+  // The rest of the block is not read, on purpose (a keyword anvil only lists).
+  void skip_rest() {
+    i_ = end_;
+    b_.taken = end_;
+  }
 
 private:
+  const Line& take(const Line& l) {
+    b_.taken = i_;
+    return l;
+  }
   const Block& b_;
   std::size_t i_ = 0, end_ = 0;
 };
+
+// After a keyword's reader: a non-blank line it did not take is a card more than the
+// keyword holds (a second rigid wall in one *RIGIDWALL_PLANAR, a second
+// *CONTROL_TERMINATION card). LS-DYNA's single-definition keywords take one set of
+// cards; rather than drop the rest, anvil stops at the first of them.
+void check_all_taken(const Block& b) {
+  if (!b.taken) return; // not read card by card (ignored keywords are listed instead)
+  for (std::size_t i = *b.taken; i < b.lines.size(); ++i) {
+    if (trim(b.lines[i].text).empty()) continue;
+    const std::size_t n = *b.taken;
+    throw InputError(b.lines[i].where("*" + b.name),
+                     fmt::format("one data card more than *{} takes: it takes {} card{} here "
+                                 "(from line {}), and anvil does not drop the rest (a second "
+                                 "definition needs a *{} keyword of its own)",
+                                 b.name, n, n == 1 ? "" : "s", b.lines[0].line, b.name));
+  }
+}
 
 // ---- what the deck defines ----------------------------------------------------------------
 
@@ -548,7 +583,22 @@ public:
   explicit KeywordReader(bool mesh_only) : mesh_only_(mesh_only) {}
 
   void read(std::vector<Block>& blocks) {
-    for (const Block& b : blocks) dispatch(b);
+    // Keywords that hold one setting of the whole run: a repeat replaces the earlier one,
+    // said in a warning. Decks often *INCLUDE shared controls and override one of them, so
+    // a repeat is not an error, but a silent override could hide a forgotten copy.
+    static const std::set<std::string> settings{"CONTROL_TERMINATION",    "CONTROL_TIMESTEP",
+                                                "CONTROL_HOURGLASS",      "CONTROL_CONTACT",
+                                                "CONTROL_BULK_VISCOSITY", "DATABASE_BINARY_D3PLOT"};
+    std::map<std::string, Where> first;
+    for (const Block& b : blocks) {
+      dispatch(b);
+      check_all_taken(b);
+      if (mesh_only_ || !settings.count(b.name)) continue;
+      const auto [it, fresh] = first.emplace(b.name, where_of(b.head));
+      if (!fresh)
+        warnings_.push_back(fmt::format("{}: *{} repeats the one at {}; the later one is used",
+                                        where_of(b.head).str(), b.name, it->second.str()));
+    }
   }
 
   Mesh mesh() {
@@ -562,11 +612,17 @@ public:
 
   Config config(const std::string& deck_file);
 
+  // The one warning that lists the keywords anvil ignored ("" if none), and an input error
+  // that carries it, for an error that stops the read before config() returns it.
+  std::string ignored_keywords(const std::string& deck_file) const;
+  InputError with_ignored_keywords(const InputError& e, const std::string& deck_file) const;
+
 private:
   // ---- dispatch -------------------------------------------------------------------------
 
   void dispatch(const Block& b) {
     const std::string& n = b.name;
+    if (starts_with(n, "INCLUDE_")) return include_variant(b);
     if (n == "NODE") return node(b);
     if (n == "ELEMENT_SOLID") return element_solid(b);
     if (n == "PART") return part(b);
@@ -609,19 +665,42 @@ private:
     if (n == "CONTROL_BULK_VISCOSITY") return control_bulk_viscosity(b);
     if (n == "DATABASE_BINARY_D3PLOT") return d3plot(b);
     if (n == "DATABASE_GLSTAT" || n == "DATABASE_NODOUT") return history_interval(b);
-    if (n == "DATABASE_HISTORY_NODE") return history_nodes(b);
+    if (n == "DATABASE_HISTORY_NODE") return history_nodes(b, false);
+    if (n == "DATABASE_HISTORY_NODE_SET") return history_nodes(b, true);
+    if (n == "DATABASE_HISTORY_NODE_ID") return history_nodes_id(b);
     if (n == "TITLE") {
       Cursor c(b);
       title_ = text_card(c.next());
       return;
     }
-    // Output and performance controls that change nothing anvil computes.
-    if (starts_with(n, "DATABASE_") || n == "CONTROL_ENERGY" || n == "CONTROL_OUTPUT" ||
-        n == "CONTROL_CPU" || n == "CONTROL_PARALLEL" || starts_with(n, "CONTROL_MPP_") ||
-        n == "COMMENT")
+    // Output and performance controls that change nothing anvil computes. Other
+    // *DATABASE_HISTORY_... keywords ask for output anvil does not write (element or
+    // local-system histories): listed as ignored, so that their absence is no surprise.
+    if ((starts_with(n, "DATABASE_") && !starts_with(n, "DATABASE_HISTORY_")) ||
+        n == "CONTROL_ENERGY" || n == "CONTROL_OUTPUT" || n == "CONTROL_CPU" ||
+        n == "CONTROL_PARALLEL" || starts_with(n, "CONTROL_MPP_") || n == "COMMENT")
       return;
     auto& u = unsupported_[n];
     if (u.count++ == 0) u.first = where_of(b.head);
+  }
+
+  // *INCLUDE_TRANSFORM, *INCLUDE_PATH, ...: anvil reads plain *INCLUDE only. Ignoring one
+  // would leave out what its file holds (parts, nodes, elements) and run another model.
+  [[noreturn]] static void include_variant(const Block& b) {
+    std::string file;
+    for (const auto& l : b.lines)
+      if (!trim(l.text).empty()) {
+        file = fmt::format(" ('{}')", shown(trim(l.text)));
+        break;
+      }
+    throw InputError(b.head.where("*" + b.name),
+                     fmt::format("*{}{} is not supported: anvil reads plain *INCLUDE only, and "
+                                 "leaving the file out would change the model{}",
+                                 b.name, file,
+                                 starts_with(b.name, "INCLUDE_PATH")
+                                     ? " (name included files relative to the including file)"
+                                     : " (write the transformed or converted mesh to a file and "
+                                       "*INCLUDE that)"));
   }
 
   // The title card of a _TITLE keyword (skipped), then the first card.
@@ -636,6 +715,9 @@ private:
     while (auto l = c.next_record()) {
       const Card card(b, *l, {8, 16, 16, 16, 8, 8});
       const std::int64_t nid = card.integer(0, "NID", 0);
+      if (card.blank(0))
+        card.fail("NID", "NID is blank: *NODE's first field is 8 characters wide (for 10 "
+                         "characters give *KEYWORD I10=Y or '*NODE %')");
       if (nid <= 0) card.fail("NID", fmt::format("NID must be a positive node id, found {}", nid));
       const Vec3 x{card.real(1, "X"), card.real(2, "Y"), card.real(3, "Z")};
       const std::int64_t tc = card.integer(4, "TC", 0);
@@ -660,6 +742,9 @@ private:
       e.eid = first.integer(0, "EID", 0);
       e.pid = first.integer(1, "PID", 0);
       e.at = where_of(*l);
+      if (first.blank(0))
+        first.fail("EID", "EID is blank: *ELEMENT_SOLID's fields are 8 characters wide (for "
+                          "10-character fields give *KEYWORD I10=Y or '*ELEMENT_SOLID %')");
       if (e.eid <= 0) first.fail("EID", fmt::format("EID must be a positive id, found {}", e.eid));
       if (e.pid <= 0)
         first.fail("PID", fmt::format("element {}: PID must be a positive part id, found {}", e.eid,
@@ -807,7 +892,42 @@ private:
       id = 0; // not even an id: listed as unsupported all the same
     }
     if (id > 0) into.emplace(id, SectionCard{0, b.name, where_of(l)});
+    c.skip_rest(); // the keyword is listed as ignored, whatever its cards
     unsupported(b);
+  }
+
+  // Up to `most` optional cards that LS-DYNA allows after a keyword's cards and anvil does
+  // not read (*CONTACT_... optional cards A-G, the second card of *CONTROL_TIMESTEP). With
+  // `warn`, a card that sets anything (a field not blank or zero) gets a warning naming
+  // it; more cards than `most` remain for check_all_taken to refuse.
+  void optional_cards(const Block& b, Cursor& c, int most, bool warn) {
+    for (int k = 0; k < most && !c.done(); ++k) {
+      const Line l = c.next();
+      if (!warn || !sets_something(l.text)) continue;
+      warnings_.push_back(fmt::format("{}: an optional card of *{} is ignored (anvil does not "
+                                      "read it): '{}'",
+                                      where_of(l).str(), b.name, shown(trim(l.text))));
+    }
+  }
+
+  // Whether a card holds a field other than blank or zero (in either card format).
+  static bool sets_something(std::string_view text) {
+    std::string field;
+    auto nonzero = [&] {
+      if (field.empty()) return false;
+      char* end = nullptr;
+      const double v = std::strtod(field.c_str(), &end);
+      return *end != '\0' || v != 0;
+    };
+    for (const char ch : text) {
+      if (ch == ' ' || ch == ',' || ch == '\t' || ch == '\r') {
+        if (nonzero()) return true;
+        field.clear();
+      } else {
+        field += ch;
+      }
+    }
+    return nonzero();
   }
 
   void unsupported(const Block& b) {
@@ -886,8 +1006,10 @@ private:
                                     "SRC, SRP are ignored (rate-independent yield)",
                                     where_of(l2).str(), mid));
     if (card2.real(2, "FS") != 0)
-      m.notes.push_back(fmt::format("{}: material {}: the failure strain FS is ignored (anvil "
-                                    "does not erode elements)",
+      m.notes.push_back(fmt::format("{}: material {}: the failure strain FS is ignored: a "
+                                    "keyword deck does not map it to anvil's erosion, so these "
+                                    "elements are never deleted (a YAML deck's part key "
+                                    "`erosion: {{plastic_strain: ...}}` deletes them)",
                                     where_of(l2).str(), mid));
     add_material(card, mid, std::move(m));
   }
@@ -921,7 +1043,7 @@ private:
       m.params["youngs_modulus"] = E;
       m.params["poissons_ratio"] = nu;
     } else {
-      m.params["shear_modulus_only"] = G; // needs the EOS; see johnson_cook_bulk()
+      m.params["shear_modulus_only"] = G; // needs the EOS; completed per part in config()
     }
     if (c1.real(6, "VP") != 0)
       m.notes.push_back(fmt::format("{}: material {}: VP = 1 (viscoplastic rate form) is "
@@ -966,7 +1088,10 @@ private:
     failure = failure || c4.real(0, "D5") != 0 || c4.real(2, "EROD") != 0;
     if (failure)
       m.notes.push_back(fmt::format("{}: material {}: spall (PC, SPALL) and damage (D1-D5, "
-                                    "EROD) are ignored: anvil does not fail elements",
+                                    "EROD) are ignored: anvil's johnson_cook has no damage, and "
+                                    "a keyword deck does not set anvil's erosion (a YAML deck's "
+                                    "part key `erosion: {{plastic_strain: ...}}` deletes elements "
+                                    "at a plastic strain)",
                                     m.at.str(), mid));
     add_material(c1, mid, std::move(m));
   }
@@ -985,6 +1110,7 @@ private:
       }
       if (mid > 0) materials_.emplace(mid, MaterialCard{b.name, "", {}, {}, where_of(l)});
     }
+    c.skip_rest(); // the keyword is listed as ignored, whatever its cards
     unsupported(b);
   }
 
@@ -996,7 +1122,15 @@ private:
     const std::int64_t id = card.integer(0, "EOSID", 0);
     if (id <= 0) card.fail("EOSID", fmt::format("EOSID must be a positive id, found {}", id));
     EosCard e{b.name, 0, where_of(l)};
-    if (starts_with(b.name, "EOS_GRUNEISEN")) e.c = card.real(1, "C");
+    if (starts_with(b.name, "EOS_GRUNEISEN")) {
+      e.c = card.real(1, "C");
+      // Card 2 (V0, LCID) completes the Gruneisen form; its fields are not modelled.
+      const Line l2 = c.next();
+      const Card card2(b, l2, {10, 10, 10});
+      (void)card2;
+    } else {
+      c.skip_rest(); // other forms' cards vary; anvil models none of them
+    }
     const auto [it, fresh] = eos_.emplace(id, std::move(e));
     if (!fresh)
       card.fail("EOSID", fmt::format("equation of state {} is defined twice (first at {})", id,
@@ -1034,9 +1168,10 @@ private:
 
   void spc(const Block& b, bool set) {
     Cursor c(b);
-    const bool with_id = ends_with(b.name, "_ID");
+    // The _ID option adds one card (ID, HEADING) to the keyword, not one per constraint:
+    // any number of NID/NSID cards follow it (LS-DYNA manual, *BOUNDARY_SPC).
+    if (ends_with(b.name, "_ID")) c.next();
     while (!c.done()) {
-      if (with_id) c.next(); // ID and HEADING
       const Line l = c.next();
       const Card card(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
       const char* what = set ? "NSID" : "NID";
@@ -1152,6 +1287,7 @@ private:
     k.sfs = c3.real(0, "SFS", 1);
     if (k.sfs == 0) k.sfs = 1; // LS-DYNA's default
     if (k.sfs < 0) c3.fail("SFS", "the penalty scale SFS must be positive");
+    optional_cards(b, c, 7, true); // optional cards A to G
     k.at = where_of(l);
     k.keyword = b.name;
     contacts_.push_back(k);
@@ -1163,6 +1299,9 @@ private:
     const Card card(b, l, {10});
     slsfac_ = card.real(0, "SLSFAC", 0);
     if (slsfac_ < 0) card.fail("SLSFAC", "SLSFAC must not be negative");
+    // Card 2 and optional cards 3-7 tune LS-DYNA's contact algorithms, as do the other
+    // fields of card 1; anvil's contact has no such switches.
+    optional_cards(b, c, 6, false);
   }
 
   void rigidwall(const Block& b) {
@@ -1222,6 +1361,7 @@ private:
     if (card.integer(5, "LCTM", 0) != 0)
       warnings_.push_back(
           fmt::format("{}: LCTM (a time step limit curve) is ignored", where_of(l).str()));
+    optional_cards(b, c, 1, true); // card 2: mass scaling options
   }
 
   void control_hourglass(const Block& b) {
@@ -1252,6 +1392,17 @@ private:
     d3plot_dt_ = dt;
     d3plot_states_ = card.integer(3, "NPLTC", 0);
     if (d3plot_states_ < 0) card.fail("NPLTC", "NPLTC must not be negative");
+    // Output times and contents only: the run is the same, so a warning, not an error.
+    if (card.integer(1, "LCDT", 0) != 0)
+      warnings_.push_back(fmt::format("{}: *DATABASE_BINARY_D3PLOT: LCDT (a curve of output "
+                                      "intervals) is ignored: fields are written every {}",
+                                      where_of(l).str(),
+                                      d3plot_states_ > 0 ? "ENDTIM/NPLTC" : "DT"));
+    if (card.integer(4, "PSETID", 0) != 0)
+      warnings_.push_back(fmt::format("{}: *DATABASE_BINARY_D3PLOT: PSETID is ignored: every "
+                                      "part is written",
+                                      where_of(l).str()));
+    optional_cards(b, c, 1, false); // card 2: d3plot file options (IOOPT, RATE, ...)
   }
 
   void history_interval(const Block& b) {
@@ -1263,13 +1414,24 @@ private:
     if (dt > 0) history_dt_ = history_dt_ > 0 ? std::min(history_dt_, dt) : dt;
   }
 
-  void history_nodes(const Block& b) {
+  // *DATABASE_HISTORY_NODE (node ids) or _SET (node set ids), any number per card.
+  void history_nodes(const Block& b, bool sets) {
     Cursor c(b);
     while (auto l = c.next_record()) {
       const Card card(b, *l, {10, 10, 10, 10, 10, 10, 10, 10}, Card::Extra::keep);
       for (int k = 0; k < card.size(); ++k)
         if (const auto id = card.id(k, fmt::format("ID{}", k + 1)); id != 0)
-          history_nodes_.emplace_back(id, where_of(*l));
+          history_nodes_.push_back({id, sets, where_of(*l), "*" + b.name});
+    }
+  }
+
+  // *DATABASE_HISTORY_NODE_ID: one node per card, its ID and a HEADING (not used).
+  void history_nodes_id(const Block& b) {
+    Cursor c(b);
+    while (auto l = c.next_record()) {
+      const Card card(b, *l, {10, 70}, Card::Extra::keep);
+      if (const auto id = card.id(0, "ID"); id != 0)
+        history_nodes_.push_back({id, false, where_of(*l), "*" + b.name});
     }
   }
 
@@ -1400,7 +1562,13 @@ private:
   double control_qh_ = 0, control_q1_ = 0, control_q2_ = 0;
   double d3plot_dt_ = 0, history_dt_ = 0;
   std::int64_t d3plot_states_ = 0;
-  std::vector<std::pair<std::int64_t, Where>> history_nodes_;
+  struct HistoryNode {
+    std::int64_t id; // a node, or a node set
+    bool set;
+    Where at;
+    std::string keyword;
+  };
+  std::vector<HistoryNode> history_nodes_;
   std::vector<std::string> warnings_;
   std::map<std::string, Unsupported> unsupported_;
 };
@@ -1465,8 +1633,19 @@ Config KeywordReader::config(const std::string& deck_file) {
                      "no part has solid elements: anvil needs *PART and *ELEMENT_SOLID cards");
   Mesh mesh = build_mesh(order, true); // shared by the parts once complete (below)
 
-  // Materials, in order of first use; hourglass and bulk viscosity per part.
-  std::map<std::int64_t, std::string> material_names;
+  // Materials, in order of first use; hourglass and bulk viscosity per part. A
+  // *MAT_JOHNSON_COOK with G alone takes its bulk modulus from each part's own EOS, so
+  // parts that share it with different EOS get a material each (`mat<MID>_eos<EOSID>`).
+  std::map<std::int64_t, std::set<std::int64_t>> eos_of_material; // G-only MID -> EOSIDs
+  for (const auto pid : order) {
+    const PartCard& p = *std::find_if(parts_.begin(), parts_.end(),
+                                      [&](const PartCard& q) { return q.pid == pid; });
+    if (const auto m = materials_.find(p.mid);
+        m != materials_.end() && m->second.params.count("shear_modulus_only"))
+      eos_of_material[p.mid].insert(p.eosid);
+  }
+  std::set<std::string> material_names;
+  std::set<std::int64_t> material_notes_given;
   const std::string part_key = "*PART";
   for (std::size_t i = 0; i < order.size(); ++i) {
     const PartCard& p = *std::find_if(parts_.begin(), parts_.end(),
@@ -1500,14 +1679,22 @@ Config KeywordReader::config(const std::string& deck_file) {
     if (mat == materials_.end())
       throw InputError(p.at.loc("*PART.MID"),
                        fmt::format("part {}: material {} is not defined", p.pid, p.mid));
-    MaterialCard& mc = mat->second;
+    const MaterialCard& mc = mat->second;
     if (mc.model.empty())
       throw InputError(p.at.loc("*PART.MID"),
                        fmt::format("part {}: material {} is a *{} (at {}), which anvil does not "
                                    "have (supported: *MAT_ELASTIC, *MAT_PLASTIC_KINEMATIC, "
                                    "*MAT_JOHNSON_COOK)",
                                    p.pid, p.mid, mc.keyword, mc.at.str()));
-    const std::string mname = fmt::format("mat{}", p.mid);
+    std::string mname = fmt::format("mat{}", p.mid);
+    ParamValues params = mc.params; // this part's copy: its EOS may complete it
+    const bool g_only = params.count("shear_modulus_only") > 0;
+    if (g_only && p.eosid == 0)
+      throw InputError(mc.at.loc(fmt::format("*{}.PR", mc.keyword)),
+                       fmt::format("material {} gives only the shear modulus G; anvil needs PR "
+                                   "(or E) for its bulk modulus, or an *EOS_GRUNEISEN on every "
+                                   "part that uses it, but part {} (at {}) has no EOSID",
+                                   p.mid, p.pid, p.at.str()));
     // Equation of state: anvil's models carry their own linear elastic pressure.
     if (p.eosid != 0) {
       const auto e = eos_.find(p.eosid);
@@ -1515,9 +1702,9 @@ Config KeywordReader::config(const std::string& deck_file) {
         throw InputError(
             p.at.loc("*PART.EOSID"),
             fmt::format("part {}: equation of state {} is not defined", p.pid, p.eosid));
-      if (mc.params.count("shear_modulus_only")) {
+      if (g_only) {
         // *MAT_JOHNSON_COOK with G only: the EOS's bulk sound speed gives K = rho C^2.
-        const double G = mc.params["shear_modulus_only"], rho = mc.params["density"];
+        const double G = params["shear_modulus_only"], rho = params["density"];
         const double K = rho * e->second.c * e->second.c;
         const double nu = (3 * K - 2 * G) / (2 * (3 * K + G));
         if (!(K > 0) || !(nu > -1 && nu < 0.5))
@@ -1526,14 +1713,15 @@ Config KeywordReader::config(const std::string& deck_file) {
                                        "on the material card, or an *EOS_GRUNEISEN with a "
                                        "sound speed C, for its bulk modulus",
                                        p.pid, p.mid));
-        mc.params.erase("shear_modulus_only");
-        mc.params["youngs_modulus"] = 2 * G * (1 + nu);
-        mc.params["poissons_ratio"] = nu;
+        params.erase("shear_modulus_only");
+        params["youngs_modulus"] = 2 * G * (1 + nu);
+        params["poissons_ratio"] = nu;
+        if (eos_of_material[p.mid].size() > 1) mname += fmt::format("_eos{}", p.eosid);
         warnings.push_back(fmt::format(
-            "{}: part {}: *{} {} is not supported; anvil uses a linear elastic pressure with "
-            "the bulk modulus rho C^2 = {:.6g} Pa from its sound speed C (S1-S3, GAMA0 and "
-            "the energy term are ignored)",
-            p.at.str(), p.pid, e->second.keyword, p.eosid, K));
+            "{}: part {}: *{} {} is not modelled; anvil gives material {} (G only) the bulk "
+            "modulus rho C^2 = {:.6g} Pa of this EOS's sound speed C and a linear elastic "
+            "pressure (S1-S3, GAMA0 and the energy term are ignored)",
+            p.at.str(), p.pid, e->second.keyword, p.eosid, p.mid, K));
       } else {
         warnings.push_back(fmt::format(
             "{}: part {}: *{} {} is not supported; anvil computes the pressure of material {} "
@@ -1541,22 +1729,19 @@ Config KeywordReader::config(const std::string& deck_file) {
             p.at.str(), p.pid, e->second.keyword, p.eosid, p.mid));
       }
     }
-    if (mc.params.count("shear_modulus_only"))
-      throw InputError(mc.at.loc(fmt::format("*{}.PR", mc.keyword)),
-                       fmt::format("material {} gives only the shear modulus G; anvil needs PR "
-                                   "(or E) for its bulk modulus (no equation of state is given)",
-                                   p.mid));
-    if (material_names.emplace(p.mid, mname).second) {
-      MaterialConfig m{mname, mc.model, mc.params, {}, {}, mc.at.loc("*" + mc.keyword)};
+    if (material_names.insert(mname).second) {
+      MaterialConfig m{mname, mc.model, params, {}, {}, mc.at.loc("*" + mc.keyword)};
       complete_material(m);
-      const double rho = m.params["density"];
-      if (rho < 10 || rho > 1e5)
-        warnings.push_back(
-            fmt::format("{}: material {}: density {} looks like it is not in kg/m^3: "
-                        "anvil reads keyword decks in SI units (m, kg, s, Pa) "
-                        "and converts nothing",
-                        mc.at.str(), p.mid, rho));
-      for (const auto& n : mc.notes) warnings.push_back(n);
+      if (material_notes_given.insert(p.mid).second) {
+        const double rho = m.params["density"];
+        if (rho < 10 || rho > 1e5)
+          warnings.push_back(
+              fmt::format("{}: material {}: density {} looks like it is not in kg/m^3: "
+                          "anvil reads keyword decks in SI units (m, kg, s, Pa) "
+                          "and converts nothing",
+                          mc.at.str(), p.mid, rho));
+        for (const auto& n : mc.notes) warnings.push_back(n);
+      }
       c.materials.push_back(std::move(m));
     }
     pc.material = mname;
@@ -1748,39 +1933,88 @@ Config KeywordReader::config(const std::string& deck_file) {
     c.fields_every = d3plot_dt_;
   c.history_every = history_dt_;
 
-  // Probes: *DATABASE_HISTORY_NODE, at the node's position (anvil probes the nearest node,
-  // the lowest id among coincident ones).
+  // Probes: *DATABASE_HISTORY_NODE (and _ID, _SET), at the node's position. anvil probes
+  // the model's node nearest to a point, the lowest id among coincident ones; a node that
+  // no element uses is in no rank's model, so a probe there would follow another node.
+  std::vector<char> used(nodes_.size(), 0);
+  for (const auto& e : elements_)
+    for (const auto n : e.nodes) used[static_cast<std::size_t>(node_index_.at(n))] = 1;
   std::set<std::int64_t> probed;
   std::map<std::array<double, 3>, std::int64_t> first_at; // position -> first node there
   if (!history_nodes_.empty())
     for (std::size_t j = 0; j < nodes_.size(); ++j)
-      first_at.emplace(std::array<double, 3>{nodes_[j].x, nodes_[j].y, nodes_[j].z},
-                       static_cast<std::int64_t>(j));
-  for (const auto& [nid, at] : history_nodes_) {
-    const auto pos = node_position(nid, at, "*DATABASE_HISTORY_NODE", "the history node list");
-    if (!probed.insert(nid).second) continue;
-    const Vec3 x = nodes_[pos];
+      if (used[j])
+        first_at.emplace(std::array<double, 3>{nodes_[j].x, nodes_[j].y, nodes_[j].z},
+                         static_cast<std::int64_t>(j));
+  auto probe = [&](std::int64_t pos, const HistoryNode& h) {
+    const std::int64_t nid = node_ids_[static_cast<std::size_t>(pos)];
+    if (!probed.insert(nid).second) return;
+    const Vec3 x = nodes_[static_cast<std::size_t>(pos)];
     const std::int64_t j = first_at.at({x.x, x.y, x.z});
     if (j != pos)
       warnings.push_back(fmt::format("{}: history node {} lies on node {} (same coordinates); "
                                      "the probe follows node {}",
-                                     at.str(), nid, node_ids_[j], node_ids_[j]));
-    c.probes.push_back(
-        ProbeConfig{fmt::format("node{}", nid), x, at.loc("*DATABASE_HISTORY_NODE")});
+                                     h.at.str(), nid, node_ids_[j], node_ids_[j]));
+    c.probes.push_back(ProbeConfig{fmt::format("node{}", nid), x, h.at.loc(h.keyword)});
+  };
+  for (const auto& h : history_nodes_) {
+    if (!h.set) {
+      const auto pos = node_position(h.id, h.at, h.keyword + ".ID", "the history node list");
+      if (!used[static_cast<std::size_t>(pos)])
+        throw InputError(h.at.loc(h.keyword + ".ID"),
+                         fmt::format("history node {} belongs to no solid element: anvil's model "
+                                     "holds only the nodes of its elements, so nothing there "
+                                     "can be recorded",
+                                     h.id));
+      probe(pos, h);
+      continue;
+    }
+    // A set's nodes that no element uses (a left-out shell part's) are skipped, said once.
+    const auto it = node_sets_.find(h.id);
+    if (it == node_sets_.end())
+      throw InputError(h.at.loc(h.keyword + ".ID"),
+                       fmt::format("node set {} is not defined (*SET_NODE_LIST)", h.id));
+    std::vector<std::int64_t> unused;
+    for (const auto pos : resolve_node_set(h.id, it->second)) {
+      if (used[static_cast<std::size_t>(pos)])
+        probe(pos, h);
+      else
+        unused.push_back(node_ids_[static_cast<std::size_t>(pos)]);
+    }
+    if (!unused.empty())
+      warnings.push_back(fmt::format("{}: {} node{} of history node set {} (node {}{}) belong "
+                                     "to no solid element and get no probe",
+                                     h.at.str(), unused.size(), unused.size() == 1 ? "" : "s", h.id,
+                                     unused.front(), unused.size() > 1 ? ", ..." : ""));
   }
 
   // One warning lists every keyword anvil ignored.
-  if (!unsupported_.empty()) {
-    std::string list;
-    for (const auto& [name, u] : unsupported_)
-      list += fmt::format("{}*{} ({}x, first at {})", list.empty() ? "" : ", ", name, u.count,
-                          u.first.str());
-    warnings.push_back(fmt::format("{}: {} keyword{} not supported by anvil and ignored: {}",
-                                   deck_file, unsupported_.size(),
-                                   unsupported_.size() == 1 ? " is" : "s are", list));
-  }
+  if (std::string w = ignored_keywords(deck_file); !w.empty()) warnings.push_back(std::move(w));
   c.warnings = std::move(warnings);
   return c;
+}
+
+std::string KeywordReader::ignored_keywords(const std::string& deck_file) const {
+  if (unsupported_.empty()) return "";
+  std::string list;
+  for (const auto& [name, u] : unsupported_)
+    list += fmt::format("{}*{} ({}x, first at {})", list.empty() ? "" : ", ", name, u.count,
+                        u.first.str());
+  return fmt::format("{}: {} keyword{} not supported by anvil and ignored: {}", deck_file,
+                     unsupported_.size(), unsupported_.size() == 1 ? " is" : "s are", list);
+}
+
+InputError KeywordReader::with_ignored_keywords(const InputError& e,
+                                                const std::string& deck_file) const {
+  const std::string w = ignored_keywords(deck_file);
+  if (w.empty()) return e;
+  // The warning goes on a line of its own after the error, as `anvil` prints warnings:
+  // an ignored keyword (a *PART_CONTACT) is often the cause of the error (its part "not
+  // defined"), and the warning is otherwise lost with the Config.
+  const std::string what = e.what(), prefix = e.where().str() + ": ";
+  const std::string note = "\nanvil: warning: " + w;
+  if (starts_with(what, prefix)) return InputError(e.where(), what.substr(prefix.size()) + note);
+  return InputError(what + note);
 }
 
 // Runs `f`, turning allocation failures on absurd input into an InputError.
@@ -1820,8 +2054,12 @@ Config parse_keyword_deck(std::string_view text, const std::string& name,
     Lexer lex(true);
     lex.lex_main(text, name, base_dir);
     KeywordReader r(false);
-    r.read(lex.blocks());
-    return r.config(name);
+    try {
+      r.read(lex.blocks());
+      return r.config(name);
+    } catch (const InputError& e) {
+      throw r.with_ignored_keywords(e, name);
+    }
   });
 }
 
