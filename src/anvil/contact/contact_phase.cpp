@@ -186,6 +186,7 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
   }
   std::sort(faces_by_element_.begin(), faces_by_element_.end());
   live_ = static_cast<std::size_t>(std::count(face_active_.begin(), face_active_.end(), 1));
+  list_live_faces();
   my_face_rank_.assign(my_face_gid_.size(), comm.rank());
   const std::size_t nf_all = my_face_gid_.size();
   // The fields of the items that never change (ids, owners, penalty data), set once.
@@ -385,7 +386,24 @@ void ContactPhase::set_eroded(std::span<const std::int64_t> fresh, bool exposing
     }
   }
   if (!changed) return;
+  list_live_faces();
   ++surface_version_;
+}
+
+void ContactPhase::list_live_faces() {
+  live_faces_.clear();
+  if (live_ == face_active_.size()) return; // (every face: no list needed)
+  for (std::size_t f = 0; f < face_active_.size(); ++f)
+    if (face_active_[f] != 0) live_faces_.push_back(static_cast<int>(f));
+}
+
+// The planes and boxes of the live faces: of an eroding part's interior faces, which
+// outnumber its exterior ones several times, only those erosion has exposed.
+void ContactPhase::compute_live_captures() {
+  if (live_ == my_face_gid_.size())
+    compute_captures(corners(), cap_);
+  else
+    compute_captures(corners(), live_faces_, cap_);
 }
 
 FaceCorners ContactPhase::corners() const {
@@ -1041,7 +1059,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       bound_ok = shared_bound_holds();
       if (bound_ok && !fail_.empty()) bound_ok = rebase_faces();
     }
-    if (!lazy_cycle && !bound_ok) compute_captures(corners(), cap_);
+    if (!lazy_cycle && !bound_ok) compute_live_captures();
     if (lazy_cycle) {
       // One rank, the lists valid: the search reads the nodes with candidates only (in
       // place: the item of node k is node_out_[k]).
@@ -1181,7 +1199,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       if (!alone && bound_ok) {
         // Some other rank's bound failed: this rank keeps its destinations, and its items
         // go in full.
-        compute_captures(corners(), cap_);
+        compute_live_captures();
         node_out_.resize(my_nodes_.size());
         for (std::size_t k = 0; k < my_nodes_.size(); ++k) pack_node(k, nd, node_out_[k]);
       }

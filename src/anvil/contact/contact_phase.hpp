@@ -166,6 +166,7 @@ private:
   int exposed_age_ = 0;               // 1: set_eroded() exposed faces this cycle; 2: last cycle
   std::vector<int> my_face_rank_;     // contact rank of the centroid, last cycle
   std::size_t live_ = 0;              // faces active (face_active_)
+  std::vector<int> live_faces_;       // the active faces, ascending, when not every face is
   std::uint64_t surface_version_ = 0; // counts the changes of face_active_
   // The surface's points on this rank: the owned contact nodes and the corners of the
   // faces above (local node indices, ascending), with their predicted positions, computed
@@ -352,6 +353,8 @@ private:
   // Face f is on the surface: its element has not eroded, and it is exterior or erosion
   // has removed the element across it.
   bool active(std::size_t f) const { return face_active_[f] != 0; }
+  void list_live_faces();
+  void compute_live_captures();
   // Several ranks: node and face destinations (faces by their enlarged capture box); true
   // when they differ from those the plans were built for.
   bool compute_destinations(std::size_t live);
