@@ -32,9 +32,18 @@ std::vector<std::uint8_t> Simulation::select_particles(const Selection& sel) con
     set = config_.particle_set(*sel.part);
     if (set < 0) return out; // a finite-element part
   }
+  // Below 3 dimensions every particle lies on the plane z = 0 (the line y = z = 0)
+  // whatever z (y) range its set was given, so a box selects by the model's coordinates
+  // only: a box drawn around the set's shape still selects it.
+  const int dims = config_.sph.dimensions;
+  auto inside = [&](std::size_t i) {
+    for (int c = 0; c < dims; ++c)
+      if (!(pt.x[c][i] >= sel.box->lo[c] && pt.x[c][i] <= sel.box->hi[c])) return false;
+    return true;
+  };
   for (std::size_t i = 0; i < n; ++i) {
     if (set >= 0 && pt.set[i] != set) continue;
-    if (sel.box && !sel.box->contains({pt.x[0][i], pt.x[1][i], pt.x[2][i]})) continue;
+    if (sel.box && !inside(i)) continue;
     out[i] = 1;
   }
   return out;
@@ -112,6 +121,14 @@ void Simulation::apply_particle_boundary_conditions() {
       }
     }
   }
+  // Plane strain (1-D: uniaxial strain): the out-of-model velocity components are held
+  // at 0, so that every particle stays on the model's plane (line). An initial velocity
+  // there is removed at t = 0 like any constrained component (external work).
+  for (std::size_t i = 0; i < pt.size(); ++i)
+    for (int k = config_.sph.dimensions; k < 3; ++k) {
+      pt.constrained[i] |= static_cast<std::uint8_t>(1u << k);
+      pt.v_bc[k][i] = 0.0;
+    }
   for (std::size_t i = 0; i < pt.size(); ++i)
     for (int k = 0; k < 3; ++k)
       if (pt.constrained[i] & (1u << k)) pt.v[k][i] = pt.v_bc[k][i];
