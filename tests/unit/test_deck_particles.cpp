@@ -314,3 +314,39 @@ particles:
   }
   EXPECT_GT(vx, 0.1); // the tube did run
 }
+
+// The particle step bounds the move per step to 0.3 h (sph.md, "stable step"): two gas
+// streams at +-2000 m/s, out of each other's support, moved 3 h in the first step and
+// the run failed; a cold gas (c = 0) in motion took dt = 9e299 s.
+TEST(DeckParticles, StepBoundsTheMovePerStep) {
+  const char* streams = R"(termination: {cycles: 40}
+materials:
+  gas: {model: ideal_gas, density: 1.0, gamma: 1.4, specific_energy: 4000}
+particles:
+  a: {generate: {shape: box, min: [-0.00325, 0, 0], max: [-0.00125, 0.002, 0.002], spacing: 2.5e-4},
+      material: gas}
+  b: {generate: {shape: box, min: [0.00125, 0, 0], max: [0.00325, 0.002, 0.002], spacing: 2.5e-4},
+      material: gas}
+initial_conditions:
+  - {part: a, velocity: [2000, 0, 0]}
+  - {part: b, velocity: [-2000, 0, 0]}
+)";
+  Simulation sim(test::deck(streams), Comm::world());
+  const double h = 1.3 * 2.5e-4;
+  sim.step();
+  EXPECT_LE(sim.clock().dt * 2000, 0.3 * h * (1 + 1e-12));
+  while (!sim.finished()) sim.step(); // no non-finite force (a RunError) on the way
+
+  Simulation cold(test::deck(R"(termination: {cycles: 3}
+materials:
+  gas: {model: ideal_gas, density: 1.0, gamma: 1.4, specific_energy: 0}
+particles:
+  a: {generate: {shape: box, min: [0, 0, 0], max: [0.002, 0.002, 0.002], spacing: 5.0e-4},
+      material: gas}
+initial_conditions:
+  - {part: a, velocity: [10, 0, 0]}
+)"),
+                  Comm::world());
+  cold.step();
+  EXPECT_NEAR(cold.clock().dt, 0.9 * 0.3 * 1.3 * 5.0e-4 / 10, 1e-12); // scale 0.9
+}
