@@ -229,6 +229,36 @@ TEST(Eos, MieGruneisenReplacesThePressure) {
 
 } // namespace
 
+namespace {
+
+// The InputError a deck gives when a Simulation is built from it (empty if none).
+std::string setup_error(const std::string& text) {
+  try {
+    Simulation sim(test::deck(text, "deck.yaml"), Comm::world());
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+bool has_warning(const Simulation& sim, const std::string& fragment) {
+  return std::any_of(sim.warnings().begin(), sim.warnings().end(),
+                     [&](const std::string& w) { return w.find(fragment) != std::string::npos; });
+}
+
+const char* hybrid = R"(termination: {cycles: 5}
+materials:
+  steel: {model: elastic, density: 7830, youngs_modulus: 200.0e9, poissons_ratio: 0.29}
+parts:
+  plate: {mesh: {generate: box, min: [-0.004, -0.004, -0.001], max: [0.004, 0.004, 0],
+                 divisions: [4, 4, 1]}, material: steel}
+particles:
+  ball: {generate: {shape: sphere, center: [0, 0, 0.002], radius: 1.5e-3, spacing: 5.0e-4},
+         material: steel}
+)";
+
+} // namespace
+
 // Below 3 dimensions every set lies on the model's plane z = 0 (line y = z = 0), whatever
 // extent its shape was given there: a 2-D cylinder on its section (not its base), a box
 // off the plane on it, a 1-D box off the line on it (QA round 5: each set was on its
@@ -349,4 +379,28 @@ initial_conditions:
                   Comm::world());
   cold.step();
   EXPECT_NEAR(cold.clock().dt, 0.9 * 0.3 * 1.3 * 5.0e-4 / 10, 1e-12); // scale 0.9
+}
+
+// A node set whose box misses the particle set it names says so (it said "part 'ball'
+// is not defined"); an unused node set that selects nothing is an error, for particles
+// and for elements (deck.md, node_sets).
+TEST(DeckParticles, EmptyNodeSetsAreErrors) {
+  std::string used = std::string(hybrid) + R"(node_sets:
+  s: {part: ball, box: {min: [1, 1, 1], max: [2, 2, 2]}}
+boundary_conditions:
+  - {set: s, velocity: [0, 0, -10.0]}
+)";
+  std::string e = setup_error(used);
+  EXPECT_NE(e.find("the box selects no particle of set 'ball'"), std::string::npos) << e;
+  EXPECT_NE(e.find("node_sets.s"), std::string::npos) << e;
+  for (const std::string part : {"ball", "plate"}) {
+    const std::string unused = std::string(hybrid) + "node_sets:\n  s: {part: " + part +
+                               ", box: {min: [1, 1, 1], max: [2, 2, 2]}}\n";
+    e = setup_error(unused);
+    EXPECT_NE(e.find("node_sets.s"), std::string::npos) << part << ": " << e;
+    const std::string says = part == "ball" ? "selects no particle" : "contains no nodes";
+    EXPECT_NE(e.find(says), std::string::npos) << part << ": " << e;
+  }
+  e = setup_error(std::string(hybrid) + "contact:\n  - {parts: [plate, bal]}\n");
+  EXPECT_NE(e.find("part 'bal' is not defined under parts or particles"), std::string::npos) << e;
 }

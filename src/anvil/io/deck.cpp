@@ -908,7 +908,7 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
           for (const auto& it : p.items()) {
             const std::string name = it.str();
             if (!part_exists(name))
-              it.fail(fmt::format("part '{}' is not defined under parts", name));
+              it.fail(fmt::format("part '{}' is not defined under parts or particles", name));
             cc.parts.push_back(name);
           }
           if (cc.parts.empty()) p.fail("give a list of parts or 'all'");

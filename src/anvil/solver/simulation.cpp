@@ -113,6 +113,9 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
             std::find(config_.contact[0].parts.begin(), config_.contact[0].parts.end(),
                       config_.particles[s].name) != config_.contact[0].parts.end();
   }
+  // Every deck node set must select something (deck.md), used or not: a set that
+  // selects nothing is a mistake whether or not a condition names it yet.
+  for (const auto& [name, sel] : config_.node_sets) (void)selected_nodes(mesh, sel);
   apply_initial_conditions(mesh);
   // Constraints stop the constrained velocity components at once (a node on a fixed
   // impact face hits the wall at t = 0): the kinetic energy they remove is work done by

@@ -51,6 +51,11 @@ std::vector<std::uint8_t> Simulation::select_particles(const Selection& sel) con
 
 std::vector<std::int64_t> Simulation::selected_nodes(const Mesh& mesh, const Selection& sel) const {
   if (!sph_) return resolve_selection(mesh, config_, sel);
+  // A deck node set is an inline selection: resolved as one, so that its errors are its
+  // own (a box that selects none of a particle set's particles, below).
+  if (!sel.name.empty())
+    if (const auto it = config_.node_sets.find(sel.name); it != config_.node_sets.end())
+      return selected_nodes(mesh, it->second);
   std::vector<std::int64_t> ids;
   std::optional<InputError> error;
   const bool names_particles = sel.part && config_.particle_set(*sel.part) >= 0;
@@ -65,6 +70,10 @@ std::vector<std::int64_t> Simulation::selected_nodes(const Mesh& mesh, const Sel
   const std::int64_t particles =
       comm_.sum(static_cast<std::int64_t>(std::count(mask.begin(), mask.end(), 1)));
   if (ids.empty() && particles == 0) {
+    // A particle set always holds particles: only its box can leave it empty.
+    if (names_particles)
+      throw InputError(sel.where,
+                       fmt::format("the box selects no particle of set '{}'", *sel.part));
     // An unknown set is best told by the node resolution's own message.
     if (error && !(sel.name.empty() && !sel.part)) throw *error;
     throw InputError(sel.where, "the selection contains no nodes or particles");
