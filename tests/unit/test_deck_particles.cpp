@@ -404,3 +404,18 @@ boundary_conditions:
   e = setup_error(std::string(hybrid) + "contact:\n  - {parts: [plate, bal]}\n");
   EXPECT_NE(e.find("part 'bal' is not defined under parts or particles"), std::string::npos) << e;
 }
+
+// Particle contact that cannot act is warned of: a contact of particle sets alone, and
+// particles that start inside an element of a part in contact.
+TEST(DeckParticles, WarnsOfParticleContactThatCannotAct) {
+  Simulation alone(test::deck(std::string(hybrid) + "contact:\n  - {parts: [ball]}\n"),
+                   Comm::world());
+  EXPECT_TRUE(has_warning(alone, "no finite-element part"));
+  Simulation both(test::deck(std::string(hybrid) + "contact:\n  - {parts: all}\n"), Comm::world());
+  EXPECT_FALSE(has_warning(both, "no finite-element part"));
+  EXPECT_FALSE(has_warning(both, "start inside"));
+  std::string sunk = std::string(hybrid) + "contact:\n  - {parts: all}\n";
+  sunk.replace(sunk.find("center: [0, 0, 0.002]"), 21, "center: [0, 0, 0.0002]");
+  Simulation inside(test::deck(sunk), Comm::world());
+  EXPECT_TRUE(has_warning(inside, "start inside elements"));
+}
