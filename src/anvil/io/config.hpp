@@ -74,7 +74,7 @@ struct ParticleSetConfig {
   std::string name;
   LatticeSpec lattice;
   std::string material;
-  double smoothing_ratio = 1.3; // h = ratio * spacing
+  double smoothing_ratio = 1.3; // h = ratio * (lattice cell volume)^(1/dimensions)
   Kernel kernel = Kernel::cubic_spline;
   double viscosity_linear = 1.0;    // Monaghan-Gingold alpha
   double viscosity_quadratic = 2.0; // Monaghan-Gingold beta

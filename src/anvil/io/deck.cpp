@@ -511,7 +511,8 @@ ParticleSetConfig parse_particle_set(const std::string& name, const Node& n) {
   if (n.has("smoothing_ratio")) {
     p.smoothing_ratio = n.child("smoothing_ratio").positive();
     if (p.smoothing_ratio < 0.8 || p.smoothing_ratio > 3)
-      n.child("smoothing_ratio").fail("must be between 0.8 and 3 (h = ratio * spacing)");
+      n.child("smoothing_ratio")
+          .fail("must be between 0.8 and 3 (h = ratio * (cell volume)^(1/dimensions))");
   }
   if (n.has("kernel")) {
     const std::string k = n.child("kernel").str();
@@ -908,7 +909,7 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
           for (const auto& it : p.items()) {
             const std::string name = it.str();
             if (!part_exists(name))
-              it.fail(fmt::format("part '{}' is not defined under parts", name));
+              it.fail(fmt::format("part '{}' is not defined under parts or particles", name));
             cc.parts.push_back(name);
           }
           if (cc.parts.empty()) p.fail("give a list of parts or 'all'");

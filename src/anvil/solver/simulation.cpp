@@ -131,6 +131,9 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
             std::find(config_.contact[0].parts.begin(), config_.contact[0].parts.end(),
                       config_.particles[s].name) != config_.contact[0].parts.end();
   }
+  // Every deck node set must select something (deck.md), used or not: a set that
+  // selects nothing is a mistake whether or not a condition names it yet.
+  for (const auto& [name, sel] : config_.node_sets) (void)selected_nodes(mesh, sel);
   apply_initial_conditions(mesh);
   // Constraints stop the constrained velocity components at once (a node on a fixed
   // impact face hits the wall at t = 0): the kinetic energy they remove is work done by
@@ -155,14 +158,17 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
   initial_energy_ = ke_given + comm_.sum(particle_internal_energy());
   const double ke_kept = comm_.sum(kinetic_local_);
   if (comm_.rank() == 0) external_work_ = ke_kept - ke_given; // counted once, on rank 0
-  warn_of_setup();
+  warn_of_setup(mesh);
 }
 
 // What the setup finds questionable, for the user: nodes and particles that start behind
 // a rigid wall (the first step puts them on it, with whatever velocity that takes: a deck
-// may mean it, or a wall cuts a corner), and probes outside the model (each takes the
-// nearest node or particle, wherever that is). Collective.
-void Simulation::warn_of_setup() {
+// may mean it, or a wall cuts a corner), probes outside the model (each takes the
+// nearest node or particle, wherever that is), and particle contact that cannot act:
+// particles meet only element faces, so a contact of particle sets alone touches nothing,
+// and particles that start inside an element in contact never came through its faces.
+// Collective.
+void Simulation::warn_of_setup(const Mesh& mesh) {
   // The model's bounding box, for the tolerances.
   Vec3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
           std::numeric_limits<double>::infinity()};
@@ -211,6 +217,24 @@ void Simulation::warn_of_setup() {
           "{}: {} nodes or particles start behind rigid wall {}; the first step moves them "
           "onto it (with the velocity that takes; its impulse is external work)",
           walls[w].where.str(), behind[w], w));
+  if (contact_ && sph_ &&
+      std::find(sph_contact_set_.begin(), sph_contact_set_.end(), 1) != sph_contact_set_.end()) {
+    const auto& listed = config_.contact[0].parts;
+    const bool any_part =
+        std::any_of(config_.parts.begin(), config_.parts.end(), [&](const PartConfig& p) {
+          return listed.empty() || std::find(listed.begin(), listed.end(), p.name) != listed.end();
+        });
+    if (!any_part)
+      warnings_.push_back(fmt::format(
+          "{}: contact lists particle sets but no finite-element part: particles touch only "
+          "the faces of elements in contact, so they touch nothing (list the parts they hit)",
+          config_.contact[0].where.str()));
+    else if (const std::int64_t inside = particles_inside_contact_parts(mesh); inside > 0)
+      warnings_.push_back(fmt::format(
+          "{}: {} particles start inside elements of parts in contact; contact takes a particle "
+          "only when it comes through a face, so it ignores these",
+          config_.contact[0].where.str(), inside));
+  }
   for (const auto& probe : config_.probes) {
     const double margin = 0.01 * size;
     bool outside = false;

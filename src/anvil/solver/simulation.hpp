@@ -128,7 +128,7 @@ private:
   void detect_contacts();
   void correct();
   void share_eroded(bool exposing = true);
-  void warn_of_setup();
+  void warn_of_setup(const Mesh& mesh);
   void apply_walls();             // the rigid walls' part of correct()
   void sample_probe_velocities(); // at the end of correct()
   ContactNodes contact_view();
@@ -154,6 +154,9 @@ private:
   void update_particles(double dt);
   // restore() for the particles; `from` names the checkpoint in messages. Collective.
   void restore_particles(const Checkpoint& c, const std::string& from);
+  // Particles of the sets in contact that start inside an element of a part in contact
+  // (global count; the setup's warning). Collective.
+  std::int64_t particles_inside_contact_parts(const Mesh& mesh) const;
 
   Config config_;
   const Comm& comm_;

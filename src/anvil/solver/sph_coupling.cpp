@@ -4,7 +4,10 @@
 // coupled to the mesh only through contact: each is a contact node (slave) against the
 // exterior faces, with an id after every node and face id.
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <limits>
+#include <map>
 #include <optional>
 
 #include <fmt/format.h>
@@ -32,9 +35,18 @@ std::vector<std::uint8_t> Simulation::select_particles(const Selection& sel) con
     set = config_.particle_set(*sel.part);
     if (set < 0) return out; // a finite-element part
   }
+  // Below 3 dimensions every particle lies on the plane z = 0 (the line y = z = 0)
+  // whatever z (y) range its set was given, so a box selects by the model's coordinates
+  // only: a box drawn around the set's shape still selects it.
+  const int dims = config_.sph.dimensions;
+  auto inside = [&](std::size_t i) {
+    for (int c = 0; c < dims; ++c)
+      if (!(pt.x[c][i] >= sel.box->lo[c] && pt.x[c][i] <= sel.box->hi[c])) return false;
+    return true;
+  };
   for (std::size_t i = 0; i < n; ++i) {
     if (set >= 0 && pt.set[i] != set) continue;
-    if (sel.box && !sel.box->contains({pt.x[0][i], pt.x[1][i], pt.x[2][i]})) continue;
+    if (sel.box && !inside(i)) continue;
     out[i] = 1;
   }
   return out;
@@ -42,6 +54,11 @@ std::vector<std::uint8_t> Simulation::select_particles(const Selection& sel) con
 
 std::vector<std::int64_t> Simulation::selected_nodes(const Mesh& mesh, const Selection& sel) const {
   if (!sph_) return resolve_selection(mesh, config_, sel);
+  // A deck node set is an inline selection: resolved as one, so that its errors are its
+  // own (a box that selects none of a particle set's particles, below).
+  if (!sel.name.empty())
+    if (const auto it = config_.node_sets.find(sel.name); it != config_.node_sets.end())
+      return selected_nodes(mesh, it->second);
   std::vector<std::int64_t> ids;
   std::optional<InputError> error;
   const bool names_particles = sel.part && config_.particle_set(*sel.part) >= 0;
@@ -56,6 +73,10 @@ std::vector<std::int64_t> Simulation::selected_nodes(const Mesh& mesh, const Sel
   const std::int64_t particles =
       comm_.sum(static_cast<std::int64_t>(std::count(mask.begin(), mask.end(), 1)));
   if (ids.empty() && particles == 0) {
+    // A particle set always holds particles: only its box can leave it empty.
+    if (names_particles)
+      throw InputError(sel.where,
+                       fmt::format("the box selects no particle of set '{}'", *sel.part));
     // An unknown set is best told by the node resolution's own message.
     if (error && !(sel.name.empty() && !sel.part)) throw *error;
     throw InputError(sel.where, "the selection contains no nodes or particles");
@@ -112,6 +133,14 @@ void Simulation::apply_particle_boundary_conditions() {
       }
     }
   }
+  // Plane strain (1-D: uniaxial strain): the out-of-model velocity components are held
+  // at 0, so that every particle stays on the model's plane (line). An initial velocity
+  // there is removed at t = 0 like any constrained component (external work).
+  for (std::size_t i = 0; i < pt.size(); ++i)
+    for (int k = config_.sph.dimensions; k < 3; ++k) {
+      pt.constrained[i] |= static_cast<std::uint8_t>(1u << k);
+      pt.v_bc[k][i] = 0.0;
+    }
   for (std::size_t i = 0; i < pt.size(); ++i)
     for (int k = 0; k < 3; ++k)
       if (pt.constrained[i] & (1u << k)) pt.v[k][i] = pt.v_bc[k][i];
@@ -258,6 +287,80 @@ void Simulation::restore_particles(const Checkpoint& c, const std::string& from)
     pt.last_face[i] = c.particle_face[k];
   }
   sph_->redistribute();
+}
+
+// Own particles of the sets in contact are binned on a grid of the mean element size;
+// each element of a part in contact tests the particles in the cells its bounding box
+// covers: inside when behind the plane of every face (through the face's centre, normal
+// the cross product of its diagonals: exact for flat faces, and a warning's accuracy
+// for warped ones). Each particle counts once.
+std::int64_t Simulation::particles_inside_contact_parts(const Mesh& mesh) const {
+  const auto& pt = sph_->particles();
+  const auto& listed = config_.contact[0].parts;
+  std::vector<std::size_t> blocks;
+  for (std::size_t b = 0; b < mesh.blocks.size(); ++b)
+    if (listed.empty() ||
+        std::find(listed.begin(), listed.end(), mesh.blocks[b].name) != listed.end())
+      blocks.push_back(b);
+  auto corners = [&](const Hex& e) {
+    std::array<Vec3, 8> x;
+    for (int k = 0; k < 8; ++k) x[k] = mesh.nodes[static_cast<std::size_t>(e[k])];
+    return x;
+  };
+  auto bounds = [](const std::array<Vec3, 8>& x) {
+    Box3 b{x[0], x[0]};
+    for (const Vec3& q : x)
+      for (int i = 0; i < 3; ++i) {
+        b.lo[i] = std::min(b.lo[i], q[i]);
+        b.hi[i] = std::max(b.hi[i], q[i]);
+      }
+    return b;
+  };
+  double extent = 0;
+  std::int64_t elements = 0;
+  for (std::size_t b : blocks)
+    for (const Hex& e : mesh.blocks[b].elements) {
+      const Box3 bb = bounds(corners(e));
+      extent += std::max({bb.hi.x - bb.lo.x, bb.hi.y - bb.lo.y, bb.hi.z - bb.lo.z});
+      ++elements;
+    }
+  std::int64_t inside = 0;
+  if (elements > 0 && extent > 0) {
+    const double cell = extent / static_cast<double>(elements);
+    auto key = [cell](double a) { return static_cast<std::int64_t>(std::floor(a / cell)); };
+    std::map<std::array<std::int64_t, 3>, std::vector<std::size_t>> grid;
+    for (std::size_t i = 0; i < pt.size(); ++i)
+      if (sph_contact_set_[static_cast<std::size_t>(pt.set[i])])
+        grid[{key(pt.x[0][i]), key(pt.x[1][i]), key(pt.x[2][i])}].push_back(i);
+    std::vector<std::uint8_t> found(pt.size(), 0);
+    for (std::size_t b : blocks)
+      for (const Hex& e : mesh.blocks[b].elements) {
+        const auto x = corners(e);
+        const Box3 bb = bounds(x);
+        Vec3 centre[6], normal[6];
+        for (int f = 0; f < 6; ++f) {
+          const auto& q = hex_faces[static_cast<std::size_t>(f)];
+          centre[f] = 0.25 * (x[q[0]] + x[q[1]] + x[q[2]] + x[q[3]]);
+          normal[f] = cross(x[q[2]] - x[q[0]], x[q[3]] - x[q[1]]);
+        }
+        const std::int64_t l[3] = {key(bb.lo.x), key(bb.lo.y), key(bb.lo.z)};
+        const std::int64_t h[3] = {key(bb.hi.x), key(bb.hi.y), key(bb.hi.z)};
+        for (std::int64_t a = l[0]; a <= h[0]; ++a)
+          for (std::int64_t c = l[1]; c <= h[1]; ++c)
+            for (std::int64_t d = l[2]; d <= h[2]; ++d) {
+              const auto it = grid.find({a, c, d});
+              if (it == grid.end()) continue;
+              for (std::size_t i : it->second) {
+                const Vec3 p{pt.x[0][i], pt.x[1][i], pt.x[2][i]};
+                bool in = true;
+                for (int f = 0; f < 6 && in; ++f) in = dot(p - centre[f], normal[f]) < 0;
+                found[i] |= in ? 1 : 0;
+              }
+            }
+      }
+    inside = static_cast<std::int64_t>(std::count(found.begin(), found.end(), 1));
+  }
+  return comm_.sum(inside);
 }
 
 } // namespace anvil

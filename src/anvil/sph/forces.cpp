@@ -869,7 +869,10 @@ void forces_pairs(const SphView& p, std::span<const SetParams> sets, SphWorkspac
     for (int a = 0; a < 3; ++a) p.force[a][i] = pi[R2::mass] * acc[a];
     p.energy_rate[i] = de;
     const double ci = pi[R2::c];
-    const double dt = courant * pi[R2::h] / (ci + 1.2 * (si.alpha * ci + si.beta * mu_max));
+    double dt = courant * pi[R2::h] / (ci + 1.2 * (si.alpha * ci + si.beta * mu_max));
+    const double v2 =
+        pi[R2::v] * pi[R2::v] + pi[R2::v + 1] * pi[R2::v + 1] + pi[R2::v + 2] * pi[R2::v + 2];
+    if (v2 > 0) dt = std::min(dt, max_move * pi[R2::h] / std::sqrt(v2));
     if (dt < res.dt_stable || (dt == res.dt_stable && p.gid[i] < res.stable_gid)) {
       res.dt_stable = dt;
       res.stable_gid = p.gid[i];

@@ -67,6 +67,15 @@ struct SetParams {
 // beta max_j |mu_ij|)) (Monaghan 1992).
 inline constexpr double courant = 0.3;
 
+// Largest move of a particle in one step, as a fraction of its h: dt_i <= move h_i / |v_i|
+// (v(n - 1/2)). The Courant condition bounds the step by the sound speed and the
+// approach of neighbours only: bodies approaching from outside each other's support, or
+// a cold gas (c = 0), would otherwise jump through the kernel support in one step (or
+// take an unbounded step). The same 0.3 as the Courant number: a particle moves no
+// further in a step than a sound wave may, as LS-DYNA's SPH step h / (c + |v|) and
+// LAMMPS's `fix dt/reset` (a largest displacement Xmax per step) bound it.
+inline constexpr double max_move = 0.3;
+
 // Arrays over the particles of one rank: own particles [0, n_local), ghost copies after
 // them up to n_all. `in` arrays hold n_all values, `own` arrays n_local, `all` arrays
 // n_all whose ghost part the caller fills between the two passes.

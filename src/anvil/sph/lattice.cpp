@@ -21,12 +21,12 @@ Lattice generate_lattice(const LatticeSpec& l, int dims) {
         d[i] = len;
       }
     }
+    // Below 3 dimensions the out-of-model coordinates are 0 (lattice.hpp).
+    auto at = [&](int c, int k) { return c < dims ? l.min[c] + (k + 0.5) * d[c] : 0.0; };
     out.points.reserve(static_cast<std::size_t>(n[0]) * n[1] * n[2]);
     for (int k = 0; k < n[2]; ++k)
       for (int j = 0; j < n[1]; ++j)
-        for (int i = 0; i < n[0]; ++i)
-          out.points.push_back(
-              {l.min.x + (i + 0.5) * d[0], l.min.y + (j + 0.5) * d[1], l.min.z + (k + 0.5) * d[2]});
+        for (int i = 0; i < n[0]; ++i) out.points.push_back({at(0, i), at(1, j), at(2, k)});
     out.volume = d[0] * (dims >= 2 ? d[1] : 1.0) * (dims >= 3 ? d[2] : 1.0);
     break;
   }
@@ -38,7 +38,10 @@ Lattice generate_lattice(const LatticeSpec& l, int dims) {
       for (int j = -m; j < m; ++j)
         for (int i = -m; i < m; ++i) {
           const Vec3 o{(i + 0.5) * s, (j + 0.5) * s, dims == 3 ? (k + 0.5) * s : 0.0};
-          if (dot(o, o) < r2) out.points.push_back(l.center + o);
+          if (dot(o, o) >= r2) continue;
+          Vec3 p = l.center + o;
+          if (dims == 2) p.z = 0; // the model's plane
+          out.points.push_back(p);
         }
     out.volume = dims == 3 ? s * s * s : s * s;
     break;
@@ -55,7 +58,7 @@ Lattice generate_lattice(const LatticeSpec& l, int dims) {
           const double u = (i + 0.5) * s, w = (j + 0.5) * s;
           if (u * u + w * w >= r2 || u * u + w * w < ri2) continue;
           Vec3 p = l.origin;
-          p[a] += dims == 3 ? (k + 0.5) * da : 0.0; // 2-D: the base plane
+          p[a] = dims == 3 ? p[a] + (k + 0.5) * da : 0.0; // 2-D (axis z): the model's plane
           // Right-handed (b, c, a): x then y across an axis along z.
           p[b] += u;
           p[c] += w;

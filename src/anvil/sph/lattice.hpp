@@ -22,10 +22,11 @@ struct Lattice {
 // centre's lattice (c + (k + 1/2) s), kept when inside. Cylinder: n = round(length / s)
 // layers of spacing length / n along the axis, cross-section as the sphere's (without
 // the points inside inner_radius: a ring or a tube).
-// In fewer than 3 dimensions (SphConfig::dimensions) the lattice is one layer: in 2-D
-// the plane z = centre of the shape (a box's mid-plane, a sphere's centre: a disc; a
-// cylinder must lie along z: its cross-section, a disc or a ring), in 1-D the line
-// y, z = the box's centre (boxes only); volume is then per unit thickness or area.
+// In fewer than 3 dimensions (SphConfig::dimensions) the lattice is one layer on the
+// model's plane z = 0 (2-D: a box's section, a sphere's: a disc, a cylinder's, which
+// must lie along z: a disc or a ring) or its line y = z = 0 (1-D, boxes only), whatever
+// the shape's extent there: distances are 3-D, so every set must lie on the same plane
+// (line) to interact with the others in plane. Volume is then per unit thickness or area.
 Lattice generate_lattice(const LatticeSpec& spec, int dimensions = 3);
 
 } // namespace anvil::sph
