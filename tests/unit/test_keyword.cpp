@@ -170,7 +170,8 @@ TEST(Keyword, FreeFormatFieldsAreAllReadOrRefused) {
                {"model.k:30: *ELEMENT_SOLID.card", "12 comma-separated fields", "at most 10"});
 }
 
-// An inverted element is named by its EID, not by its position in the part.
+// An inverted element is named by its EID, not by its position in the part, at its own
+// card's line (QA round 5: the part's *PART line was given).
 TEST(Keyword, InvertedElementIsNamedByItsId) {
   std::string text = with(good, "       1       1       1", "     100       1       1");
   text =
@@ -181,6 +182,11 @@ TEST(Keyword, InvertedElementIsNamedByItsId) {
     ADD_FAILURE() << "no error for an inverted element";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("element 200 of part part1 has a non-positive volume"),
+              std::string::npos)
+        << e.what();
+    const auto at = text.find("     200       1       9");
+    const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(at), '\n');
+    EXPECT_NE(std::string(e.what()).find(fmt::format(":{}: *ELEMENT_SOLID", line)),
               std::string::npos)
         << e.what();
   }

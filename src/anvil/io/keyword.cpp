@@ -1485,6 +1485,15 @@ private:
       for (int a = 0; a < 8; ++a)
         h[a] = node_position(e.nodes[a], e.at, fmt::format("*ELEMENT_SOLID.N{}", a + 1),
                              fmt::format("element {}", e.eid));
+      // An inverted element is named at its own card (the model's check would name the
+      // part's, not knowing the file's lines).
+      std::array<Vec3, 8> x;
+      for (int a = 0; a < 8; ++a) x[a] = nodes_[static_cast<std::size_t>(h[a])];
+      if (const double v = hex_volume(x); !(v > 0))
+        throw InputError(e.at.loc("*ELEMENT_SOLID"),
+                         fmt::format("element {} of part {} has a non-positive volume ({:.3g} "
+                                     "m^3): check the node order",
+                                     e.eid, part_name(e.pid), v));
       m.blocks[b->second].elements.push_back(h);
       m.blocks[b->second].ids.push_back(e.eid);
     }
