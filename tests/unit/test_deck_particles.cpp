@@ -233,8 +233,9 @@ namespace {
 
 // The InputError a deck gives when a Simulation is built from it (empty if none).
 std::string setup_error(const std::string& text) {
+  const Comm world = Comm::world(); // (Simulation keeps a reference)
   try {
-    Simulation sim(test::deck(text, "deck.yaml"), Comm::world());
+    Simulation sim(test::deck(text, "deck.yaml"), world);
   } catch (const InputError& e) {
     return e.what();
   }
@@ -293,6 +294,7 @@ TEST(Lattice, LowerDimensionsOnOnePlane) {
 // Two 2-D blocks given different z ranges meet and exchange momentum (they passed
 // through each other, 24 J of kinetic energy unchanged, before).
 TEST(DeckParticles, TwoDimensionalSetsOnDifferentZCollide) {
+  const Comm world = Comm::world(); // (Simulation keeps a reference)
   Simulation sim(test::deck(R"(termination: {cycles: 60}
 sph: {dimensions: 2}
 materials:
@@ -305,7 +307,7 @@ particles:
 initial_conditions:
   - {part: a, velocity: [20, 0, 0]}
 )"),
-                 Comm::world());
+                 world);
   while (!sim.finished()) sim.step();
   const auto& pt = sim.sph()->particles();
   double pb = 0, pa = 0;
@@ -321,6 +323,7 @@ initial_conditions:
 // A 1-D Sod pair whose right set was given another y range: no sideways motion (the
 // particles moved 24 mm in y at up to 1.9 m/s before).
 TEST(DeckParticles, OneDimensionalSetsOnDifferentYStayOnTheLine) {
+  const Comm world = Comm::world(); // (Simulation keeps a reference)
   Simulation sim(test::deck(R"(termination: {cycles: 100}
 sph: {dimensions: 1}
 materials:
@@ -332,7 +335,7 @@ particles:
   right: {generate: {shape: box, min: [0, 0, -0.001], max: [0.2, 0.003, 0.001], spacing: 0.01},
           material: gas_right, summation_density: true}
 )"),
-                 Comm::world());
+                 world);
   while (!sim.finished()) sim.step();
   const auto& pt = sim.sph()->particles();
   double vx = 0;
@@ -349,6 +352,7 @@ particles:
 // streams at +-2000 m/s, out of each other's support, moved 3 h in the first step and
 // the run failed; a cold gas (c = 0) in motion took dt = 9e299 s.
 TEST(DeckParticles, StepBoundsTheMovePerStep) {
+  const Comm world = Comm::world(); // (Simulation keeps a reference)
   const char* streams = R"(termination: {cycles: 40}
 materials:
   gas: {model: ideal_gas, density: 1.0, gamma: 1.4, specific_energy: 4000}
@@ -361,7 +365,7 @@ initial_conditions:
   - {part: a, velocity: [2000, 0, 0]}
   - {part: b, velocity: [-2000, 0, 0]}
 )";
-  Simulation sim(test::deck(streams), Comm::world());
+  Simulation sim(test::deck(streams), world);
   const double h = 1.3 * 2.5e-4;
   sim.step();
   EXPECT_LE(sim.clock().dt * 2000, 0.3 * h * (1 + 1e-12));
@@ -376,7 +380,7 @@ particles:
 initial_conditions:
   - {part: a, velocity: [10, 0, 0]}
 )"),
-                  Comm::world());
+                  world);
   cold.step();
   EXPECT_NEAR(cold.clock().dt, 0.9 * 0.3 * 1.3 * 5.0e-4 / 10, 1e-12); // scale 0.9
 }
@@ -408,14 +412,14 @@ boundary_conditions:
 // Particle contact that cannot act is warned of: a contact of particle sets alone, and
 // particles that start inside an element of a part in contact.
 TEST(DeckParticles, WarnsOfParticleContactThatCannotAct) {
-  Simulation alone(test::deck(std::string(hybrid) + "contact:\n  - {parts: [ball]}\n"),
-                   Comm::world());
+  const Comm world = Comm::world(); // (Simulation keeps a reference)
+  Simulation alone(test::deck(std::string(hybrid) + "contact:\n  - {parts: [ball]}\n"), world);
   EXPECT_TRUE(has_warning(alone, "no finite-element part"));
-  Simulation both(test::deck(std::string(hybrid) + "contact:\n  - {parts: all}\n"), Comm::world());
+  Simulation both(test::deck(std::string(hybrid) + "contact:\n  - {parts: all}\n"), world);
   EXPECT_FALSE(has_warning(both, "no finite-element part"));
   EXPECT_FALSE(has_warning(both, "start inside"));
   std::string sunk = std::string(hybrid) + "contact:\n  - {parts: all}\n";
   sunk.replace(sunk.find("center: [0, 0, 0.002]"), 21, "center: [0, 0, 0.0002]");
-  Simulation inside(test::deck(sunk), Comm::world());
+  Simulation inside(test::deck(sunk), world);
   EXPECT_TRUE(has_warning(inside, "start inside elements"));
 }

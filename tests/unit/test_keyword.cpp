@@ -173,12 +173,13 @@ TEST(Keyword, FreeFormatFieldsAreAllReadOrRefused) {
 // An inverted element is named by its EID, not by its position in the part, at its own
 // card's line (QA round 5: the part's *PART line was given).
 TEST(Keyword, InvertedElementIsNamedByItsId) {
+  const Comm world = Comm::world(); // (Simulation keeps a reference)
   std::string text = with(good, "       1       1       1", "     100       1       1");
   text =
       with(text, "       2       1       5       6       7       8       9      10      11      12",
            "     200       1       9      10      11      12       5       6       7       8");
   try {
-    Simulation sim(kw(text), Comm::world());
+    Simulation sim(kw(text), world);
     ADD_FAILURE() << "no error for an inverted element";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("element 200 of part part1 has a non-positive volume"),

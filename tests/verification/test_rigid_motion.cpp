@@ -161,7 +161,8 @@ parts:
 initial_conditions:
   - {part: block, velocity: [120.0, -35.0, 240.0]}
 )");
-  Simulation sim(c, Comm::self());
+  const Comm self = Comm::self(); // (Simulation keeps a reference)
+  Simulation sim(c, self);
   while (!sim.finished()) sim.step();
   double smax = 0;
   for (const auto& b : sim.blocks())

@@ -60,6 +60,8 @@ public:
   // Builds the model from the deck on `comm` (collective). Throws InputError on a bad
   // model (sets that select nothing, unreadable mesh).
   Simulation(const Config& config, const Comm& comm);
+  // The simulation keeps a reference to its communicator: a temporary would dangle.
+  Simulation(const Config& config, const Comm&& comm) = delete;
   ~Simulation();
 
   // One cycle: fe_forces, sph_forces, predict, contact_detect, contact_correct, update.
