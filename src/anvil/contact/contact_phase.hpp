@@ -81,6 +81,8 @@ public:
   void detect(const ContactNodes& nodes, double dt, PhaseTimers& timers);
   // Step 5: penalty forces of the pairs, returned to the FE owners, summed in ascending
   // pair id and copied to every rank holding the node: fills `nodes.force`. Collective.
+  // dt: the step that bounds the stiffness and the friction (PenaltyOptions), the full
+  // step also where the last one is shortened to end on the end time.
   void forces(const ContactNodes& nodes, double dt, PhaseTimers& timers);
 
   // Contact nodes of another decomposition (SPH particles) for this cycle, given before

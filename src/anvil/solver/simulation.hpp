@@ -187,7 +187,8 @@ private:
 
   // Rigid walls: normal impulse given to owned nodes in the last step, per wall.
   std::vector<WallHit> wall_hits_; // of the last step (owned nodes, own particles)
-  double dt_avg_ = 0; // the velocity step of the last cycle (mean of the two intervals)
+  double dt_avg_ = 0;  // the velocity step of the last cycle (mean of the two intervals)
+  double dt_full_ = 0; // the last cycle's step before shortening it to the end time
 
   // Diagnostics accumulated by this rank over owned entities.
   double external_work_ = 0;
