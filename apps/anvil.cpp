@@ -119,7 +119,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(200, 10000000));
   // Bounded here: the deck's own limit, which would name a line of a generated deck.
   can->add_option("--cycles", cc.cycles, "stop after this many cycles (default: run to 3.2 ms)")
-      ->check(CLI::Range(0LL, 9000000000000000LL));
+      ->check(CLI::Range(1LL, 9000000000000000LL));
   can->add_option("-o,--output", bench_out, "output directory")->capture_default_str();
   std::string wall = "thick_shell";
   can->add_option("--wall", wall,

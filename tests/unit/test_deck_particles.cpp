@@ -407,6 +407,9 @@ boundary_conditions:
   }
   e = setup_error(std::string(hybrid) + "contact:\n  - {parts: [plate, bal]}\n");
   EXPECT_NE(e.find("part 'bal' is not defined under parts or particles"), std::string::npos) << e;
+  // A part listed twice is a slip too (QA round 6: accepted silently).
+  e = setup_error(std::string(hybrid) + "contact:\n  - {parts: [plate, ball, plate]}\n");
+  EXPECT_NE(e.find("part 'plate' is listed twice"), std::string::npos) << e;
 }
 
 // Particle contact that cannot act is warned of: a contact of particle sets alone, and

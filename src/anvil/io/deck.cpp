@@ -910,6 +910,8 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
             const std::string name = it.str();
             if (!part_exists(name))
               it.fail(fmt::format("part '{}' is not defined under parts or particles", name));
+            if (std::find(cc.parts.begin(), cc.parts.end(), name) != cc.parts.end())
+              it.fail(fmt::format("part '{}' is listed twice", name));
             cc.parts.push_back(name);
           }
           if (cc.parts.empty()) p.fail("give a list of parts or 'all'");

@@ -480,8 +480,10 @@ void Outputs::write_summary(int status, const std::string& message) {
   j["dt_initial"] = clk.dt_initial;
   j["dt_final"] = clk.dt;
   j["wall_seconds"] = wall;
-  j["grind_us"] = wall / cycles / n * 1e6;
-  j["grind_us_compute"] = (wall - tmax[static_cast<int>(Phase::output)]) / cycles / n * 1e6;
+  // (A run that took no cycle has no grind time: 0, not its setup's wall time.)
+  const double per = clk.cycle > start_cycle_ && n > 0 ? 1e6 / cycles / n : 0.0;
+  j["grind_us"] = wall * per;
+  j["grind_us_compute"] = (wall - tmax[static_cast<int>(Phase::output)]) * per;
   json t, imb;
   for (std::size_t p = 0; p < tmax.size(); ++p) t[std::string(phase_names[p])] = tmax[p];
   j["timers"] = t;
