@@ -25,6 +25,7 @@ set -e
 [ "$status" -ne 0 ] || { echo "a stopped run must not exit 0"; exit 1; }
 # It stops once cycle 700 is done, not one cycle later.
 grep -q "(cycle 700)" stopped.err || { cat stopped.err; exit 1; }
+grep -q '"status": "stopped"' stopped/summary.json
 run 3 "$anvil" run deck.yaml -o elsewhere -q --restart stopped/checkpoint.anvil
 "$compare" full/checkpoint.anvil elsewhere/checkpoint.anvil
 /usr/bin/python3 - full elsewhere <<'PY'

@@ -475,7 +475,8 @@ void Outputs::write_summary(int status, const std::string& message) {
   j["anvil_version"] = std::string(version);
   j["title"] = sim_.config().title;
   j["deck"] = sim_.config().deck_file;
-  j["status"] = status == 0 ? "completed" : "failed";
+  // A run stopped by a signal (exit 128 + N, a checkpoint written) can go on: "stopped".
+  j["status"] = status == 0 ? "completed" : status >= 128 ? "stopped" : "failed";
   j["exit_status"] = status;
   if (!message.empty()) j["message"] = message;
   j["ranks"] = comm.size();

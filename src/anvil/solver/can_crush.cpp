@@ -35,7 +35,7 @@ std::string can_crush_deck(const CanCrushOptions& o) {
   const char* decomposition = o.decomposition == CanCrushOptions::Decomposition::sectors
                                   ? "decomposition: {fe: rcb, scale: [1, 1, 0.25]}\n"
                                   : "";
-  return fmt::format(R"(title: Scaled can crush, {} ranks
+  return fmt::format(R"(title: Scaled can crush, {} rank{}
 termination: {}
 time_step: {{scale: 0.9}}
 materials:
@@ -59,8 +59,8 @@ probes:
   - {{name: block, at: [0, 0, 0.1005]}}
 output: {{fields_every: 1.6e-3, history_every: 1.0e-5}}
 {})",
-                     o.ranks, termination, can[0], can[1], can[2], wall, block[0], block[1],
-                     block[2], decomposition);
+                     o.ranks, o.ranks == 1 ? "" : "s", termination, can[0], can[1], can[2], wall,
+                     block[0], block[1], block[2], decomposition);
 }
 
 Config can_crush_config(const CanCrushOptions& o) {
