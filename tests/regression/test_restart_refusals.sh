@@ -38,10 +38,13 @@ set -e
 # Expects `anvil run DECK --restart CHECKPOINT` on 2 ranks to exit 2 saying FRAGMENT.
 refused() {
   local deck=$1 checkpoint=$2 fragment=$3 status
+  rm -rf out
   set +e
   run 2 "$anvil" run "$deck" -o out -q --restart "$checkpoint" 2> err.txt
   status=$?
   set -e
+  # Refused before anything is written: no output directory is left behind.
+  [ ! -e out ] || { echo "the refused restart of $deck left an output directory"; exit 1; }
   if [ "$status" -ne 2 ] || ! grep -q "$checkpoint" err.txt || ! grep -q -- "$fragment" err.txt; then
     echo "restart of $deck from $checkpoint: exit $status (expected 2 and '$fragment'):"
     cat err.txt

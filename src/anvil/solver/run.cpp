@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <optional>
 
 #include "anvil/io/checkpoint.hpp"
 #include "anvil/io/outputs.hpp"
@@ -48,15 +49,21 @@ int run(const Config& config, const RunOptions& options, const Comm& comm) {
   Simulation sim(config, comm);
   if (comm.rank() == 0 && options.restart.empty())
     for (const auto& w : sim.warnings()) std::fprintf(stderr, "anvil: warning: %s\n", w.c_str());
+  // A checkpoint is read and checked before the output directory is made: a refused
+  // restart leaves nothing behind.
+  std::optional<Checkpoint> restored;
+  if (!options.restart.empty()) {
+    restored = read_checkpoint(options.restart); // every rank reads it
+    sim.restore(*restored);
+  }
   Outputs out(sim, {options.output_dir, options.progress});
   const std::string checkpoint_path = options.output_dir + "/checkpoint.anvil";
   double next_checkpoint = config.checkpoint_every > 0 ? config.checkpoint_every
                                                        : std::numeric_limits<double>::infinity();
-  if (!options.restart.empty()) {
-    const Checkpoint c = read_checkpoint(options.restart); // every rank reads it
-    sim.restore(c);
-    out.resume(c.outputs, std::filesystem::path(options.restart).parent_path().string());
-    if (config.checkpoint_every > 0) next_checkpoint = c.outputs.next_checkpoint;
+  if (restored) {
+    out.resume(restored->outputs, std::filesystem::path(options.restart).parent_path().string());
+    if (config.checkpoint_every > 0) next_checkpoint = restored->outputs.next_checkpoint;
+    restored.reset(); // (its copy of the state is not needed during the run)
   } else {
     out.begin();
   }
