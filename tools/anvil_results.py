@@ -8,6 +8,7 @@ Public interface:
     read_summary(outdir) -> dict | None  OUTDIR/summary.json, or None when absent (its
                                          shape checked by check_summary)
     time_unit(t_max) -> (factor, label)  scale seconds for an axis ("µs", "ms" or "s")
+    time_axis(history) -> (t, label, xlim) history times scaled, with x limits
     length_unit(extent) -> (factor, label)
     run_main(main)                       call main(); turn errors into exit status 2
     save_figure(fig, path)               write a PNG, creating the directory
@@ -165,6 +166,24 @@ def time_unit(t_max):
     if 0 < t_max < 1:
         return 1e3, "ms"
     return 1.0, "s"
+
+
+def time_axis(h):
+    """(t, unit, (lo, hi)): History `h`'s times in a unit chosen by time_unit, the unit's
+    label and x limits spanning them.  A history of one row (a run stopped at its first
+    output) spans no time; equal limits make matplotlib warn ("identical low and high
+    xlims"), so there the unit comes from the step dt and the limits are one step either
+    side of the point (one unit without a dt column)."""
+    t_ref = h["time"].max()
+    dt = float(h["dt"][0]) if "dt" in h.data and h["dt"][0] > 0 else 0.0
+    if len(h) == 1:
+        t_ref = max(t_ref, dt)
+    factor, label = time_unit(t_ref)
+    t = h["time"] * factor
+    if t[-1] > t[0]:
+        return t, label, (t[0], t[-1])
+    half = dt * factor if dt else 1.0
+    return t, label, (t[0] - half, t[0] + half)
 
 
 def length_unit(extent):
