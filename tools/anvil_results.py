@@ -5,8 +5,10 @@ unit choices for axes, and command-line error handling.
 Public interface:
     ResultsError                         malformed or missing input (message names the file)
     read_history(outdir) -> History      the columns of OUTDIR/history.csv as float arrays
-    read_summary(outdir) -> dict | None  OUTDIR/summary.json, or None when absent
+    read_summary(outdir) -> dict | None  OUTDIR/summary.json, or None when absent (its
+                                         shape checked by check_summary)
     time_unit(t_max) -> (factor, label)  scale seconds for an axis ("µs", "ms" or "s")
+    time_axis(history) -> (t, label, xlim) history times scaled, with x limits
     length_unit(extent) -> (factor, label)
     run_main(main)                       call main(); turn errors into exit status 2
     save_figure(fig, path)               write a PNG, creating the directory
@@ -99,9 +101,61 @@ def read_summary(outdir):
         return None
     try:
         with open(path, encoding="utf-8") as f:
-            return json.load(f)
+            summary = json.load(f)
     except (OSError, ValueError) as e:
         raise ResultsError(f"{path}: cannot read ({e})") from None
+    check_summary(summary, path)
+    return summary
+
+
+# The summary.json fields the tools read, with the type anvil writes. Checked once here so
+# that a file of the wrong shape (hand-edited, from another program) gives one clear error
+# instead of a traceback wherever a tool first uses the field. Unknown keys are allowed.
+_INT, _NUM, _STR = "an integer", "a number", "a string"
+SUMMARY_FIELDS = {
+    "title": _STR, "deck": _STR, "status": _STR, "message": _STR, "anvil_version": _STR,
+    "ranks": _INT, "nodes": _INT, "elements": _INT, "particles": _INT, "cycles": _INT,
+    "eroded_elements": _INT, "exit_status": _INT, "restart_cycle": _INT,
+    "time": _NUM, "wall_seconds": _NUM, "grind_us": _NUM, "grind_us_compute": _NUM,
+    "dt_initial": _NUM, "dt_final": _NUM,
+}
+# Blocks whose values are all numbers (energy.initial, timers.fe, contact.rebalances, ...).
+SUMMARY_NUMBER_BLOCKS = ("energy", "timers", "imbalance", "contact", "sph", "part_mass")
+
+
+def _is_type(value, kind):
+    """True when a JSON value has the kind of SUMMARY_FIELDS (bool is not a number)."""
+    if kind == _STR:
+        return isinstance(value, str)
+    if isinstance(value, bool):
+        return False
+    return isinstance(value, int) if kind == _INT else isinstance(value, (int, float))
+
+
+def _json_type(value):
+    """The JSON name of a value's type, for messages."""
+    names = {bool: "a boolean", str: "a string", list: "a list", dict: "an object",
+             int: "an integer", float: "a number", type(None): "null"}
+    return names.get(type(value), type(value).__name__)
+
+
+def check_summary(summary, path):
+    """Raise ResultsError naming `path` unless `summary` has summary.json's shape."""
+    if not isinstance(summary, dict):
+        raise ResultsError(f"{path}: expected a JSON object, found {_json_type(summary)}")
+    for key, kind in SUMMARY_FIELDS.items():
+        if key in summary and not _is_type(summary[key], kind):
+            raise ResultsError(f"{path}: {key!r} is {_json_type(summary[key])}, expected {kind}")
+    for block in SUMMARY_NUMBER_BLOCKS:
+        if block not in summary:
+            continue
+        if not isinstance(summary[block], dict):
+            raise ResultsError(
+                f"{path}: {block!r} is {_json_type(summary[block])}, expected an object")
+        for key, value in summary[block].items():
+            if not _is_type(value, _NUM):
+                raise ResultsError(
+                    f"{path}: '{block}.{key}' is {_json_type(value)}, expected a number")
 
 
 def time_unit(t_max):
@@ -112,6 +166,24 @@ def time_unit(t_max):
     if 0 < t_max < 1:
         return 1e3, "ms"
     return 1.0, "s"
+
+
+def time_axis(h):
+    """(t, unit, (lo, hi)): History `h`'s times in a unit chosen by time_unit, the unit's
+    label and x limits spanning them.  A history of one row (a run stopped at its first
+    output) spans no time; equal limits make matplotlib warn ("identical low and high
+    xlims"), so there the unit comes from the step dt and the limits are one step either
+    side of the point (one unit without a dt column)."""
+    t_ref = h["time"].max()
+    dt = float(h["dt"][0]) if "dt" in h.data and h["dt"][0] > 0 else 0.0
+    if len(h) == 1:
+        t_ref = max(t_ref, dt)
+    factor, label = time_unit(t_ref)
+    t = h["time"] * factor
+    if t[-1] > t[0]:
+        return t, label, (t[0], t[-1])
+    half = dt * factor if dt else 1.0
+    return t, label, (t[0] - half, t[0] + half)
 
 
 def length_unit(extent):
@@ -208,9 +280,14 @@ def read_machine(root):
         return {}
     try:
         with open(path, encoding="utf-8") as f:
-            return json.load(f)
+            machine = json.load(f)
     except (OSError, ValueError) as e:
         raise ResultsError(f"{path}: cannot read ({e})") from None
+    if not isinstance(machine, dict):
+        raise ResultsError(f"{path}: expected a JSON object, found {_json_type(machine)}")
+    if "nproc" in machine and not (_is_type(machine["nproc"], _INT) and machine["nproc"] > 0):
+        raise ResultsError(f"{path}: 'nproc' is {machine['nproc']!r}, expected a positive integer")
+    return machine
 
 
 def read_cpu_seconds(run_dir):

@@ -14,11 +14,16 @@ Public interface:
     read_pvd(path) -> [PvdEntry]    the time series, sorted by time
     select_entry(entries, step=None, time=None) -> PvdEntry
     load_output(outdir, step=None, time=None) -> (PvdEntry, Grid)
+    exodus_hint(outdir) -> str      why OUTDIR has no results.pvd when it holds Exodus II
 
+Run as a script (anvil_vtu.py OUTDIR|FILE ...), it lists the arrays of the last output.
 Every failure on malformed or missing input raises VtuError whose message names the file.
 """
 
+import argparse
+import glob
 import os
+import sys
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 
@@ -426,6 +431,9 @@ def load_output(outdir, step=None, time=None):
     if os.path.isdir(outdir):
         pvd = os.path.join(outdir, "results.pvd")
         if not os.path.exists(pvd):
+            hint = exodus_hint(outdir)
+            if hint:
+                raise VtuError(f"{outdir}: no results.pvd: {hint}")
             raise VtuError(f"{outdir}: no results.pvd (is this an anvil output directory?)")
     else:
         pvd = outdir
@@ -436,15 +444,39 @@ def load_output(outdir, step=None, time=None):
     return entry, read_grid(entry.path)
 
 
-if __name__ == "__main__":
-    import sys
+def exodus_hint(outdir):
+    """A hint for a run directory without results.pvd that holds Exodus II files
+    (output.format exodus: results.exo on one rank, results.exo.P.R on P ranks), else ''."""
+    exo = sorted(glob.glob(os.path.join(outdir, "results.exo*")))
+    if not exo:
+        return ""
+    return ("this run wrote Exodus II output (output.format); open "
+            f"{os.path.basename(exo[0])} in ParaView, or rerun with --format vtu")
 
+
+def main(argv=None):
+    """List the arrays of the last field output of each OUTDIR or file; exit 2 on bad input."""
+    p = argparse.ArgumentParser(
+        description="List the point and cell arrays of an anvil field output (the last one "
+        "of results.pvd for a run directory).",
+        epilog="example: anvil_vtu.py out/taylor_bar_np3 out/taylor_bar_np3/fields/step_000000.pvtu",
+    )
+    p.add_argument("paths", nargs="+", metavar="OUTDIR|FILE",
+                   help="anvil output directory, or a .pvd, .pvtu or .vtu file")
+    args = p.parse_args(argv)
     try:
-        for arg in sys.argv[1:]:
+        for arg in args.paths:
             e, g = load_output(arg)
             print(f"{e.path}: t={e.time:g} points={g.n_points} cells={g.n_cells}")
             for kind, d in (("point", g.point_data), ("cell", g.cell_data)):
                 for name, a in d.items():
                     print(f"  {kind:5s} {name:16s} {str(a.shape):14s} {a.dtype}")
     except VtuError as err:
-        sys.exit(f"anvil_vtu: {err}")
+        # Exit status 2 on missing or malformed input, like the other tools (tools/README.md).
+        print(f"anvil_vtu.py: error: {err}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

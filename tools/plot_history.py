@@ -25,7 +25,7 @@ from anvil_results import (
     run_description,
     run_main,
     save_figure,
-    time_unit,
+    time_axis,
     title_of,
     use_agg,
 )
@@ -86,8 +86,8 @@ def plot(h, summary, title):
     missing = [c for c, _, _ in ENERGY_CURVES if c not in h.data]
     if missing:
         raise ResultsError(f"{h.path}: missing energy columns {missing}")
-    tf, tu = time_unit(h["time"].max())
-    t = h["time"] * tf
+    t, tu, xlim = time_axis(h)
+    marker = dict(marker="o") if len(h) == 1 else {}  # a single point draws no line
     e_max = max(np.abs(h[c]).max() for c, _, _ in ENERGY_CURVES)
     ef, eu = energy_unit(e_max)
 
@@ -95,7 +95,7 @@ def plot(h, summary, title):
         2, 1, sharex=True, figsize=(7.5, 6.0), gridspec_kw=dict(height_ratios=[3, 1.3])
     )
     for col, label, style in ENERGY_CURVES:
-        ax.plot(t, h[col] * ef, label=label, **style)
+        ax.plot(t, h[col] * ef, label=label, **style, **marker)
     ax.set_ylabel(f"energy [{eu}]")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=9, ncol=2, framealpha=0.9)
@@ -103,12 +103,12 @@ def plot(h, summary, title):
     ax.set_title(title + (f"\n{sub}" if sub else ""), fontsize=11)
 
     err = balance_error(h, initial_energy(h, summary)) * 100
-    axb.plot(t, err, color="tab:red")
+    axb.plot(t, err, color="tab:red", **marker)
     axb.set_ylabel("balance error [%]")
     axb.set_xlabel(f"time [{tu}]")
     axb.grid(True, alpha=0.3)
     axb.set_ylim(bottom=0, top=max(err.max() * 1.6, 1e-3))
-    axb.set_xlim(t[0], t[-1])
+    axb.set_xlim(*xlim)  # one history row: a window around the point (time_axis)
     note = f"final {err[-1]:.3g} %, max {err.max():.3g} % (history rows)"
     reported = (summary or {}).get("energy", {}).get("balance_error")
     if isinstance(reported, (int, float)):

@@ -26,6 +26,7 @@ with many cycles and P = 16..64 with a few) and draws, against P on a log2 axis:
 import argparse
 import os
 import re
+import sys
 
 import numpy as np
 
@@ -125,25 +126,40 @@ def plot(series, rows, title):
         series_plot(ax, ranks, [r[key] for r in rows], over, dict(color=colour, marker=marker),
                     label)
     ax.axhline(1.0, ls="--", color="0.4", lw=1)
-    top = np.nanmax([[r["imb_fe"], r["imb_contact"], r["load_max"]] for r in rows])
-    ax.set_ylim(0.95, max(1.5, top * 1.08))
+    # Only finite values set the range: a run without contact has no contact load.
+    imb = [v for r in rows for v in (r["imb_fe"], r["imb_contact"], r["load_max"])
+           if np.isfinite(v)]
+    ax.set_ylim(0.95, max([1.5] + [v * 1.08 for v in imb]))
     ax.set_ylabel("max / mean over ranks")
     ax.set_title("(a) work imbalance", fontsize=10)
     ax.legend(fontsize=7.5, loc="upper left")
 
     ax = axes[1]
-    series_plot(ax, ranks, [r["bytes"] / 1e3 for r in rows], over,
-                dict(color="tab:purple", marker="o"), "max over ranks")
-    for r in rows:
-        text = f"{r['bytes'] / 1e3:,.0f}"
-        if r["layers"]:
-            text += f"\n{r['layers']} layer" + ("s" if r["layers"] > 1 else "")
-        ax.annotate(text, (r["ranks"], r["bytes"] / 1e3), textcoords="offset points",
-                    xytext=(4, 6), fontsize=7.5)
-    ax.set_ylim(0, np.nanmax([r["bytes"] for r in rows]) / 1e3 * 1.2)
+    sent = [r["bytes"] for r in rows if np.isfinite(r["bytes"])]
+    if sent:
+        series_plot(ax, ranks, [r["bytes"] / 1e3 for r in rows], over,
+                    dict(color="tab:purple", marker="o"), "max over ranks")
+        for r in rows:
+            if not np.isfinite(r["bytes"]):
+                continue
+            text = f"{r['bytes'] / 1e3:,.0f}"
+            if r["layers"]:
+                text += f"\n{r['layers']} layer" + ("s" if r["layers"] > 1 else "")
+            ax.annotate(text, (r["ranks"], r["bytes"] / 1e3), textcoords="offset points",
+                        xytext=(4, 6), fontsize=7.5)
+        ax.set_ylim(0, max(max(sent) / 1e3 * 1.2, 1e-3))
+        ax.legend(fontsize=8, loc="lower right")
+    else:
+        # No summary has contact.bytes_sent_per_rank_per_cycle_max (runs without contact,
+        # such as the Taylor bar). Panels (a) and (c) still hold, so the figure is drawn
+        # with this panel left empty and saying why, rather than refused (exit 2).
+        ax.text(0.5, 0.5, "no contact bytes in these summaries\n(runs without contact)",
+                transform=ax.transAxes, ha="center", va="center", fontsize=9, color="0.4")
+        ax.set_ylim(0, 1)
+        print("note: no summary has contact.bytes_sent_per_rank_per_cycle_max: "
+              "panel (b) is left empty", file=sys.stderr)
     ax.set_ylabel("kB sent per rank per cycle")
     ax.set_title("(b) contact transfers: bytes sent to other ranks", fontsize=10)
-    ax.legend(fontsize=8, loc="lower right")
 
     ax = axes[2]
     series_plot(ax, ranks, [r["ms_rank"] for r in rows], over,
@@ -192,7 +208,7 @@ def main(argv=None):
         machine += f"; P > {series.nproc} oversubscribed (hollow markers, shaded)"
     cycles = sorted({r["cycles"] for r in rows})
     head = args.title or "Scaled can crush: parallel behaviour against the rank count"
-    title = f"{head}\ncycles per run: {', '.join(map(str, cycles))}; {machine}"
+    title = f"{head}\ncycles per run: {', '.join(map(str, cycles))}" + (f"; {machine}" if machine else "")
     fig = plot(series, rows, title)
     out = args.output or os.path.join(args.outroot[0], "parallel_evidence.png")
     save_figure(fig, out, dpi=args.dpi)

@@ -7,7 +7,11 @@ of the first output) are drawn as dots coloured by a particle field (sph_rank by
 default: the SPH decomposition; or pressure, density, plastic_strain, velocity, a
 component such as stress.zz or velocity.z). Hexahedra whose centroid lies in the slab
 are drawn as grey outlines of their face that faces the section's -normal side, so the
-structure appears in the same cut. Several outputs (--steps 0,2,4) give a sequence.
+structure appears in the same cut. Several outputs (--steps 0,2,4) give a sequence;
+a negative index counts from the end (-1, the default, is the last output).
+
+Without results.pvd (an `anvil decompose` output of a deck of particles only, which
+writes no FE pieces) the particles are drawn alone.
 """
 
 import argparse
@@ -17,7 +21,7 @@ import sys
 import numpy as np
 
 from anvil_results import ResultsError, read_summary, run_main, save_figure, title_of, use_agg
-from anvil_vtu import VtuError, read_grid, read_pvd, select_entry
+from anvil_vtu import exodus_hint, read_grid, read_pvd, select_entry
 
 FIELD_INFO = {
     "sph_rank": ("SPH rank", "", 1.0),
@@ -37,16 +41,46 @@ AXES = {"x": 0, "y": 1, "z": 2}
 SECTION_FACE = {0: [0, 3, 7, 4], 1: [0, 1, 5, 4], 2: [0, 1, 2, 3]}
 
 
+def step_list(text):
+    """argparse type of --steps: '0,2,-1' -> [0, 2, -1]; anything else is a usage error
+    (exit 2) rather than a traceback from int()."""
+    try:
+        steps = [int(s) for s in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: expected comma-separated output indices such as 0,2,-1") from None
+    return steps
+
+
+def cut_plane(text):
+    """argparse type of --cut: 'y=0' -> (1, 0.0)."""
+    axis_name, _, value = text.partition("=")
+    try:
+        return AXES[axis_name], float(value)
+    except (KeyError, ValueError):
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: expected AXIS=VALUE with AXIS x, y or z (e.g. y=0)") from None
+
+
 def parse_args(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("outdir", help="anvil output directory (with particles.pvd)")
-    p.add_argument("--steps", default="-1", help="comma-separated output indices (default: last)")
+    p.add_argument("--steps", type=step_list, default=[-1],
+                   help="comma-separated output indices of particles.pvd, negative from the "
+                   "end (default: -1, the last)")
     p.add_argument("--field", default="sph_rank", help="particle field (default sph_rank)")
-    p.add_argument("--cut", default="y=0", help="section plane AXIS=VALUE (default y=0)")
+    p.add_argument("--cut", type=cut_plane, default="y=0",
+                   help="section plane AXIS=VALUE (default y=0)")
     p.add_argument("--slab", type=float, default=None, help="half-thickness of the slab, m")
     p.add_argument("--clim", type=float, nargs=2, default=None, help="colour range (display units)")
     p.add_argument("-o", "--output", default="particles.png", help="PNG to write")
-    return p.parse_args(argv)
+    args = p.parse_args(argv)
+    # A slab of no thickness selects no particle: an empty figure that looks like a bug.
+    if args.slab is not None and not args.slab > 0:
+        p.error(f"--slab {args.slab:g}: the half-thickness must be > 0 (m)")
+    if args.clim is not None and not args.clim[0] < args.clim[1]:
+        p.error("--clim needs MIN < MAX")
+    return args
 
 
 def field_values(grid, name, where):
@@ -68,25 +102,43 @@ def field_values(grid, name, where):
 
 def main(argv=None):
     args = parse_args(argv)
-    axis_name, _, value = args.cut.partition("=")
-    if axis_name not in AXES or not value:
-        raise ResultsError(f"--cut {args.cut!r}: expected AXIS=VALUE with AXIS x, y or z")
-    axis, cut = AXES[axis_name], float(value)
+    axis, cut = args.cut
+    cut_text = f"{'xyz'[axis]}={cut:g}"
     plane = [a for a in range(3) if a != axis]
+    if not os.path.isdir(args.outdir):
+        raise ResultsError(f"{args.outdir}: no such directory")
     pvd = os.path.join(args.outdir, "particles.pvd")
     if not os.path.exists(pvd):
         raise ResultsError(f"{args.outdir}: no particles.pvd (a run without particles?)")
     entries = read_pvd(pvd)
-    fe_entries = read_pvd(os.path.join(args.outdir, "results.pvd"))
-    steps = [int(s) for s in args.steps.split(",")]
+    for s in args.steps:
+        if not -len(entries) <= s < len(entries):
+            raise ResultsError(f"{pvd}: --steps {s} is out of range: the series has "
+                               f"{len(entries)} output(s), 0 to {len(entries) - 1}")
+    # The mesh: `anvil decompose` of a deck of particles only writes no FE pieces and no
+    # results.pvd, so there the particles are drawn alone (docs/sph.md, "Outputs").
+    fe_pvd = os.path.join(args.outdir, "results.pvd")
+    fe_entries = read_pvd(fe_pvd) if os.path.exists(fe_pvd) else None
+    if fe_entries is None:
+        hint = exodus_hint(args.outdir)
+        print(f"note: {args.outdir}: no results.pvd, drawing the particles without the mesh"
+              + (f" ({hint})" if hint else ""), file=sys.stderr)
     plt = use_agg()
-    fig, axs = plt.subplots(1, len(steps), figsize=(4.2 * len(steps) + 1.2, 4.6), squeeze=False)
-    summary = read_summary(args.outdir) if os.path.exists(os.path.join(args.outdir, "summary.json")) else {}
-    grids = [(select_entry(entries, step=s), select_entry(fe_entries, step=s)) for s in steps]
-    parts = [(e, read_grid(e.path), read_grid(f.path)) for e, f in grids]
+    fig, axs = plt.subplots(1, len(args.steps), figsize=(4.2 * len(args.steps) + 1.2, 4.6),
+                            squeeze=False)
+    summary = read_summary(args.outdir) or {}
+    parts = []
+    for s in args.steps:
+        e = select_entry(entries, step=s)
+        # The FE output of the same time (the two series share their step numbers).
+        fe = read_grid(select_entry(fe_entries, time=e.time).path) if fe_entries else None
+        parts.append((e, read_grid(e.path), fe))
     slab = args.slab
     if slab is None:
-        slab = float(np.max(parts[0][1].point_data["smoothing_length"]))
+        g0 = parts[0][1]
+        if "smoothing_length" not in g0.point_data or not g0.n_points:
+            raise ResultsError(f"{g0.sources[0]}: no smoothing_length to size the slab; give --slab")
+        slab = float(np.max(g0.point_data["smoothing_length"]))
     all_vals = []
     for _, g, _ in parts:
         v, label = field_values(g, args.field, g.sources[0])
@@ -99,7 +151,7 @@ def main(argv=None):
     lim_hi = np.max([np.max(g.points[:, plane], axis=0) for _, g, _ in parts], axis=0)
     for (entry, g, fe), v, ax in zip(parts, all_vals, axs[0]):
         # The mesh in the section.
-        if fe.cell_types.size and np.all(fe.cell_types == 12):
+        if fe is not None and fe.cell_types.size and np.all(fe.cell_types == 12):
             conn = fe.connectivity
             cent = fe.points[conn].mean(axis=1)
             keep = np.abs(cent[:, axis] - cut) <= 0.5 * np.ptp(fe.points[conn][:, :, axis], axis=1).max(initial=0) + 1e-12
@@ -130,8 +182,9 @@ def main(argv=None):
         fig.legend(handles=handles, title=label, loc="center right")
     else:
         fig.colorbar(sc, ax=list(axs[0]), label=label, shrink=0.8)
-    fig.suptitle(f"{title_of(summary, args.outdir)}: section {args.cut}, particles within ±{slab * 1e3:.2g} mm")
+    fig.suptitle(f"{title_of(summary, args.outdir)}: section {cut_text}, particles within ±{slab * 1e3:.2g} mm")
     save_figure(fig, args.output, tight=True)
+    print(args.output)
     return 0
 
 

@@ -16,7 +16,7 @@ from anvil_results import (
     read_summary,
     run_main,
     save_figure,
-    time_unit,
+    time_axis,
     title_of,
     use_agg,
 )
@@ -77,18 +77,18 @@ def plot(h, columns, title):
     """One panel per kind of column, shared time axis; returns the Figure."""
     plt = use_agg()
     groups = group_columns(columns)
-    tf, tu = time_unit(h["time"].max())
-    t = h["time"] * tf
+    t, tu, xlim = time_axis(h)
+    marker = dict(marker="o") if len(h) == 1 else {}  # a single point draws no line
     fig, axes = plt.subplots(len(groups), 1, sharex=True, squeeze=False,
                              figsize=(7.5, 2.0 + 2.3 * len(groups)))
     for ax, (label, factor, cols) in zip(axes[:, 0], groups):
         for col in cols:
-            ax.plot(t, h[col] * factor, label=col)
+            ax.plot(t, h[col] * factor, label=col, **marker)
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
         ax.legend(loc="best", fontsize=9)
     axes[-1, 0].set_xlabel(f"time [{tu}]")
-    axes[-1, 0].set_xlim(t[0], t[-1])
+    axes[-1, 0].set_xlim(*xlim)  # one history row: a window around the point (time_axis)
     axes[0, 0].set_title(title, fontsize=11)
     fig.align_ylabels(axes[:, 0])
     fig.tight_layout()

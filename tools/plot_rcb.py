@@ -14,13 +14,31 @@ Uses Debian's python3-matplotlib: run with /usr/bin/python3.
 """
 import argparse
 import json
-import sys
 
-import matplotlib
+from anvil_results import ResultsError, run_main, save_figure, use_agg
 
-matplotlib.use("Agg")
-import matplotlib.patches as patches  # noqa: E402
-import matplotlib.pyplot as plt  # noqa: E402
+# Top-level keys of bench/rcb_dump's JSON that the figure uses, with their JSON type.
+RCB_KEYS = {"points_xy_owner": list, "ranks": int, "domain": dict, "cut_segments": list,
+            "boxes": list, "counts": list, "points": int, "total_iterations": int}
+TYPE_NAMES = {list: "a list", int: "an integer", dict: "an object"}
+
+
+def read_rcb(path):
+    """The rcb_dump JSON at `path` as a dict; ResultsError naming the file when it is
+    missing, not JSON, or lacks a key the figure needs."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            d = json.load(f)
+    except (OSError, ValueError) as e:
+        raise ResultsError(f"{path}: cannot read ({getattr(e, 'strerror', None) or e})") from None
+    if not isinstance(d, dict):
+        raise ResultsError(f"{path}: expected a JSON object (the output of bench/rcb_dump)")
+    for key, kind in RCB_KEYS.items():
+        if key not in d:
+            raise ResultsError(f"{path}: no {key!r} (is this the output of bench/rcb_dump?)")
+        if not isinstance(d[key], kind) or isinstance(d[key], bool):
+            raise ResultsError(f"{path}: {key!r} is not {TYPE_NAMES[kind]}")
+    return d
 
 
 def main():
@@ -28,8 +46,21 @@ def main():
     ap.add_argument("json", help="output of bench/rcb_dump")
     ap.add_argument("-o", "--output", default="rcb_figure1.png", help="PNG to write")
     args = ap.parse_args()
-    with open(args.json) as f:
-        d = json.load(f)
+    d = read_rcb(args.json)
+    try:
+        fig = draw(d)
+    except (KeyError, IndexError, TypeError, ValueError) as e:
+        # A key present but of the wrong shape inside (a box without "lo", a short point).
+        raise ResultsError(f"{args.json}: malformed rcb_dump output ({type(e).__name__}: {e})") from None
+    save_figure(fig, args.output)
+    print(f"wrote {args.output}")
+    return 0
+
+
+def draw(d):
+    """Both panels of Figure 1 from the rcb_dump dict `d`; returns the Figure."""
+    plt = use_agg()  # imported here: errors in the input are reported without the wait
+    import matplotlib.patches as patches
 
     pts = d["points_xy_owner"]
     xs = [p[0] for p in pts]
@@ -76,10 +107,8 @@ def main():
     fig.text(0.5, 0.02, f"{d['points']} points; points per rank: {counts}; "
              f"{d['total_iterations']} median-search rounds", ha="center", fontsize=9)
     fig.tight_layout(rect=(0, 0.05, 1, 0.97))
-    fig.savefig(args.output, dpi=110)
-    print(f"wrote {args.output}")
-    return 0
+    return fig
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    run_main(main, "plot_rcb.py")

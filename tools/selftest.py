@@ -213,6 +213,39 @@ def write_history(outdir):
         f.write("\n".join(lines) + "\n")
 
 
+def write_particles(outdir, times):
+    """particles.pvd and per-rank vertex-cell pieces as anvil writes them (docs/sph.md,
+    "Outputs"): a 4 x 2 x 3 block of particles above the box, split in x over 2 ranks.
+    Written into a run directory, or alone (as `anvil decompose` of a deck of particles
+    only, which writes no results.pvd)."""
+    os.makedirs(os.path.join(outdir, "fields"), exist_ok=True)
+    h = 0.5e-3
+    pts = np.array([(i * h, j * h, 4.5e-3 + k * h) for k in range(3) for j in range(2)
+                    for i in range(4)])
+    entries = []
+    for step, t in enumerate(times):
+        names = []
+        for r in range(RANKS):
+            mine = np.flatnonzero((pts[:, 0] >= 1e-3) == bool(r))
+            x = pts[mine] + [0.0, 0.0, -10.0 * t]  # falling at 10 m/s
+            n = len(mine)
+            piece = {
+                "points": x.ravel().tolist(), "connectivity": list(range(n)),
+                "offsets": list(range(1, n + 1)), "types": [1] * n,
+                "point_data": [("velocity", 3, [0.0, 0.0, -10.0] * n, False),
+                               ("pressure", 1, (1e6 * x[:, 2]).tolist(), False),
+                               ("smoothing_length", 1, [1.2 * h] * n, False),
+                               ("sph_rank", 1, [r] * n, True),
+                               ("particle_id", 1, (mine + 1).tolist(), True)],
+                "cell_data": [],
+            }
+            names.append(f"particles_step_{step:06d}_r{r:04d}.vtu")
+            write_vtu(os.path.join(outdir, "fields", names[-1]), piece)
+        write_pvtu(os.path.join(outdir, "fields", f"particles_step_{step:06d}.pvtu"), names, piece)
+        entries.append((t, f"fields/particles_step_{step:06d}.pvtu"))
+    write_pvd(os.path.join(outdir, "particles.pvd"), entries)
+
+
 # --------------------------------------------------------------------------- checks
 
 
@@ -326,7 +359,16 @@ def run_tool(args, expect):
         f"{' '.join(cmd)}: exit {r.returncode}, expected {expect}\n{r.stdout}{r.stderr}")
     if expect == 2:
         assert "error" in r.stderr, r.stderr
+    # A user error is a message, never a traceback (tools/README.md).
+    assert "Traceback" not in r.stderr, f"{' '.join(cmd)}: traceback\n{r.stderr}"
     return r
+
+
+def expect_usage_error(args, *words):
+    """The tool exits 2 with a message containing every word (a file or an argument)."""
+    r = run_tool(args, 2)
+    for w in words:
+        assert w in r.stderr, f"{' '.join(args)}: {w!r} not in {r.stderr!r}"
 
 
 def check_png(path):
@@ -337,10 +379,11 @@ def check_png(path):
     assert os.path.getsize(path) > 5000, f"{path} is suspiciously small"
 
 
-def write_series(root, ranks=(1, 2, 4, 8), nproc=2):
+def write_series(root, ranks=(1, 2, 4, 8), nproc=2, contact=True):
     """A synthetic scaling_series.sh output root: machine.json and P<n>/summary.json with
     the keys plot_figure2.py and plot_parallel_evidence.py read; P = 8 lacks its summary
-    (a failed run) and P = 4's repeats sit in rep<k>/ as with --repeat."""
+    (a failed run) and P = 4's repeats sit in rep<k>/ as with --repeat.  contact=False
+    leaves out the contact block (a model without contact)."""
     os.makedirs(root)
     with open(os.path.join(root, "machine.json"), "w") as f:
         json.dump({"nproc": nproc, "cpu_model": "Synthetic CPU", "ranks": list(ranks),
@@ -360,6 +403,8 @@ def write_series(root, ranks=(1, 2, 4, 8), nproc=2):
                    "contact": {"rebalances": p, "load_imbalance_last": 1.02,
                                "load_imbalance_max": 1.1, "pairs_last_cycle": 10 * p,
                                "bytes_sent_per_rank_per_cycle_max": 1.5e6 + 1e4 * p}}
+        if not contact:
+            del summary["contact"]
         for where in (d, os.path.join(d, "rep1")):
             with open(os.path.join(where, "summary.json"), "w") as f:
                 json.dump(summary, f)
@@ -386,6 +431,137 @@ def check_series_tools(tmp):
                 ["plot_figure2.py", os.path.join(tmp, "run", "fields")],
                 ["plot_parallel_evidence.py", os.path.join(tmp, "no_such_dir")]):
         run_tool(bad, 2)
+
+
+def check_particles(outdir, tmp):
+    """plot_particles.py: a run with mesh and particles, a particles-only decomposition
+    (no results.pvd), the PNG path printed, and exit 2 on impossible arguments."""
+    write_particles(outdir, [0.0, 1e-5])
+    png = f"{tmp}/particles.png"
+    r = run_tool(["plot_particles.py", outdir, "--steps", "0,-1", "-o", png], 0)
+    check_png(png)
+    assert r.stdout.strip() == png, r.stdout
+    ponly = os.path.join(tmp, "particles_only")
+    write_particles(ponly, [0.0])
+    png = f"{tmp}/particles_only.png"
+    r = run_tool(["plot_particles.py", ponly, "--field", "pressure", "-o", png], 0)
+    check_png(png)
+    assert "no results.pvd" in r.stderr, r.stderr
+    for args, words in ((["--steps", "a,b"], ["--steps", "'a,b'"]),
+                        (["--steps", ""], ["--steps"]),
+                        (["--steps", "2"], ["particles.pvd", "out of range"]),
+                        (["--steps", "0,-3"], ["particles.pvd", "out of range"]),
+                        (["--slab", "0"], ["--slab"]),
+                        (["--slab", "-1e-3"], ["--slab"]),
+                        (["--cut", "y=abc"], ["--cut"])):
+        expect_usage_error(["plot_particles.py", outdir] + args + ["-o", f"{tmp}/x.png"], *words)
+
+
+def check_summary_shapes(outdir, tmp):
+    """summary.json that is valid JSON of the wrong shape: a ResultsError naming the file
+    from anvil_results (checked once there), and exit 2 from the tools that read it."""
+    from anvil_results import ResultsError, read_summary
+
+    bad = os.path.join(tmp, "bad_summary")
+    os.makedirs(bad)
+    shutil.copy(os.path.join(outdir, "history.csv"), bad)
+    path = os.path.join(bad, "summary.json")
+    for text, word in (('[1, 2]', "JSON object"), ('{"cycles": "many"}', "'cycles'"),
+                       ('{"ranks": null}', "'ranks'"), ('{"title": 3}', "'title'"),
+                       ('{"energy": 3}', "'energy'"),
+                       ('{"energy": {"initial": "x"}}', "'energy.initial'")):
+        with open(path, "w") as f:
+            f.write(text)
+        try:
+            read_summary(bad)
+        except ResultsError as e:
+            assert path in str(e) and word in str(e), e
+        else:
+            raise AssertionError(f"{text}: no ResultsError")
+        if word in ("JSON object", "'cycles'"):  # the two cases of the QA report
+            expect_usage_error(["plot_history.py", bad, "-o", f"{tmp}/x.png"], path)
+            expect_usage_error(["plot_probe.py", bad, "tip.uz", "-o", f"{tmp}/x.png"], path)
+    assert read_summary(outdir)["title"] == "selftest box"  # the good one still reads
+
+
+def write_rcb(path):
+    """A small JSON of bench/rcb_dump's shape: 2 ranks split at x = 0.5."""
+    pts = [[0.1 * i, 0.05 * i, int(i >= 5)] for i in range(10)]
+    with open(path, "w") as f:
+        json.dump({"points_xy_owner": pts, "ranks": 2, "points": 10, "total_iterations": 3,
+                   "domain": {"lo": [0, 0, 0], "hi": [1, 1, 0]}, "counts": [5, 5],
+                   "cut_segments": [{"level": 0, "from": [0.5, 0], "to": [0.5, 1]}],
+                   "boxes": [{"lo": [0, 0, 0], "hi": [0.5, 1, 0]},
+                             {"lo": [0.5, 0, 0], "hi": [1, 1, 0]}]}, f)
+
+
+def check_rcb(tmp):
+    """plot_rcb.py draws a rcb_dump JSON; a missing file, or JSON without its keys, is exit 2."""
+    good = os.path.join(tmp, "rcb.json")
+    write_rcb(good)
+    run_tool(["plot_rcb.py", good, "-o", f"{tmp}/rcb.png"], 0)
+    check_png(os.path.join(tmp, "rcb.png"))
+    missing = os.path.join(tmp, "no_rcb.json")
+    expect_usage_error(["plot_rcb.py", missing, "-o", f"{tmp}/x.png"], missing)
+    empty = os.path.join(tmp, "rcb_empty.json")
+    with open(empty, "w") as f:
+        f.write("{}")
+    expect_usage_error(["plot_rcb.py", empty, "-o", f"{tmp}/x.png"], empty, "points_xy_owner")
+
+
+def check_vtu_cli(outdir, tmp):
+    """anvil_vtu.py as a command: --help, no argument (usage, exit 2), a missing directory
+    (exit 2), a run of Exodus II output only (a hint, also from plot_decomposition.py)."""
+    r = run_tool(["anvil_vtu.py", "--help"], 0)
+    assert r.stdout.startswith("usage:"), r.stdout
+    r = run_tool(["anvil_vtu.py"], 2)
+    assert "usage:" in r.stderr, r.stderr
+    missing = os.path.join(tmp, "no_such_dir")
+    expect_usage_error(["anvil_vtu.py", missing], missing)
+    r = run_tool(["anvil_vtu.py", outdir], 0)
+    assert "fe_rank" in r.stdout, r.stdout
+    exo = os.path.join(tmp, "exodus_only")
+    os.makedirs(exo)
+    for name in ("results.exo", "history.csv"):
+        open(os.path.join(exo, name), "w").close()
+    for tool in ("anvil_vtu.py", "plot_decomposition.py"):
+        expect_usage_error([tool, exo], exo, "Exodus II", "results.exo", "--format vtu")
+
+
+def check_no_contact_series(tmp):
+    """plot_parallel_evidence.py on runs without contact bytes draws the other panels and
+    says panel (b) is empty (it raised on NaN axis limits)."""
+    root = os.path.join(tmp, "series_no_contact")
+    write_series(root, ranks=(1, 2, 4), contact=False)
+    r = run_tool(["plot_parallel_evidence.py", root, "-o", f"{tmp}/evidence_nc.png"], 0)
+    check_png(os.path.join(tmp, "evidence_nc.png"))
+    assert "panel (b)" in r.stderr, r.stderr
+
+
+def check_one_row_history(outdir, tmp):
+    """A history.csv of one row plots without matplotlib's singular-limits warning."""
+    one = os.path.join(tmp, "one_row")
+    os.makedirs(one)
+    with open(os.path.join(outdir, "history.csv")) as f:
+        lines = f.read().splitlines()
+    with open(os.path.join(one, "history.csv"), "w") as f:
+        f.write(lines[0] + "\n" + lines[1] + "\n")
+    for args in (["plot_history.py", one, "-o", f"{tmp}/one.png"],
+                 ["plot_probe.py", one, "tip.uz", "-o", f"{tmp}/one_probe.png"]):
+        r = run_tool(args, 0)
+        assert "Warning" not in r.stderr, r.stderr
+    check_png(os.path.join(tmp, "one.png"))
+
+
+def check_executable():
+    """Every tool with a #! line is executable (the docs run mpi_trace.py, corner_census.py
+    and scaling_series.sh directly; the mode comes from git)."""
+    for name in sorted(os.listdir(HERE)):
+        path = os.path.join(HERE, name)
+        if name.endswith((".py", ".sh")):
+            with open(path, "rb") as f:
+                if f.read(2) == b"#!":
+                    assert os.access(path, os.X_OK), f"{path} has a #! line but is not executable"
 
 
 def check_figure3(outdir, tmp):
@@ -488,6 +664,13 @@ def main():
         c.run("plot_figure3 on the synthetic run", check_figure3, outdir, tmp)
         c.run("plot_history: balance error against E0", check_balance, tmp)
         c.run("mpi_trace on synthetic records", check_mpi_trace, tmp)
+        c.run("plot_particles: run, particles only, bad arguments", check_particles, outdir, tmp)
+        c.run("summary.json of the wrong shape", check_summary_shapes, outdir, tmp)
+        c.run("plot_rcb: PNG, missing file, JSON without its keys", check_rcb, tmp)
+        c.run("anvil_vtu.py command line, Exodus-only run", check_vtu_cli, outdir, tmp)
+        c.run("plot_parallel_evidence without contact bytes", check_no_contact_series, tmp)
+        c.run("one-row history.csv: no matplotlib warning", check_one_row_history, outdir, tmp)
+        c.run("tools with #! are executable", check_executable)
     finally:
         if args.keep:
             print(f"kept {tmp}")
