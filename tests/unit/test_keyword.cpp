@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "anvil/io/keyword.hpp"
+#include "anvil/io/outputs.hpp"
 #include "anvil/solver/model.hpp"
 #include "anvil/solver/simulation.hpp"
 #include "test_support.hpp"
@@ -190,6 +191,33 @@ TEST(Keyword, InvertedElementIsNamedByItsId) {
     EXPECT_NE(std::string(e.what()).find(fmt::format(":{}: *ELEMENT_SOLID", line)),
               std::string::npos)
         << e.what();
+  }
+}
+
+// The outputs carry the deck's own ids: node_id and element_id of the VTU pieces (and with
+// them Exodus's id maps) are NID and EID, not positions (QA round 5: ParaView showed 1..N
+// while history.csv and the messages used the file's ids). Node 12 renumbered 1212 and
+// element 2 renumbered 200.
+TEST(Keyword, OutputsCarryTheFilesIds) {
+  std::string text = with(good, "      12             0.0             1.0             2.0",
+                          "    1212             0.0             1.0             2.0");
+  text =
+      with(text, "       2       1       5       6       7       8       9      10      11      12",
+           "     200       1       5       6       7       8       9      10      11    1212");
+  text = with(text, "*DATABASE_HISTORY_NODE\n        12", "*DATABASE_HISTORY_NODE\n      1212");
+  const Comm world = Comm::world(); // (Simulation keeps a reference)
+  Simulation sim(kw(text), world);
+  const VtuPiece p = fe_piece(sim);
+  std::vector<std::int64_t> nodes, elements;
+  for (const auto& a : p.point_data)
+    if (a.name == "node_id") nodes = a.i64;
+  for (const auto& a : p.cell_data)
+    if (a.name == "element_id") elements = a.i64;
+  std::sort(nodes.begin(), nodes.end());
+  std::sort(elements.begin(), elements.end());
+  if (world.size() == 1) {
+    EXPECT_EQ(nodes, (std::vector<std::int64_t>{1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 1212}));
+    EXPECT_EQ(elements, (std::vector<std::int64_t>{1, 200}));
   }
 }
 

@@ -1467,6 +1467,7 @@ private:
   Mesh build_mesh(const std::vector<std::int64_t>& pids, bool parts_must_exist) const {
     Mesh m;
     m.nodes = nodes_;
+    m.node_ids = node_ids_;
     std::unordered_map<std::int64_t, std::size_t> block_of;
     for (const auto pid : pids) {
       block_of.emplace(pid, m.blocks.size());

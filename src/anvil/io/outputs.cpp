@@ -34,7 +34,7 @@ VtuPiece fe_piece(const Simulation& sim) {
       disp.f64[3 * n + i] = nd.x[i][n] - nd.x0[i][n];
       vel.f64[3 * n + i] = nd.v[i][n];
     }
-    nid.i64[n] = sim.fe().node_gid[n] + 1;
+    nid.i64[n] = sim.node_file_id(n);
   }
   p.point_data = {std::move(disp), std::move(vel), std::move(nid)};
 
@@ -42,7 +42,8 @@ VtuPiece fe_piece(const Simulation& sim) {
       temp{"temperature", 1}, rank{"fe_rank", 1}, eid{"element_id", 1}, part{"part", 1};
   rank.is_int = eid.is_int = part.is_int = true;
   bool any_temp = false;
-  for (const auto& b : sim.blocks()) {
+  for (std::size_t bi = 0; bi < sim.blocks().size(); ++bi) {
+    const HexBlock& b = sim.blocks()[bi];
     for (int e = 0; e < b.size(); ++e) {
       for (int a = 0; a < 8; ++a) p.connectivity.push_back(b.conn[a][e]);
       p.offsets.push_back(static_cast<std::int64_t>(p.connectivity.size()));
@@ -62,7 +63,7 @@ VtuPiece fe_piece(const Simulation& sim) {
       temp.f64.push_back(b.temperature.empty() ? 0.0 : b.temperature[e]);
       any_temp = any_temp || !b.temperature.empty();
       rank.i64.push_back(sim.comm().rank());
-      eid.i64.push_back(b.gid[e] + 1);
+      eid.i64.push_back(sim.element_file_id(bi, static_cast<std::size_t>(e)));
       part.i64.push_back(b.part);
     }
   }

@@ -22,16 +22,16 @@ std::vector<std::int64_t> Mesh::block_offsets() const {
   return off;
 }
 
-void Mesh::append(const Mesh& other, const std::string& prefix) {
+std::int64_t Mesh::append_nodes(const Mesh& other, const std::string& prefix) {
   const std::int64_t node_shift = num_nodes();
-  const std::int64_t elem_shift = num_elements();
-  nodes.insert(nodes.end(), other.nodes.begin(), other.nodes.end());
-  for (const auto& b : other.blocks) {
-    ElementBlock nb{b.name, b.elements, b.ids};
-    for (auto& h : nb.elements)
-      for (auto& n : h) n += node_shift;
-    blocks.push_back(std::move(nb));
+  // File ids where either mesh has them (a generated mesh's nodes: their position).
+  if (!node_ids.empty() || !other.node_ids.empty()) {
+    for (std::size_t n = node_ids.size(); n < nodes.size(); ++n) node_ids.push_back(node_id(n));
+    for (std::size_t n = 0; n < other.nodes.size(); ++n)
+      node_ids.push_back(other.node_ids.empty() ? node_shift + static_cast<std::int64_t>(n) + 1
+                                                : other.node_ids[n]);
   }
+  nodes.insert(nodes.end(), other.nodes.begin(), other.nodes.end());
   auto name = [&](const std::string& s) { return prefix.empty() ? s : prefix + "." + s; };
   for (const auto& [k, ids] : other.node_sets) {
     auto& dst = node_sets[name(k)];
@@ -39,6 +39,37 @@ void Mesh::append(const Mesh& other, const std::string& prefix) {
     std::sort(dst.begin(), dst.end());
     dst.erase(std::unique(dst.begin(), dst.end()), dst.end());
   }
+  return node_shift;
+}
+
+namespace {
+bool without_repeats(std::vector<std::int64_t> ids) {
+  std::sort(ids.begin(), ids.end());
+  return std::adjacent_find(ids.begin(), ids.end()) == ids.end();
+}
+} // namespace
+
+bool Mesh::node_ids_unique() const {
+  return node_ids.empty() || without_repeats(node_ids);
+}
+
+bool Mesh::element_ids_unique() const {
+  std::vector<std::int64_t> all;
+  for (const auto& b : blocks)
+    for (std::size_t e = 0; e < b.elements.size(); ++e) all.push_back(b.id(e));
+  return without_repeats(std::move(all));
+}
+
+void Mesh::append(const Mesh& other, const std::string& prefix) {
+  const std::int64_t elem_shift = num_elements();
+  const std::int64_t node_shift = append_nodes(other, prefix);
+  for (const auto& b : other.blocks) {
+    ElementBlock nb{b.name, b.elements, b.ids};
+    for (auto& h : nb.elements)
+      for (auto& n : h) n += node_shift;
+    blocks.push_back(std::move(nb));
+  }
+  auto name = [&](const std::string& s) { return prefix.empty() ? s : prefix + "." + s; };
   for (const auto& [k, sides] : other.side_sets) {
     auto& dst = side_sets[name(k)];
     for (auto s : sides) dst.push_back({s.element + elem_shift, s.face});

@@ -43,12 +43,18 @@ struct SideEntry {
 };
 
 struct Mesh {
-  std::vector<Vec3> nodes;                                    // coordinates by global id
+  std::vector<Vec3> nodes; // coordinates by global id
+  // The mesh file's id of each node (LS-DYNA NID, Gmsh tag, Exodus node_num_map), for the
+  // outputs' id arrays; empty for a generated mesh, whose nodes are 1, 2, ... in order.
+  std::vector<std::int64_t> node_ids;
   std::vector<ElementBlock> blocks;                           // in global element order
   std::map<std::string, std::vector<std::int64_t>> node_sets; // sorted, unique node ids
   std::map<std::string, std::vector<SideEntry>> side_sets;
 
   std::int64_t num_nodes() const { return static_cast<std::int64_t>(nodes.size()); }
+  std::int64_t node_id(std::size_t n) const {
+    return node_ids.empty() ? static_cast<std::int64_t>(n) + 1 : node_ids[n];
+  }
   std::int64_t num_elements() const;
   // Global id of the first element of each block, plus the total at the end.
   std::vector<std::int64_t> block_offsets() const;
@@ -56,6 +62,13 @@ struct Mesh {
   // Appends `other` after this mesh (nodes and elements renumbered after ours). Its
   // blocks keep their names; its sets are renamed `prefix.SET` unless prefix is empty.
   void append(const Mesh& other, const std::string& prefix);
+  // Appends the nodes of `other` (with their file ids and node sets, renamed as by
+  // append()) and returns the global id its first node takes here.
+  std::int64_t append_nodes(const Mesh& other, const std::string& prefix);
+  // Whether the file ids of the nodes, and of the elements of every block together, are
+  // each without repeats (models assembled from several files may repeat them).
+  bool node_ids_unique() const;
+  bool element_ids_unique() const;
 
   // Moves every node by `d`.
   void translate(const Vec3& d);

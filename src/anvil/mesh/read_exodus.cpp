@@ -349,6 +349,12 @@ Mesh read_all(const ExodusFile& f) {
         f.fail(fmt::format("node {} has a non-finite coordinate", i + 1));
       mesh.nodes[i] = Vec3{x[i], y[i], z[i]};
     }
+    // The file's node ids (node_num_map; 1 to N without one).
+    if (f.has("node_num_map")) {
+      f.expect_values("node_num_map", nn, "the node ids");
+      mesh.node_ids.resize(static_cast<std::size_t>(nn));
+      f.check(ex_get_id_map(f.id(), EX_NODE_MAP, mesh.node_ids.data()), "the node ids");
+    }
   }
 
   // Element blocks, in file order: the file's element numbering runs through them.
@@ -564,6 +570,7 @@ std::string encode(const Mesh& m) {
   Writer w;
   w.pod<char>('M');
   w.vec(m.nodes);
+  w.vec(m.node_ids);
   w.pod<std::uint64_t>(m.blocks.size());
   for (const auto& b : m.blocks) {
     w.str(b.name);
@@ -587,6 +594,7 @@ std::optional<Mesh> decode(std::string_view bytes) {
   Reader r{bytes};
   Mesh m;
   m.nodes = r.vec<Vec3>();
+  m.node_ids = r.vec<std::int64_t>();
   for (auto n = r.pod<std::uint64_t>(); r.ok && n > 0; --n) {
     ElementBlock b;
     b.name = r.str();

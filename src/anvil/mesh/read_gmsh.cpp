@@ -380,6 +380,7 @@ private:
     if (!node_index_.emplace(t, static_cast<std::int64_t>(nodes_.size())).second)
       fail(fmt::format("node {} is defined twice", t));
     nodes_.push_back(x);
+    node_tags_.push_back(t);
   }
 
   // Reserve for `n` records, but never more than the remaining text could hold.
@@ -593,6 +594,7 @@ private:
                         "Mesh.SaveAll)");
     Mesh mesh;
     mesh.nodes = std::move(nodes_);
+    mesh.node_ids = std::move(node_tags_);
     // Blocks by ascending physical tag, "mesh" (no group) last; file order within.
     std::set<std::int64_t> groups;
     for (const auto& h : hexes_) groups.insert(h.group);
@@ -640,6 +642,7 @@ private:
   std::map<EntityKey, std::vector<std::int64_t>> entities_; // entity -> physical tags
   std::vector<Vec3> nodes_;
   std::unordered_map<std::int64_t, std::int64_t> node_index_; // Gmsh tag -> position
+  std::vector<std::int64_t> node_tags_;                       // position -> Gmsh tag
   std::unordered_set<std::int64_t> element_tags_;
   std::vector<HexRecord> hexes_;
   std::map<Hex, std::size_t> hex_seen_;                      // MSH 2 duplicates

@@ -90,12 +90,7 @@ Mesh build_mesh(const Config& config) {
       auto it = std::find_if(embedded_offset.begin(), embedded_offset.end(),
                              [&](const auto& e) { return e.first == src; });
       if (it == embedded_offset.end()) {
-        const std::int64_t shift = mesh.num_nodes();
-        mesh.nodes.insert(mesh.nodes.end(), src->nodes.begin(), src->nodes.end());
-        for (const auto& [name, ids] : src->node_sets) {
-          auto& dst = mesh.node_sets[name];
-          for (const auto id : ids) dst.push_back(id + shift);
-        }
+        const std::int64_t shift = mesh.append_nodes(*src, "");
         embedded_offset.emplace_back(src, shift);
         it = std::prev(embedded_offset.end());
       }

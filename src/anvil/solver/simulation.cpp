@@ -88,6 +88,24 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
   gather_corners(fe_, {corner_mass.data()}, {nodes_.mass.data()});
   std::fill(corner_mass.begin(), corner_mass.end(), 0.0);
 
+  // The mesh files' ids for the outputs, where they do not repeat (a model assembled from
+  // several files may repeat them: then 1..N in global order, as for generated meshes).
+  {
+    const bool node_ids = mesh.node_ids_unique(), element_ids = mesh.element_ids_unique();
+    node_file_id_.resize(nn);
+    for (std::size_t n = 0; n < nn; ++n)
+      node_file_id_[n] =
+          node_ids ? mesh.node_id(static_cast<std::size_t>(fe_.node_gid[n])) : fe_.node_gid[n] + 1;
+    element_file_id_.resize(blocks_.size());
+    for (std::size_t b = 0; b < blocks_.size(); ++b)
+      for (int e = 0; e < blocks_[b].size(); ++e) {
+        const std::int64_t gid = blocks_[b].gid[static_cast<std::size_t>(e)];
+        element_file_id_[b].push_back(
+            element_ids ? mesh.blocks[b].id(static_cast<std::size_t>(gid - block_offsets_[b]))
+                        : gid + 1);
+      }
+  }
+
   part_mass_.assign(config_.parts.size(), 0.0);
   for (const auto& b : blocks_)
     for (int e = 0; e < b.size(); ++e) part_mass_[b.part] += b.mass[e];

@@ -115,6 +115,12 @@ public:
   std::int64_t global_elements() const { return global_elements_; }
   // mesh_fingerprint() of the initial global mesh (the same on every rank).
   std::uint64_t mesh_fingerprint() const { return mesh_fingerprint_; }
+  // The ids the outputs give local node n and element e of block b: the mesh file's
+  // (LS-DYNA NID/EID, Gmsh tag, Exodus id maps) where they do not repeat, else 1..N.
+  std::int64_t node_file_id(std::size_t n) const { return node_file_id_[n]; }
+  std::int64_t element_file_id(std::size_t b, std::size_t e) const {
+    return element_file_id_[b][e];
+  }
   // Of the initial particles (ids, sets, masses, reference positions; 0 without any).
   std::uint64_t particle_fingerprint() const { return particle_fingerprint_; }
   const std::vector<double>& part_masses() const { return part_mass_; }
@@ -231,6 +237,8 @@ private:
   std::vector<std::string> warnings_;
   std::uint64_t mesh_fingerprint_ = 0;
   std::uint64_t particle_fingerprint_ = 0;
+  std::vector<std::int64_t> node_file_id_;                 // per local node
+  std::vector<std::vector<std::int64_t>> element_file_id_; // per block and element
   std::vector<std::int64_t> block_offsets_;
   std::vector<double> part_mass_;
 };
