@@ -6,6 +6,7 @@
 #include <random>
 
 #include "anvil/fe/hex8.hpp"
+#include "anvil/mesh/generators.hpp"
 #include "anvil/mesh/mesh.hpp"
 
 namespace {
@@ -383,6 +384,30 @@ TEST(OrientThickness, ThinnestDirectionBecomesZeta) {
     nodes.push_back(m.blocks[0].elements[0][static_cast<std::size_t>(c)]);
   std::sort(nodes.begin(), nodes.end());
   EXPECT_EQ(nodes, (std::vector<std::int64_t>{0, 3, 4, 7}));
+}
+
+// A wall one element thick of cubes (QA round 7): the three sizes of a cube tie, so the
+// thickness is the direction whose two faces are on the wall's surface, whatever the
+// round-off in the corners. Walls thin in x, y and z, at an offset that makes the corner
+// coordinates inexact; every element's zeta edge must run through the thickness.
+TEST(OrientThickness, AWallOfCubesTurnsByItsFaces) {
+  for (int thin = 0; thin < 3; ++thin) {
+    BoxSpec spec;
+    spec.min = {0.0013, -0.0071, 0.0029};
+    spec.max = spec.min;
+    spec.divisions = {6, 6, 6};
+    for (int i = 0; i < 3; ++i) spec.max[i] += i == thin ? 0.002 : 0.012;
+    spec.divisions[static_cast<std::size_t>(thin)] = 1;
+    Mesh m = generate_box(spec);
+    orient_thickness_zeta(m, 0);
+    int wrong = 0;
+    for (const Hex& h : m.blocks[0].elements) {
+      const Vec3 d =
+          m.nodes[static_cast<std::size_t>(h[4])] - m.nodes[static_cast<std::size_t>(h[0])];
+      wrong += std::abs(std::abs(d[thin]) - 0.002) > 1e-9 ? 1 : 0;
+    }
+    EXPECT_EQ(wrong, 0) << "wall thin in direction " << thin;
+  }
 }
 
 } // namespace

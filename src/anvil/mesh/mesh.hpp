@@ -92,9 +92,12 @@ double hex_volume(const std::array<Vec3, 8>& x);
 std::vector<std::int64_t> select_nodes(const Mesh& mesh, const Box3& box,
                                        const std::vector<std::int64_t>* candidates = nullptr);
 
-// Turns every element of block `b` so that its thinnest direction (the smallest column
-// of the Jacobian at its centre, ties kept in the order zeta, xi, eta) is its zeta axis:
-// the corners are renumbered by a cyclic turn of the natural axes, which keeps the
+// Turns every element of block `b` so that its thickness direction is its zeta axis: the
+// natural direction whose two faces are both on the block's surface (shared with no other
+// element of the block), where exactly one is, as through a wall one element thick;
+// otherwise the thinnest of those directions (or of all three where none is), by the
+// smallest column of the Jacobian at the centre, ties kept in the order zeta, xi, eta.
+// The corners are renumbered by a cyclic turn of the natural axes, which keeps the
 // element's orientation and its node set. The thick-shell element integrates through
 // zeta (docs/element.md). Side sets on the block follow the new face numbers.
 void orient_thickness_zeta(Mesh& mesh, std::size_t b);
