@@ -895,7 +895,10 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       for (int k = 0; k < lanes; ++k) {
         const std::int64_t id = b.gid[e + k];
         if (b.alive[e + k] == 0.0) continue;
-        const bool erode = (b.erosion.inverted && !(vol[k] > 0.0)) ||
+        // An element crushed flat reaches a volume that is positive by round-off, and
+        // forces that are not finite, before its volume turns negative: with `inverted`
+        // it erodes then too (QA round 7: the run stopped instead).
+        const bool erode = (b.erosion.inverted && (!(vol[k] > 0.0) || !std::isfinite(check[k]))) ||
                            (erode_ep && b.plastic_strain[e + k] >= b.erosion.plastic_strain);
         if (erode) { // delete it now: this cycle's forces already leave it out
           b.alive[e + k] = 0.0;
