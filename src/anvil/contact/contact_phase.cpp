@@ -1141,14 +1141,25 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
     }
     // One reduction: 2 when some rank's destinations have changed (the plans are rebuilt,
     // instead of two all-to-alls of counts), 1 when some rank's bound fails (a full
-    // cycle), 0 when every rank's bound holds (a lazy cycle); and whether some rank has
-    // extra nodes (then the next cycle cannot be lazy either: no reference is set).
-    std::int64_t red[2] = {changed ? 2 : (alone || bound_ok ? 0 : 1),
-                           static_cast<std::int64_t>(!extra_.empty())};
-    comm_.max(std::span<std::int64_t>(red, 2));
+    // cycle), 0 when every rank's bound holds (a lazy cycle); whether some rank has
+    // extra nodes (then the next cycle cannot be lazy either: no reference is set); and
+    // whether some rank that exchanges faces cannot send them as motions (below): the
+    // senders and receivers of the face plan must agree on what travels, FaceMotion or
+    // ContactFaceItem (QA round 7: on 5 to 8 ranks with particles, a rank that had never
+    // received whole items took motions from one that sent items, and read garbage).
+    const bool keeps_items =
+        node_plan_.stays() && face_plan_.stays() && one_copy_each_; // (in place: no peers)
+    const bool can_send_motions =
+        keeps_items ||
+        (face_in_full_ && motion_.size() == face_in_.size() && unpacked_.size() == face_in_.size());
+    std::int64_t red[3] = {changed ? 2 : (alone || bound_ok ? 0 : 1),
+                           static_cast<std::int64_t>(!extra_.empty()),
+                           static_cast<std::int64_t>(!can_send_motions)};
+    comm_.max(std::span<std::int64_t>(red, 3));
     const std::int64_t worst = red[0];
     lazy = !alone && worst == 0;
     extra_somewhere = red[1] != 0;
+    const bool motions_everywhere = red[2] == 0;
     if (worst == 2) {
       node_plan_.build(comm_, node_dest_);
       face_plan_.build(comm_, face_dest_);
@@ -1215,8 +1226,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       // constant fields are in place: every face sends only what changes, and the items
       // that stay give their boxes and planes straight from cap_ (as on a lazy cycle; the
       // items of the queued faces are completed below).
-      motions_only = !alone && worst == 1 && !in_place_ && face_in_full_ &&
-                     motion_.size() == face_in_.size() && unpacked_.size() == face_in_.size();
+      motions_only = !alone && worst == 1 && !in_place_ && motions_everywhere;
       if (worst == 2) face_in_full_ = false;
       if (in_place_) {
         search_faces_ = &face_local_;
