@@ -176,8 +176,15 @@ TEST(Cli, ProbeOutsideTheModelIsWarnedOf) {
 TEST(Cli, RunWritesTheOutputs) {
   const auto dir = (std::filesystem::temp_directory_path() / "anvil_cli_run").string();
   std::filesystem::remove_all(dir);
+  // Temporaries a killed run left there (QA round 7: summary.json.tmp and no summary)
+  // are removed: never a complete output.
+  std::filesystem::create_directories(dir + "/fields");
+  std::ofstream(dir + "/summary.json.tmp") << "{";
+  std::ofstream(dir + "/fields/step_000009.vtu.tmp") << "<";
   const auto r = run("run " + write_temp("small.yaml", small_deck) + " -o " + dir + " -q");
   ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/summary.json.tmp"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/fields/step_000009.vtu.tmp"));
   for (const char* f : {"summary.json", "history.csv", "results.pvd"})
     EXPECT_TRUE(std::filesystem::exists(dir + "/" + f)) << f;
   std::ifstream h(dir + "/history.csv");

@@ -156,6 +156,13 @@ Outputs::Outputs(const Simulation& sim, OutputOptions options)
     make_directories(opt_.directory);
     if (sim_.config().output_format != OutputFormat::exodus || sim_.sph())
       make_directories(opt_.directory + "/fields");
+    // Temporaries a killed run left behind (every file is written as NAME.tmp, then
+    // renamed): never a complete output, so they go.
+    for (const std::string dir : {opt_.directory, opt_.directory + "/fields"}) {
+      std::error_code ec;
+      for (const auto& entry : std::filesystem::directory_iterator(dir, ec))
+        if (entry.path().extension() == ".tmp") std::filesystem::remove(entry.path(), ec);
+    }
   });
   // Under mpirun, OpenMPI gives rank 0 a pseudo-terminal whatever mpirun's own output is
   // (a log file too): there, periodic lines are the safe choice.
@@ -437,11 +444,15 @@ void Outputs::finish(int status, const std::string& message) {
     initial_row_due_ = false;
     write_history_row(initial_);
   }
+  // A run stopped by a signal may be killed soon after (mpirun kills its ranks about a
+  // second after passing the signal on): its summary goes first, the last fields after.
+  const bool stopping = status >= 128;
+  if (stopping) write_summary(status, message);
   {
     ScopedPhase t(output_timer_, Phase::output);
     write_fields();
   }
-  write_summary(status, message);
+  if (!stopping) write_summary(status, message);
 }
 
 void Outputs::write_summary(int status, const std::string& message) {

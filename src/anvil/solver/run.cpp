@@ -46,6 +46,9 @@ private:
 } // namespace
 
 int run(const Config& config, const RunOptions& options, const Comm& comm) {
+  // From the start: a signal during the set-up (a large mesh's partition) stops the run
+  // after its first cycle, with a checkpoint, instead of killing it without one.
+  StopSignals signals;
   Simulation sim(config, comm);
   if (comm.rank() == 0 && options.restart.empty())
     for (const auto& w : sim.warnings()) std::fprintf(stderr, "anvil: warning: %s\n", w.c_str());
@@ -93,7 +96,6 @@ int run(const Config& config, const RunOptions& options, const Comm& comm) {
     throw InputError(error);
   };
 
-  StopSignals signals;
   try {
     while (!sim.finished()) {
       // The request travels with the coming step's reduction, so --stop-at-cycle N asks
