@@ -476,7 +476,8 @@ TEST(Cli, DecomposeWritesTheParticleDecomposition) {
   ASSERT_EQ(r.status, 0) << r.out;
   std::stringstream json;
   json << std::ifstream(dir + "/decomposition.json").rdbuf();
-  for (const char* key : {"\"particles\": 512", "\"sph\"", "\"cuts\"", "\"boxes\""})
+  for (const char* key :
+       {"\"particles\": 512", "\"sph\"", "\"cuts\"", "\"boxes\"", "\"rcb_scale\""})
     EXPECT_NE(json.str().find(key), std::string::npos) << key << "\n" << json.str();
   EXPECT_EQ(json.str().find("\"fe\""), std::string::npos) << json.str(); // no elements
   std::stringstream pvtu;

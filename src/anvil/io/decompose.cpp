@@ -67,8 +67,12 @@ void write_decomposition(const Config& config, const std::string& outdir, const 
   j["elements"] = sim.global_elements();
   j["nodes"] = sim.global_nodes();
   j["particles"] = sim.sph() ? sim.sph()->global_count() : 0;
+  // The deck's `decomposition` key, as used: the RCBs' stretch (and the FE method below).
+  const DecompositionConfig& dc = config.decomposition;
+  j["rcb_scale"] = {dc.scale.x, dc.scale.y, dc.scale.z};
   if (elements) {
     nlohmann::json fe;
+    fe["method"] = dc.fe == DecompositionConfig::Fe::metis ? "metis" : "rcb";
     fe["elements"] = per_rank(comm, static_cast<double>(sim.fe().num_elements()));
     // The work the partition balances: each element weighted by its formulation's cost.
     double cost = 0;
