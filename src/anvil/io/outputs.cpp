@@ -158,7 +158,7 @@ Outputs::Outputs(const Simulation& sim, OutputOptions options)
       make_directories(opt_.directory + "/fields");
     // Temporaries a killed run left behind (every file is written as NAME.tmp, then
     // renamed): never a complete output, so they go.
-    for (const std::string dir : {opt_.directory, opt_.directory + "/fields"}) {
+    for (const std::string& dir : {opt_.directory, opt_.directory + "/fields"}) {
       std::error_code ec;
       for (const auto& entry : std::filesystem::directory_iterator(dir, ec))
         if (entry.path().extension() == ".tmp") std::filesystem::remove(entry.path(), ec);
