@@ -541,8 +541,26 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
                 2.0 * (s[3] * d[3] + s[4] * d[4] + s[5] * d[5]);
         _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) simd::store(s[k], &b.stress[k][e]);
       }
+      vdouble density = simd::load(&b.mass[e]) * inv;
+      if (b.eroded > 0) {
+        // Eroded elements deform no more: with no rate of deformation their material
+        // state (plastic strain, temperature) stays as it was when they eroded, whatever
+        // their nodes do (QA round 12: it grew to 4e15 and went non-finite, and every
+        // later checkpoint was refused). Any finite density serves them.
+        const auto gone = simd::load(&b.alive[e]) == 0.0;
+        if (stdx::any_of(gone)) {
+          _Pragma("GCC unroll 6") for (int k = 0; k < 6; ++k) stdx::where(gone, d[k]) = 0.0;
+          stdx::where(gone, density) = 1.0;
+          if constexpr (Shell)
+            for (int k = 0; k < 6 * np; ++k) {
+              vdouble dk = simd::load(scratch(s_pd0 + k) + l);
+              stdx::where(gone, dk) = 0.0;
+              simd::store(dk, scratch(s_pd0 + k) + l);
+            }
+        }
+      }
       _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) simd::store(d[k], scratch(s_d0 + k) + l);
-      simd::store(simd::load(&b.mass[e]) * inv, scratch(s_density) + l);
+      simd::store(density, scratch(s_density) + l);
       simd::store(power, scratch(s_power_old) + l);
       simd::store(vol, scratch(s_volume_mid) + l);
       if (stiff) // the stiffness form rotates its hourglass forces with Q
@@ -810,6 +828,12 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       // arithmetic may have produced non-finite values).
       if (any_dead) {
         stdx::where(dead, dte) = 1e300;
+        for (auto& hk : b.hourglass_force) { // (stiffness forms only)
+          if (hk.empty()) break;
+          vdouble q = simd::load(&hk[e]);
+          stdx::where(dead, q) = 0.0;
+          simd::store(q, &hk[e]);
+        }
         _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) {
           vdouble sk = simd::load(&b.stress[k][e]);
           stdx::where(dead, sk) = 0.0;
@@ -908,6 +932,8 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
           for (int a = 0; a < 8; ++a)
             for (double* r : rows_of) r[8 * k + a] = 0.0;
           for (auto& sk : b.stress) sk[e + k] = 0.0;
+          for (auto& hk : b.hourglass_force)
+            if (!hk.empty()) hk[e + k] = 0.0;
           for (auto& pt : b.point_stress)
             for (auto& sk : pt) sk[e + k] = 0.0;
           ++result.eroded;
