@@ -5,6 +5,7 @@
 #  - damaged (one flipped bit in a velocity), truncated, or followed by extra bytes;
 #  - of a deck whose thick-shell part has other points through the thickness (found on
 #    the ranks holding that part only: this hung on 2 ranks);
+#  - of a deck without the thick shell, or whose termination comes before the checkpoint;
 #  - of another mesh with the same numbers of nodes and elements;
 # and a checkpoint that cannot be written stops the run with exit 2 and a failed summary.
 set -euo pipefail
@@ -65,7 +66,15 @@ refused deck.yaml short.anvil "is truncated"
 refused deck.yaml long.anvil "bytes follow its end"
 
 sed -e 's/points: 3/points: 5/' deck.yaml > points5.yaml
-refused points5.yaml first/checkpoint.anvil "lacks the 5 thick-shell points of element 257"
+refused points5.yaml first/checkpoint.anvil "with thick_shell {points: 3} for element 257 (part plate, element 1 of the part), the deck gives thick_shell {points: 5}"
+# Without the thick shell (QA round 12: accepted silently, its points' state dropped, or
+# refused as "another mesh" where the thick shell had turned the elements).
+grep -v "thick_shell" deck.yaml > no_shell.yaml
+refused no_shell.yaml first/checkpoint.anvil "the deck gives no thick_shell: a part's thick_shell cannot change"
+# A termination before the checkpoint (QA round 12: "completed" with a meaningless energy
+# block and no final fields).
+sed -e 's/cycles: 60/cycles: 10/' deck.yaml > short.yaml
+refused short.yaml first/checkpoint.anvil "past the deck's termination (10 cycles)"
 sed -e 's/divisions: \[4, 4, 16\]/divisions: [16, 4, 4]/' deck.yaml > other_mesh.yaml
 refused other_mesh.yaml first/checkpoint.anvil "was written for another mesh"
 

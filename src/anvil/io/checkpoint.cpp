@@ -204,6 +204,8 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
   h["field_count"] = c.outputs.field_count;
   h["pvd"] = c.outputs.pvd;
   h["particle_pvd"] = c.outputs.particle_pvd;
+  h["history_rows"] = c.outputs.history_rows;
+  h["history_last"] = c.outputs.history_last;
   // Doubles as raw bits in the binary part: the header's decimal text is for people.
   const double exact[8] = {c.time,
                            c.dt,
@@ -325,6 +327,10 @@ Checkpoint read_checkpoint(const std::string& path) {
     c.outputs.pvd = h.at("pvd").get<std::vector<std::pair<double, std::string>>>();
     c.outputs.particle_pvd =
         h.at("particle_pvd").get<std::vector<std::pair<double, std::string>>>();
+    if (h.contains("history_rows")) { // (since 2026-11-23; same format version)
+      c.outputs.history_rows = h.at("history_rows").get<std::int64_t>();
+      c.outputs.history_last = h.at("history_last").get<std::string>();
+    }
   } catch (const std::exception& e) {
     throw InputError("checkpoint '" + path + "' has a damaged header: " + e.what());
   }

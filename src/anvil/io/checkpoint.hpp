@@ -22,6 +22,11 @@ struct OutputState {
   int field_count = 0;
   std::vector<std::pair<double, std::string>> pvd;          // results.pvd (rank 0)
   std::vector<std::pair<double, std::string>> particle_pvd; // particles.pvd (rank 0)
+  // history.csv as written so far (rank 0): its rows and the last of them, for a restart
+  // to tell this run's history from a later run's in the same directory (-1: unknown, a
+  // checkpoint from before they were recorded).
+  std::int64_t history_rows = -1;
+  std::string history_last;
 };
 
 struct Checkpoint {

@@ -226,7 +226,7 @@ void Outputs::resume(const OutputState& state, const std::string& from) {
     const fs::path up = fs::relative(old_dir, new_dir, e3);
     if (!e3)
       for (auto* series : {&pvd_, &particle_pvd_})
-        for (auto& [t, file] : *series) file = (up / file).generic_string();
+        for (auto& [t, file] : *series) file = (up / file).lexically_normal().generic_string();
   }
   last_field_cycle_ = sim_.clock().cycle; // the fields at the checkpoint were written then
   start_cycle_ = sim_.clock().cycle;
@@ -261,7 +261,10 @@ void Outputs::resume(const OutputState& state, const std::string& from) {
                        "lists those that are",
                        n - series->size(), name, old_dir.string()));
   }
+  std::string old_header;
+  bool have_old = false;
   if (std::FILE* in = std::fopen(old_path.c_str(), "r")) {
+    have_old = true;
     char* line = nullptr;
     std::size_t cap = 0;
     bool header = true;
@@ -270,6 +273,7 @@ void Outputs::resume(const OutputState& state, const std::string& from) {
       if (!l.empty() && l.back() == '\n') l.pop_back();
       if (header) {
         header = false;
+        old_header = l;
         continue;
       }
       if (std::strtod(l.c_str(), nullptr) < sim_.clock().time) keep.push_back(l);
@@ -277,8 +281,41 @@ void Outputs::resume(const OutputState& state, const std::string& from) {
     std::free(line);
     std::fclose(in);
   }
+  // The rows must be the checkpoint's run's: a later run in that directory (another deck,
+  // or the same one run again from the start past it) wrote over its history and fields
+  // (QA round 12: copied as this run's, without a word).
+  if (have_old && state.history_rows >= 0 &&
+      (static_cast<std::int64_t>(keep.size()) != state.history_rows ||
+       (!keep.empty() && keep.back() != state.history_last))) {
+    warn(fmt::format("restart: {} is not the history of the run that wrote the checkpoint (its "
+                     "rows before t = {:.9g} s differ: a later run wrote over that directory); "
+                     "history.csv and the field series start at the checkpoint",
+                     old_path, sim_.clock().time));
+    keep.clear();
+    pvd_.clear();
+    particle_pvd_.clear();
+    std::error_code ignored; // (the series files list the later run's fields)
+    fs::remove(fs::path(opt_.directory) / "results.pvd", ignored);
+    fs::remove(fs::path(opt_.directory) / "particles.pvd", ignored);
+  }
+  // Other columns (the deck's probes or rigid walls changed): the earlier rows keep their
+  // own header in a file of their own, history.csv starts at the checkpoint.
+  if (!keep.empty() && old_header != history_header()) {
+    const std::string before =
+        fmt::format("{}/history-before-s{:06d}.csv", opt_.directory, sim_.clock().cycle);
+    std::string text = old_header + "\n";
+    for (const auto& l : keep) text += l + "\n";
+    write_file_atomic(before, text);
+    warn(fmt::format("restart: the deck's history columns (probes, rigid walls) differ from "
+                     "those of the run that wrote the checkpoint: history.csv starts at the "
+                     "checkpoint, its {} earlier rows are in {}",
+                     keep.size(), before));
+    keep.clear();
+  }
   std::string text = history_header() + "\n";
   for (const auto& l : keep) text += l + "\n";
+  history_rows_ = static_cast<std::int64_t>(keep.size());
+  history_last_ = keep.empty() ? std::string() : keep.back();
   write_file_atomic(path, text);
   history_ = std::fopen(path.c_str(), "a");
   if (!history_) throw InputError("cannot write " + path);
@@ -288,7 +325,8 @@ void Outputs::resume(const OutputState& state, const std::string& from) {
 }
 
 OutputState Outputs::state() const {
-  return {next_fields_, next_history_, 0.0, field_count_, pvd_, particle_pvd_};
+  return {next_fields_, next_history_, 0.0,           field_count_,
+          pvd_,         particle_pvd_, history_rows_, history_last_};
 }
 
 void Outputs::write_history_row(const Sample& s) {
@@ -300,6 +338,8 @@ void Outputs::write_history_row(const Sample& s) {
   for (double v : s.wall_force) row += fmt::format(",{:.17g}", v);
   std::fprintf(history_, "%s\n", row.c_str());
   std::fflush(history_);
+  ++history_rows_;
+  history_last_ = std::move(row);
 }
 
 void Outputs::after_step() {

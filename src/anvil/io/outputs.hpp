@@ -89,6 +89,8 @@ private:
   double next_fields_ = 0, next_history_ = 0;
   std::int64_t last_field_cycle_ = -1;
   int field_count_ = 0;
+  std::int64_t history_rows_ = 0; // rows of history.csv (rank 0), and the last of them
+  std::string history_last_;
   double start_wall_ = 0, last_progress_wall_ = 0, last_progress_fraction_ = 0;
   std::int64_t start_cycle_ = 0; // the cycle this run started from (its checkpoint's)
   double start_fraction_ = 0;    // the fraction done at that cycle

@@ -842,41 +842,69 @@ void Simulation::restore(const Checkpoint& c) {
                                  "(their order, lattices, spacing or density) differ from those "
                                  "of the run that wrote it (restart with the deck it came from)",
                                  from));
+  if (c.time > config_.end_time * (1 + 1e-12) || c.cycle > config_.end_cycles)
+    throw InputError(fmt::format(
+        "{}: {} is at t = {:.9g} s (cycle {}), past the deck's termination ({}): nothing is "
+        "left to run; extend the termination to continue",
+        config_.deck_file, from, c.time, c.cycle,
+        config_.end_time < std::numeric_limits<double>::infinity()
+            ? fmt::format("time {:.9g} s", config_.end_time)
+            : fmt::format("{} cycles", config_.end_cycles)));
+  auto find = [](const std::vector<std::int64_t>& ids, std::int64_t id) -> std::int64_t {
+    const auto it = std::lower_bound(ids.begin(), ids.end(), id);
+    return it != ids.end() && *it == id ? it - ids.begin() : -1;
+  };
+  // The parts' thick_shell as the checkpoint's run had it, before the mesh (a thick shell
+  // turns its elements, so the connectivity differs too): the smallest element whose
+  // points through the thickness differ, on every rank.
+  const std::int64_t none = std::numeric_limits<std::int64_t>::max();
+  {
+    std::int64_t first = none;
+    for (const auto& b : blocks_)
+      for (int e = 0; e < b.size(); ++e) {
+        const std::int64_t kp = find(c.point_gid, b.gid[e]);
+        const int had = kp < 0 ? 0 : c.point_count[static_cast<std::size_t>(kp)];
+        if (had != (b.thick_shell.enabled() ? b.thick_shell.points : 0))
+          first = std::min(first, b.gid[e]);
+      }
+    first = comm_.min(first);
+    if (first != none) {
+      std::int64_t points[2] = {-1, -1}; // the checkpoint's, the deck's
+      for (const auto& b : blocks_)
+        for (int e = 0; e < b.size(); ++e)
+          if (b.gid[e] == first) {
+            const std::int64_t kp = find(c.point_gid, first);
+            points[0] = kp < 0 ? 0 : c.point_count[static_cast<std::size_t>(kp)];
+            points[1] = b.thick_shell.enabled() ? b.thick_shell.points : 0;
+          }
+      comm_.max(std::span<std::int64_t>(points, 2));
+      auto section = [](std::int64_t n) {
+        return n == 0 ? std::string("no thick_shell")
+                      : fmt::format("thick_shell {{points: {}}}", n);
+      };
+      throw InputError(fmt::format(
+          "{} was written with {} for {}, the deck gives {}: a part's thick_shell cannot change "
+          "on restart (its state lives at the points through the thickness)",
+          from, section(points[0]), describe_element(first), section(points[1])));
+    }
+  }
   if (c.mesh_fingerprint != mesh_fingerprint_)
     throw InputError(fmt::format("{} was written for another mesh: the deck's node coordinates "
                                  "or element connectivity differ from those of the run that "
                                  "wrote it (restart with the deck it came from)",
                                  from));
-  auto find = [](const std::vector<std::int64_t>& ids, std::int64_t id) -> std::int64_t {
-    const auto it = std::lower_bound(ids.begin(), ids.end(), id);
-    return it != ids.end() && *it == id ? it - ids.begin() : -1;
-  };
   // What the checkpoint lacks is found on the ranks holding it; every rank must throw
   // (the smallest such id over all ranks), not only those.
-  const std::int64_t none = std::numeric_limits<std::int64_t>::max();
-  std::int64_t missing[3] = {none, none, none}; // node, element, thick-shell element
+  std::int64_t missing[2] = {none, none}; // node, element
   for (std::size_t n = 0; n < nodes_.size(); ++n)
     if (find(c.node_gid, fe_.node_gid[n]) < 0) missing[0] = std::min(missing[0], fe_.node_gid[n]);
   for (const auto& b : blocks_)
-    for (int e = 0; e < b.size(); ++e) {
+    for (int e = 0; e < b.size(); ++e)
       if (find(c.element_gid, b.gid[e]) < 0) missing[1] = std::min(missing[1], b.gid[e]);
-      if (!b.thick_shell.enabled()) continue;
-      const std::int64_t kp = find(c.point_gid, b.gid[e]);
-      if (kp < 0 || c.point_count[static_cast<std::size_t>(kp)] != b.thick_shell.points)
-        missing[2] = std::min(missing[2], b.gid[e]);
-    }
-  comm_.min(std::span<std::int64_t>(missing, 3));
+  comm_.min(std::span<std::int64_t>(missing, 2));
   if (missing[0] != none) throw InputError(from + " lacks node " + std::to_string(missing[0] + 1));
   if (missing[1] != none)
     throw InputError(from + " lacks element " + std::to_string(missing[1] + 1));
-  if (missing[2] != none) {
-    int points = 0; // the deck's points through that element's thickness
-    for (std::size_t b = 0; b < blocks_.size(); ++b)
-      if (missing[2] >= block_offsets_[b] && missing[2] < block_offsets_[b + 1])
-        points = blocks_[b].thick_shell.points;
-    throw InputError(fmt::format("{} lacks the {} thick-shell points of element {}", from, points,
-                                 missing[2] + 1));
-  }
   clock_.time = c.time;
   clock_.cycle = c.cycle;
   clock_.dt = c.dt;
