@@ -347,10 +347,10 @@ void ContactPhase::complete_item(const FaceMotion& m, std::size_t j) {
 }
 
 void ContactPhase::set_eroded(std::span<const std::int64_t> fresh, bool exposing) {
-  const std::size_t before = eroded_.size();
-  eroded_.insert(eroded_.end(), fresh.begin(), fresh.end());
-  std::inplace_merge(eroded_.begin(), eroded_.begin() + static_cast<std::ptrdiff_t>(before),
-                     eroded_.end());
+  // (Merged through a kept buffer: std::inplace_merge takes a temporary one each call.)
+  eroded_merge_.resize(eroded_.size() + fresh.size());
+  std::merge(eroded_.begin(), eroded_.end(), fresh.begin(), fresh.end(), eroded_merge_.begin());
+  eroded_.swap(eroded_merge_);
   auto gone = [&](std::int64_t el) {
     return std::binary_search(eroded_.begin(), eroded_.end(), el);
   };

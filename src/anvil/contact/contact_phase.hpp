@@ -164,7 +164,8 @@ private:
   // (element gid, owned node k) of the dormant nodes, and (element gid, face f) of each
   // face's element and of the element behind it, ascending: what an erosion changes.
   std::vector<std::pair<std::int64_t, std::size_t>> dormant_by_element_, faces_by_element_;
-  std::vector<std::int64_t> eroded_;  // every element eroded so far (ascending)
+  std::vector<std::int64_t> eroded_;       // every element eroded so far (ascending)
+  std::vector<std::int64_t> eroded_merge_; // set_eroded()'s buffer for the merge
   int exposed_age_ = 0;               // 1: set_eroded() exposed faces this cycle; 2: last cycle
   std::vector<int> my_face_rank_;     // contact rank of the centroid, last cycle
   std::size_t live_ = 0;              // faces active (face_active_)

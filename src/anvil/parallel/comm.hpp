@@ -137,13 +137,24 @@ public:
   // Every rank's values, concatenated in rank order (not for the hot cycle: it allocates).
   template <class T>
   std::vector<T> allgatherv(std::span<const T> mine) const {
-    static_assert(std::is_trivially_copyable_v<T>);
-    const auto bytes = allgather(static_cast<std::int64_t>(mine.size_bytes()));
-    std::int64_t total = 0;
-    for (const std::int64_t b : bytes) total += b;
-    std::vector<T> out(static_cast<std::size_t>(total) / sizeof(T));
-    allgatherv_bytes(mine.data(), mine.size_bytes(), out.data(), bytes);
+    std::vector<T> out;
+    std::vector<std::int64_t> bytes;
+    allgatherv(mine, out, bytes);
     return out;
+  }
+  // The same into `out`, with `bytes` for the ranks' sizes: both keep their capacity, so
+  // once they have grown to their largest size the call allocates nothing.
+  template <class T>
+  void allgatherv(std::span<const T> mine, std::vector<T>& out,
+                  std::vector<std::int64_t>& bytes) const {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const auto b = static_cast<std::int64_t>(mine.size_bytes());
+    bytes.resize(static_cast<std::size_t>(size_));
+    allgather_bytes(&b, sizeof b, bytes.data());
+    std::int64_t total = 0;
+    for (const std::int64_t k : bytes) total += k;
+    out.resize(static_cast<std::size_t>(total) / sizeof(T));
+    allgatherv_bytes(mine.data(), mine.size_bytes(), out.data(), bytes);
   }
   // One value to each rank, one value from each rank.
   template <class T>

@@ -391,7 +391,8 @@ void Simulation::locate_probes(const Mesh& mesh) {
 void Simulation::share_eroded(bool exposing) {
   if (!contact_) return;
   // The elements eroded here since the last call (each told once), from every rank.
-  std::vector<std::int64_t> mine;
+  std::vector<std::int64_t>& mine = erosion_mine_;
+  mine.clear();
   erosion_shared_.resize(blocks_.size());
   for (std::size_t b = 0; b < blocks_.size(); ++b) {
     const HexBlock& blk = blocks_[b];
@@ -403,7 +404,8 @@ void Simulation::share_eroded(bool exposing) {
         mine.push_back(blk.gid[e]);
       }
   }
-  std::vector<std::int64_t> fresh = comm_.allgatherv(std::span<const std::int64_t>(mine));
+  std::vector<std::int64_t>& fresh = erosion_fresh_;
+  comm_.allgatherv(std::span<const std::int64_t>(mine), fresh, erosion_bytes_);
   std::sort(fresh.begin(), fresh.end());
   contact_->set_eroded(fresh, exposing);
 }

@@ -229,6 +229,8 @@ private:
   std::int64_t eroded_ = 0; // elements this rank has eroded
   // Per block and element: 1 once share_eroded() has told the contact phase it eroded.
   std::vector<std::vector<std::uint8_t>> erosion_shared_;
+  // share_eroded()'s buffers (kept: an erosion cycle allocates only past their size)
+  std::vector<std::int64_t> erosion_mine_, erosion_fresh_, erosion_bytes_;
   // This rank's smallest element step and its element: the controlling element is found
   // from them (one more reduction) only when a message needs it.
   double dt_stable_local_ = 0;
