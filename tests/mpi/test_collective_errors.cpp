@@ -118,7 +118,9 @@ TEST(CollectiveErrors, CheckpointLackingThickShellPointsStopsAllRanks) {
   const Comm world = Comm::world();
   const Checkpoint c = two_cycles(world);
   // The plate's elements follow the bar's 256: element 257 is the plate's first.
-  expect_refused(world, restart_deck(5), c, "lacks the 5 thick-shell points of element 257");
+  expect_refused(world, restart_deck(5), c,
+                 "thick_shell {points: 3} for element 257 (part plate, element 1 of the part), "
+                 "the deck gives thick_shell {points: 5}");
 }
 
 TEST(CollectiveErrors, CheckpointLackingANodeStopsAllRanks) {
