@@ -768,6 +768,24 @@ TEST(Keyword, MessageNits) {
       << twice.warnings[0];
 }
 
+// A node id one digit too wide for the NID field runs into X: the message says so and
+// names the wider formats, rather than calling X a bad number (QA round 13).
+TEST(Keyword, NodeIdWiderThanItsFieldIsNamed) {
+  const std::string node1 = "       1             0.0             0.0             0.0";
+  expect_error(with(good, node1, "100000001 0.000000000E+00 0.000000000E+00 0.000000000E+00"),
+               {"model.k:17: *NODE.NID", "NID '100000001' is wider than its field and runs into X",
+                "8 characters wide", "I10=Y", "'*NODE %'", "LONG=Y", "comma-separated"});
+  // In I10 format the field is 10 wide: only the long format and commas are wider.
+  const std::string i10 = with(with(good, "*NODE\n", "*NODE %\n"), node1,
+                               "10000000001 0.000000000E+00 0.000000000E+00 0.000000000E+00");
+  expect_error(i10, {"*NODE.NID", "NID '10000000001'", "10 characters wide", "LONG=Y"});
+  try {
+    kw(i10);
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).find("I10=Y"), std::string::npos) << e.what();
+  }
+}
+
 // Fuzz-style: deterministic damage to the valid deck (bytes, digits, truncation, lines
 // deleted or repeated). Every variant parses or throws InputError naming the deck.
 TEST(Keyword, MutatedDecksParseOrThrowInputError) {

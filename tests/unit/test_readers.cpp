@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include <exodusII.h>
 #include <fmt/format.h>
 
 #include "anvil/core/error.hpp"
@@ -252,6 +253,53 @@ TEST(ReadExodus, UnreadableFilesAreInputErrors) {
   }
 }
 
+// A directory named like a mesh file (some tools write `model.exo` directories for
+// decomposed sets): an input error naming it, not a hang on its nonsense size (QA round 13).
+TEST(ReadExodus, DirectoryIsAnInputError) {
+  TempDir dir;
+  for (const char* name : {"model.exo", "model.e"}) {
+    fs::create_directories(dir.path / name);
+    expect_exodus_error(dir.file(name), {"is a directory, not a mesh file"});
+  }
+}
+
+// One unit-cube hexahedron as an Exodus II file with the given id maps.
+void write_one_hex(const std::string& path, const std::vector<std::int64_t>& node_map,
+                   const std::vector<std::int64_t>& elem_map) {
+  int cws = 8, iows = 8;
+  const int id = ex_create(path.c_str(), EX_CLOBBER | EX_ALL_INT64_API, &cws, &iows);
+  ASSERT_GE(id, 0);
+  ASSERT_EQ(ex_put_init(id, "one hex", 3, 8, 1, 1, 0, 0), 0);
+  const std::vector<double> x{0, 1, 1, 0, 0, 1, 1, 0}, y{0, 0, 1, 1, 0, 0, 1, 1},
+      z{0, 0, 0, 0, 1, 1, 1, 1};
+  ASSERT_EQ(ex_put_coord(id, x.data(), y.data(), z.data()), 0);
+  ASSERT_EQ(ex_put_block(id, EX_ELEM_BLOCK, 1, "HEX8", 1, 8, 0, 0, 0), 0);
+  const std::int64_t conn[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+  ASSERT_EQ(ex_put_conn(id, EX_ELEM_BLOCK, 1, conn, nullptr, nullptr), 0);
+  ASSERT_EQ(ex_put_id_map(id, EX_NODE_MAP, node_map.data()), 0);
+  ASSERT_EQ(ex_put_id_map(id, EX_ELEM_MAP, elem_map.data()), 0);
+  ex_close(id);
+}
+
+// Exodus ids are positive, and the outputs carry them: an id <= 0 in an id map is refused
+// as keyword and Gmsh input refuse it, naming the map, the entity and the id.
+TEST(ReadExodus, NonPositiveMapIdsAreRefused) {
+  TempDir dir;
+  const std::vector<std::int64_t> nodes{11, 12, 13, 14, 15, 16, 17, 18};
+  write_one_hex(dir.file("good.exo"), nodes, {7});
+  const Mesh m = read_exodus(dir.file("good.exo"));
+  EXPECT_EQ(m.node_ids, nodes);
+  EXPECT_EQ(m.blocks.at(0).ids, (std::vector<std::int64_t>{7}));
+  write_one_hex(dir.file("neg_node.exo"), {11, -5, 13, 14, 15, 16, 17, 18}, {7});
+  expect_exodus_error(dir.file("neg_node.exo"),
+                      {"node_num_map", "node 2", "id -5", "ids must be positive"});
+  write_one_hex(dir.file("zero_node.exo"), {11, 12, 13, 14, 15, 16, 17, 0}, {7});
+  expect_exodus_error(dir.file("zero_node.exo"), {"node_num_map", "node 8", "id 0"});
+  write_one_hex(dir.file("neg_elem.exo"), nodes, {-7});
+  expect_exodus_error(dir.file("neg_elem.exo"),
+                      {"elem_num_map", "element 1", "id -7", "ids must be positive"});
+}
+
 // Corrupt bytes anywhere in an Exodus file: an InputError or a mesh, never a crash or
 // the gigabyte allocations that netCDF makes from a corrupt header.
 TEST(ReadExodus, MutatedFilesParseOrThrowInputError) {
@@ -314,6 +362,36 @@ TEST(ReadGmsh, Box41BlocksPerVolumeGroupAndNodeSets) {
   // Gmsh tags are 1-based and in file order here: element 12 is nodes 1 13 25 16 5 17 26 20.
   EXPECT_EQ(m.blocks[0].elements[0], (Hex{0, 12, 24, 15, 4, 16, 25, 19}));
   expect_gmsh_box_sets(m);
+}
+
+// A UTF-8 byte-order mark (some Windows editors write one) is skipped, as in keyword files.
+TEST(ReadGmsh, ByteOrderMarkIsSkipped) {
+  const Mesh ref = parse_gmsh(slurp(data("box_2x2x2.msh")), "box.msh");
+  const Mesh m = parse_gmsh("\xEF\xBB\xBF" + slurp(data("box_2x2x2.msh")), "box.msh");
+  expect_box(m);
+  EXPECT_EQ(m.node_ids, ref.node_ids);
+  EXPECT_EQ(m.node_sets, ref.node_sets);
+  // Only at the start of the file.
+  try {
+    parse_gmsh("\n\xEF\xBB\xBF" + slurp(data("box_2x2x2.msh")), "box.msh");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("box.msh:2"), std::string::npos) << e.what();
+  }
+}
+
+// A directory named like a mesh file is named as one, not as an empty file.
+TEST(ReadGmsh, DirectoryIsAnInputError) {
+  TempDir dir;
+  fs::create_directories(dir.path / "model.msh");
+  try {
+    read_gmsh(dir.file("model.msh"));
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where().file, dir.file("model.msh"));
+    EXPECT_NE(std::string(e.what()).find("is a directory, not a mesh file"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(ReadGmsh, Box22ReadsLike41) {
@@ -670,6 +748,18 @@ TEST(ReadersDeck, BadMeshFilesExitWithStatusTwo) {
     EXPECT_EQ(r.status, 2) << r.output;
     EXPECT_NE(r.output.find("deck.yaml:7: parts.box.mesh"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find(f.fragment), std::string::npos) << r.output;
+  }
+  // Directories named like mesh files (an Exodus one used to hang the reader).
+  for (const char* name : {"dir.exo", "dir.msh", "dir.k"}) {
+    SCOPED_TRACE(name);
+    fs::create_directories(dir.path / name);
+    write(dir.path / "deck.yaml", deck_for(name, "box.top"));
+    const CheckRun r = anvil_check(dir.file("deck.yaml"));
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find(
+                  fmt::format("deck.yaml:7: parts.box.mesh: {}: is a directory", dir.file(name))),
+              std::string::npos)
+        << r.output;
   }
   // A set that the file does not define.
   fs::copy_file(data("box_2x2x2.msh"), dir.path / "box.msh");

@@ -1,7 +1,10 @@
 #include "anvil/io/exodus.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <ctime>
+#include <limits>
+#include <set>
 
 #include <exodusII.h>
 #include <fmt/format.h>
@@ -57,7 +60,37 @@ struct NameList {
   }
 };
 
+// The longest prefix of `s` of at most `max_bytes` bytes that ends on a UTF-8 character
+// boundary (deck strings are UTF-8; a cut inside a character leaves invalid text).
+std::string utf8_prefix(const std::string& s, std::size_t max_bytes) {
+  if (s.size() <= max_bytes) return s;
+  std::size_t cut = max_bytes;
+  while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;
+  return s.substr(0, cut);
+}
+
 } // namespace
+
+std::vector<std::string> exodus_names(const std::vector<std::string>& names,
+                                      std::size_t max_bytes) {
+  std::vector<std::string> out(names.size());
+  std::set<std::string> used;
+  // Names that fit are kept as they are; the others are cut, and a cut that repeats a
+  // name already taken ends in ~2, ~3, ... instead.
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i].size() <= max_bytes && used.insert(names[i]).second) out[i] = names[i];
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (!out[i].empty() || names[i].empty()) continue;
+    std::string name = utf8_prefix(names[i], max_bytes);
+    for (int k = 2; used.count(name) > 0; ++k) {
+      const std::string suffix = fmt::format("~{}", k);
+      name = utf8_prefix(names[i], max_bytes - std::min(max_bytes, suffix.size())) + suffix;
+    }
+    used.insert(name);
+    out[i] = name;
+  }
+  return out;
+}
 
 std::string exodus_path(const std::string& dir, int ranks, int rank, const std::string& stem) {
   if (ranks == 1) return fmt::format("{}/{}.exo", dir, stem);
@@ -81,11 +114,15 @@ ExodusWriter::ExodusWriter(const std::string& path, const Simulation& sim, const
   // records up to the last ex_update are consistent (HDF5 files offer no such promise).
   // Not in netCDF's share mode, which writes the record count as soon as a step begins,
   // so that a kill mid-step would leave a step of fill values. 64-bit integers through
-  // the API, 32-bit in the file (classic has no other).
-  id_ = ex_create(path.c_str(), EX_CLOBBER | EX_NOSHARE | EX_LARGE_MODEL | EX_ALL_INT64_API,
-                  &cpu_word_size, &io_word_size);
+  // the API, 32-bit in the file (classic has no other), unless an id of the model (on any
+  // rank: the pieces share one format) needs more: then the integers are 64-bit in the
+  // file, which the Exodus library (6.02 as Debian ships it) stores only in netCDF-4.
+  const bool wide_ids = sim.max_file_id() > std::numeric_limits<std::int32_t>::max();
+  const int format = wide_ids ? EX_NETCDF4 | EX_ALL_INT64_DB : EX_LARGE_MODEL;
+  id_ = ex_create(path.c_str(), EX_CLOBBER | EX_NOSHARE | format | EX_ALL_INT64_API, &cpu_word_size,
+                  &io_word_size);
   if (id_ < 0) fail("cannot create the file");
-  check(ex_set_max_name_length(id_, 80), "names");
+  check(ex_set_max_name_length(id_, static_cast<int>(max_name_bytes)), "names");
 
   const auto& blocks = sim.blocks();
   const auto& parts = sim.config().parts;
@@ -95,8 +132,8 @@ ExodusWriter::ExodusWriter(const std::string& path, const Simulation& sim, const
     block_sizes_.push_back(b.size());
     ne += b.size();
   }
-  std::string title = sim.config().title.empty() ? "anvil" : sim.config().title;
-  title.resize(std::min<std::size_t>(title.size(), MAX_LINE_LENGTH));
+  const std::string title =
+      utf8_prefix(sim.config().title.empty() ? "anvil" : sim.config().title, MAX_LINE_LENGTH);
   check(ex_put_init(id_, title.c_str(), 3, static_cast<std::int64_t>(nn), ne,
                     static_cast<std::int64_t>(blocks.size()), 0, 0),
         "the header");
@@ -136,7 +173,9 @@ ExodusWriter::ExodusWriter(const std::string& path, const Simulation& sim, const
     std::vector<std::string> names;
     for (std::size_t b = 0; b < blocks.size(); ++b)
       names.push_back(b < parts.size() ? parts[b].name : fmt::format("block_{}", b + 1));
-    NameList list(std::move(names));
+    // Cut to the file's name length here, distinct and on a character boundary, rather
+    // than by the library (which cuts bytes and warns on stderr in its own format).
+    NameList list(exodus_names(names, max_name_bytes));
     check(ex_put_names(id_, EX_ELEM_BLOCK, list.ptrs.data()), "block names");
   }
   if (element_ids && ne > 0)

@@ -9,9 +9,12 @@
 // coordinates), element stress_xx ... stress_zx, von_mises, pressure, plastic_strain,
 // temperature (when a part has it), fe_rank (and contact_rank with contact). The file is
 // netCDF classic (64-bit offset) and flushed after every step, so a run killed mid-way
-// leaves a file that reads up to its last complete step.
+// leaves a file that reads up to its last complete step. A model with an id above
+// 2^31 - 1 (a mesh file's) is written as netCDF-4 with 64-bit integers instead, the only
+// way the Exodus library stores such ids; HDF5 makes no promise about killed runs.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -25,6 +28,14 @@ class Simulation;
 // SEACAS naming that ParaView and epu read).
 std::string exodus_path(const std::string& dir, int ranks, int rank,
                         const std::string& stem = "results");
+
+// Longest name (part, variable) the files hold, in bytes.
+inline constexpr std::size_t max_name_bytes = 80;
+
+// `names` as the file stores them: a name of at most `max_bytes` bytes as it is, a longer
+// one cut on a UTF-8 character boundary, and a cut that repeats a name already taken
+// ending in ~2, ~3, ... instead, so that the names stay distinct.
+std::vector<std::string> exodus_names(const std::vector<std::string>& names, std::size_t max_bytes);
 
 class ExodusWriter {
 public:

@@ -42,26 +42,33 @@ std::string json_text(const nlohmann::json& j, int indent) {
   return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
-std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {
+void expect_regular_file(const std::string& path, const std::string& what) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const auto st = fs::status(path, ec);
   if (!fs::exists(st))
     throw InputError({path, 0, ""},
-                     "cannot open the deck file" + (ec ? ": " + ec.message() : std::string()));
-  if (fs::is_directory(st)) throw InputError({path, 0, ""}, "is a directory, not a deck file");
+                     "cannot open the " + what + (ec ? ": " + ec.message() : std::string()));
+  if (fs::is_directory(st)) throw InputError({path, 0, ""}, "is a directory, not a " + what);
   if (!fs::is_regular_file(st))
     throw InputError({path, 0, ""}, "is not a regular file (a device or a pipe?)");
+}
+
+std::string read_input_file(const std::string& path, std::uintmax_t max_bytes,
+                            const std::string& what) {
+  namespace fs = std::filesystem;
+  expect_regular_file(path, what);
+  std::error_code ec;
   const auto size = fs::file_size(path, ec);
   if (!ec && size > max_bytes)
     throw InputError(
         {path, 0, ""},
         fmt::format("the file holds {} bytes; a deck may hold at most {}", size, max_bytes));
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError({path, 0, ""}, "cannot open the deck file");
+  if (!in) throw InputError({path, 0, ""}, "cannot open the " + what);
   std::stringstream ss;
   ss << in.rdbuf();
-  if (in.bad()) throw InputError({path, 0, ""}, "cannot read the deck file");
+  if (in.bad()) throw InputError({path, 0, ""}, "cannot read the " + what);
   return ss.str();
 }
 

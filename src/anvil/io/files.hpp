@@ -17,9 +17,17 @@ void write_file_atomic(const std::string& path, std::string_view content);
 // file name in Latin-1) replaced by U+FFFD rather than thrown at, after a completed run.
 std::string json_text(const nlohmann::json& j, int indent = -1);
 
-// The whole text of an input file (a deck); InputError naming `path` if it is not a
-// regular file (a directory, a device), cannot be read, or is larger than `max_bytes`.
-std::string read_input_file(const std::string& path, std::uintmax_t max_bytes);
+// Throws an InputError naming `path` unless it is a regular file: "cannot open the WHAT"
+// when it does not exist, "is a directory, not a WHAT", or "is not a regular file". Every
+// reader checks its file with it before opening it: a directory opens as a stream that
+// reads nothing (an "empty" file) and whose size is nonsense.
+void expect_regular_file(const std::string& path, const std::string& what);
+
+// The whole text of an input file (`what`: a deck file, a mesh file); InputError naming
+// `path` if it is not a regular file (a directory, a device), cannot be read, or is
+// larger than `max_bytes`.
+std::string read_input_file(const std::string& path, std::uintmax_t max_bytes,
+                            const std::string& what = "deck file");
 
 // Creates a directory and its parents; InputError if that is impossible.
 void make_directories(const std::string& path);

@@ -320,7 +320,33 @@ public:
       const std::size_t width = kw.long_format ? 20 : (kw.i10 && w < 10 ? 10 : w);
       fields_.push_back(col < text.size() ? trim(text.substr(col, width)) : std::string_view());
       col += width;
+      ends_.push_back(col);
     }
+  }
+
+  // Fixed format: whether field i fills its last column and field i + 1 goes on from it
+  // without a blank, as a value too wide for field i does (so do two values that fill
+  // their fields exactly: callers ask only once the next field has failed to read).
+  bool runs_into_next(int i) const {
+    if (i < 0 || i + 1 >= static_cast<int>(ends_.size())) return false;
+    const std::string_view text = line_.text;
+    const std::size_t end = ends_[static_cast<std::size_t>(i)];
+    return end < text.size() && text[end - 1] != ' ' && text[end] != ' ';
+  }
+  // Fixed format: field i's width in columns.
+  std::size_t width(int i) const {
+    const auto k = static_cast<std::size_t>(i);
+    return ends_[k] - (k == 0 ? 0 : ends_[k - 1]);
+  }
+  // Fixed format: the text from field i's first non-blank column to the next blank (the
+  // value as written, when it runs past its field).
+  std::string_view written(int i) const {
+    const std::string_view text = line_.text;
+    std::size_t start = ends_[static_cast<std::size_t>(i)] - width(i);
+    while (start < text.size() && text[start] == ' ') ++start;
+    if (start >= text.size()) return {};
+    const auto stop = text.find(' ', start);
+    return text.substr(start, stop == std::string_view::npos ? stop : stop - start);
   }
 
   // Fields on the card: its widths in fixed format, every comma-separated one in free.
@@ -364,6 +390,7 @@ public:
     throw InputError(line_.where(kw_.key(field)), message);
   }
   const Line& line() const { return line_; }
+  const std::string& keyword() const { return kw_.name; }
 
 private:
   // The fields of the card's fixed-column form in standard format (80 columns).
@@ -418,7 +445,24 @@ private:
   const Block& kw_;
   Line line_;
   std::vector<std::string_view> fields_;
+  std::vector<std::size_t> ends_; // fixed format: the column after each field
 };
+
+// The message for an id too wide for its fixed-format field `i` (named `field`), which has
+// run into the next field (named `next`), with the wider formats that fit it.
+std::string wide_id(const Card& card, int i, std::string_view field, std::string_view next) {
+  const std::size_t w = card.width(i);
+  const std::string wider =
+      w < 10   ? fmt::format("*KEYWORD I10=Y or '*{0} %' for 10 characters, *KEYWORD LONG=Y or "
+                               "'*{0} +' for 20",
+                             card.keyword())
+      : w < 20 ? fmt::format("*KEYWORD LONG=Y or '*{} +' for 20 characters", card.keyword())
+               : std::string();
+  return fmt::format("{} '{}' is wider than its field and runs into {}: *{}'s {} field is {} "
+                     "characters wide here (give {}{}comma-separated fields)",
+                     field, shown(card.written(i)), next, card.keyword(), field, w, wider,
+                     wider.empty() ? "" : ", or ");
+}
 
 // A card of free text (title, heading): the whole line, trimmed.
 std::string text_card(const Line& l) {
@@ -719,7 +763,15 @@ private:
         card.fail("NID", "NID is blank: *NODE's first field is 8 characters wide (for 10 "
                          "characters give *KEYWORD I10=Y or '*NODE %')");
       if (nid <= 0) card.fail("NID", fmt::format("NID must be a positive node id, found {}", nid));
-      const Vec3 x{card.real(1, "X"), card.real(2, "Y"), card.real(3, "Z")};
+      Vec3 x;
+      try {
+        x = Vec3{card.real(1, "X"), card.real(2, "Y"), card.real(3, "Z")};
+      } catch (const InputError&) {
+        // An id wider than the NID field (the commonest slip when moving a large model)
+        // shifts the coordinates: say so rather than blame X.
+        if (card.runs_into_next(0)) card.fail("NID", wide_id(card, 0, "NID", "X"));
+        throw;
+      }
       const std::int64_t tc = card.integer(4, "TC", 0);
       if (tc < 0 || tc > 7)
         card.fail("TC", fmt::format("TC must be 0 to 7 (translational constraint), found {}", tc));

@@ -25,6 +25,7 @@
 #include <netcdf.h>
 
 #include "anvil/core/error.hpp"
+#include "anvil/io/files.hpp"
 
 namespace anvil {
 
@@ -307,6 +308,17 @@ bool is_hex(const std::string& type, std::int64_t nodes_per_element) {
   return nodes_per_element == 8 || nodes_per_element == 20 || nodes_per_element == 27;
 }
 
+// Throws unless every id of an id map is positive (Exodus ids are, and the outputs carry
+// them), naming the first that is not by its 1-based position, as keyword and Gmsh input
+// are refused for an id <= 0.
+void expect_positive_ids(const ExodusFile& f, const std::vector<std::int64_t>& ids, const char* map,
+                         const char* entity) {
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    if (ids[i] <= 0)
+      f.fail(fmt::format("the id map {} gives {} {} the id {}: ids must be positive", map, entity,
+                         i + 1, ids[i]));
+}
+
 Mesh read_all(const ExodusFile& f) {
   ex_init_params init{};
   f.check(ex_get_init_ext(f.id(), &init), "the file header");
@@ -354,6 +366,7 @@ Mesh read_all(const ExodusFile& f) {
       f.expect_values("node_num_map", nn, "the node ids");
       mesh.node_ids.resize(static_cast<std::size_t>(nn));
       f.check(ex_get_id_map(f.id(), EX_NODE_MAP, mesh.node_ids.data()), "the node ids");
+      expect_positive_ids(f, mesh.node_ids, "node_num_map", "node");
     }
   }
 
@@ -367,6 +380,7 @@ Mesh read_all(const ExodusFile& f) {
   if (init.num_elem > 0) {
     if (f.has("elem_num_map")) f.expect_values("elem_num_map", init.num_elem, "the element ids");
     f.check(ex_get_id_map(f.id(), EX_ELEM_MAP, element_ids.data()), "the element ids");
+    if (f.has("elem_num_map")) expect_positive_ids(f, element_ids, "elem_num_map", "element");
   }
   std::int64_t elements = 0;
   for (std::size_t b = 0; b < block_ids.size(); ++b) {
@@ -704,13 +718,15 @@ Mesh read_in_child(const std::string& path) {
 
 // Whether the file carries the HDF5 signature where the HDF5 library looks for it (at 0,
 // 512, 1024, 2048, ... bytes): a netCDF-4 file, read by the HDF5 library.
+// The path is a regular file (read_exodus checks it first): its size is its length, not
+// the nonsense a directory's stream reports.
 bool is_hdf5(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return false;
   in.seekg(0, std::ios::end);
   const auto size = static_cast<std::int64_t>(in.tellg());
   static constexpr char signature[8] = {'\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
-  for (std::int64_t at = 0; at + 8 <= size; at = at == 0 ? 512 : 2 * at) {
+  for (std::int64_t at = 0; size >= 8 && at <= size - 8; at = at == 0 ? 512 : 2 * at) {
     char magic[8] = {};
     in.seekg(at);
     if (in.read(magic, 8) && std::memcmp(magic, signature, 8) == 0) return true;
@@ -721,6 +737,7 @@ bool is_hdf5(const std::string& path) {
 } // namespace
 
 Mesh read_exodus(const std::string& path) {
+  expect_regular_file(path, "mesh file");
   return is_hdf5(path) ? read_in_child(path) : read_here(path);
 }
 

@@ -4,12 +4,12 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
+#include <limits>
 #include <map>
 #include <new>
 #include <optional>
 #include <set>
-#include <sstream>
+#include <stdexcept>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -18,6 +18,7 @@
 #include <fmt/format.h>
 
 #include "anvil/core/error.hpp"
+#include "anvil/io/files.hpp"
 
 namespace anvil {
 
@@ -653,6 +654,9 @@ private:
 } // namespace
 
 Mesh parse_gmsh(std::string_view text, const std::string& name) {
+  // A UTF-8 byte-order mark, as some Windows editors write it, is no part of the mesh
+  // (skipped as in keyword files).
+  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
   try {
     return Parser(text, name).parse();
   } catch (const std::bad_alloc&) {
@@ -663,12 +667,15 @@ Mesh parse_gmsh(std::string_view text, const std::string& name) {
 }
 
 Mesh read_gmsh(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(SourceLocation{path, 0, ""}, "cannot open the mesh file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw InputError(SourceLocation{path, 0, ""}, "cannot read the mesh file");
-  return parse_gmsh(ss.str(), path);
+  std::string text;
+  try {
+    text = read_input_file(path, std::numeric_limits<std::uintmax_t>::max(), "mesh file");
+  } catch (const std::bad_alloc&) {
+    throw InputError(SourceLocation{path, 0, ""}, "the file does not fit in memory");
+  } catch (const std::length_error&) {
+    throw InputError(SourceLocation{path, 0, ""}, "the file does not fit in memory");
+  }
+  return parse_gmsh(text, path);
 }
 
 } // namespace anvil

@@ -24,7 +24,8 @@ namespace anvil {
 // Never throws anything but InputError, whatever the text (fuzzing entry point).
 Mesh parse_gmsh(std::string_view text, const std::string& name);
 
-// Reads the file at `path` and parses it with parse_gmsh.
+// Reads the file at `path` (an InputError if it is not a regular file) and parses it with
+// parse_gmsh. A UTF-8 byte-order mark at the start of the text is skipped.
 Mesh read_gmsh(const std::string& path);
 
 } // namespace anvil

@@ -104,6 +104,11 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
             element_ids ? mesh.blocks[b].id(static_cast<std::size_t>(gid - block_offsets_[b]))
                         : gid + 1);
       }
+    std::int64_t top = 0;
+    for (const auto id : node_file_id_) top = std::max(top, id);
+    for (const auto& ids : element_file_id_)
+      for (const auto id : ids) top = std::max(top, id);
+    max_file_id_ = comm_.max(top);
   }
 
   part_mass_.assign(config_.parts.size(), 0.0);

@@ -121,6 +121,9 @@ public:
   std::int64_t element_file_id(std::size_t b, std::size_t e) const {
     return element_file_id_[b][e];
   }
+  // The largest of those ids over all ranks (the Exodus writer stores 64-bit id maps
+  // when it exceeds 2^31 - 1).
+  std::int64_t max_file_id() const { return max_file_id_; }
   // Of the initial particles (ids, sets, masses, reference positions; 0 without any).
   std::uint64_t particle_fingerprint() const { return particle_fingerprint_; }
   const std::vector<double>& part_masses() const { return part_mass_; }
@@ -241,6 +244,7 @@ private:
   std::uint64_t particle_fingerprint_ = 0;
   std::vector<std::int64_t> node_file_id_;                 // per local node
   std::vector<std::vector<std::int64_t>> element_file_id_; // per block and element
+  std::int64_t max_file_id_ = 0;                           // of both, over all ranks
   std::vector<std::int64_t> block_offsets_;
   std::vector<double> part_mass_;
 };
