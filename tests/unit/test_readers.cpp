@@ -718,6 +718,20 @@ TEST(ReadersDeck, CheckReadsExodusAndGmsh) {
   }
 }
 
+// A set a file part does not have: the error lists the sets its file gave it (QA round
+// 16: it listed none, where a generated part's error lists its own).
+TEST(ReadersDeck, UnknownSetOfAFilePartListsItsSets) {
+  TempDir dir;
+  fs::copy_file(data("box_2x2x2.msh"), dir.path / "box_2x2x2.msh");
+  write(dir.path / "deck.yaml", deck_for("box_2x2x2.msh", "box.nope"));
+  const CheckRun r = anvil_check(dir.file("deck.yaml"));
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("node set 'box.nope' is not defined: part 'box' has box."),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("box.top"), std::string::npos) << r.output;
+}
+
 TEST(ReadersDeck, BadMeshFilesExitWithStatusTwo) {
   TempDir dir;
   const std::string good = slurp(data("box_2x2x2.msh"));

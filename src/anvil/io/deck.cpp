@@ -346,7 +346,8 @@ MeshConfig parse_mesh(const Node& n, const std::string& base_dir) {
     n.check_keys({"file"});
     mc.kind = MeshConfig::Kind::file;
     std::filesystem::path p(n.child("file").str());
-    if (p.is_relative()) p = std::filesystem::path(base_dir) / p;
+    // (Normal form for messages: "mesh.msh", "../m/a.k", not "./mesh.msh", "m/sub/../a.k".)
+    if (p.is_relative()) p = (std::filesystem::path(base_dir) / p).lexically_normal();
     mc.file = p.string();
     if (!std::filesystem::exists(p))
       n.child("file").fail(fmt::format("mesh file '{}' does not exist", mc.file));

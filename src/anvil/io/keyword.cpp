@@ -238,7 +238,7 @@ private:
   void include(const std::string& name, const Line& ln, const fs::path& dir,
                std::vector<std::string>& stack) {
     fs::path p(name);
-    if (p.is_relative()) p = dir / p;
+    if (p.is_relative()) p = (dir / p).lexically_normal(); // ("a.k", not "./a.k")
     std::error_code ec;
     const std::string label = p.string();
     if (!fs::is_regular_file(p, ec))
@@ -250,8 +250,7 @@ private:
     if (std::find(stack.begin(), stack.end(), id) != stack.end()) {
       std::string chain;
       for (const auto& s : stack) chain += s + " -> ";
-      throw InputError(ln.where("*INCLUDE"),
-                       fmt::format("include cycle: {}{}", chain, shown(label)));
+      throw InputError(ln.where("*INCLUDE"), fmt::format("include cycle: {}{}", chain, shown(id)));
     }
     if (static_cast<int>(stack.size()) > max_include_depth)
       throw InputError(ln.where("*INCLUDE"),

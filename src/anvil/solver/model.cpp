@@ -134,7 +134,22 @@ std::vector<std::int64_t> resolve_selection(const Mesh& mesh, const Config& conf
     } else if (auto m = mesh.node_sets.find(sel.name); m != mesh.node_sets.end()) {
       ids = m->second;
     } else {
-      throw InputError(sel.where, fmt::format("node set '{}' is not defined", sel.name));
+      // A name PART.SET of a part read from a file: the sets its file has (the deck's
+      // reader lists a generated part's own).
+      std::string known;
+      if (const auto dot = sel.name.find('.'); dot != std::string::npos) {
+        const std::string prefix = sel.name.substr(0, dot + 1);
+        for (const auto& [name, nodes] : mesh.node_sets)
+          if (name.compare(0, prefix.size(), prefix) == 0)
+            known += (known.empty() ? "" : ", ") + name;
+        if (part_index(config, sel.name.substr(0, dot)) < config.parts.size())
+          known = known.empty()
+                      ? fmt::format(": part '{}' has no node sets", sel.name.substr(0, dot))
+                      : fmt::format(": part '{}' has {}", sel.name.substr(0, dot), known);
+        else
+          known.clear();
+      }
+      throw InputError(sel.where, fmt::format("node set '{}' is not defined{}", sel.name, known));
     }
   } else {
     std::vector<std::int64_t> candidates;
