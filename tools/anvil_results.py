@@ -303,22 +303,24 @@ def read_cpu_seconds(run_dir):
 
 
 def read_series(roots, nproc=None):
-    """Collect ROOT/P<n>/summary.json of every root (a root may also be one run directory).
+    """Collect ROOT/P<n>/summary.json of every root, a series OUTROOT as
+    tools/scaling_series.sh writes it.
 
     Runs with the same rank count: the first root wins and a warning names the other.
     `nproc` overrides the core count of machine.json.  Runs whose summary says failed are
-    skipped with a warning.  Raises ResultsError when no run is found."""
+    skipped with a warning.  Raises ResultsError when no run is found, and when a root is
+    one run directory (summary.json at its top, no P<n>/summary.json): read as a series of
+    one run it gave E = 1.00 and NaN CPU times that looked like results."""
     runs, machine, seen = [], {}, {}
     for root in roots:
         if not os.path.isdir(root):
             raise ResultsError(f"{root}: no such directory")
         if not machine:
             machine = read_machine(root)
-        if os.path.exists(os.path.join(root, "summary.json")):
-            dirs = [root]
-        else:
-            dirs = [d for d in glob.glob(os.path.join(root, "P*")) if re.fullmatch(
-                r"P\d+", os.path.basename(d)) and os.path.isdir(d)]
+        dirs = [d for d in glob.glob(os.path.join(root, "P*")) if re.fullmatch(
+            r"P\d+", os.path.basename(d)) and os.path.isdir(d)]
+        if not any(os.path.exists(os.path.join(d, "summary.json")) for d in dirs):
+            _refuse_single_run(root)
         for d in sorted(dirs, key=lambda d: int(re.sub(r"\D", "", os.path.basename(d)) or 0)):
             s = read_summary(d)
             if s is None:
@@ -349,6 +351,19 @@ def read_series(roots, nproc=None):
     for s in runs:
         s["_oversubscribed"] = bool(nproc) and s["ranks"] > nproc
     return Series(runs, machine, nproc)
+
+
+def _refuse_single_run(root):
+    """Raise ResultsError when ROOT is one run directory rather than a series OUTROOT."""
+    path = os.path.join(root, "summary.json")
+    if not os.path.exists(path):
+        return
+    summary = read_summary(root)
+    ranks = summary.get("ranks")
+    what = f"one run on {ranks} rank{'s' if ranks != 1 else ''}" if ranks else "one run"
+    raise ResultsError(
+        f"{root}: {what} ({path}), not a scaling series: expected a series OUTROOT with "
+        "P<n>/summary.json, as tools/scaling_series.sh writes (OUTROOT/P1, OUTROOT/P2, ...)")
 
 
 def phase_seconds(summary):
