@@ -10,7 +10,8 @@ Public interface:
     time_unit(t_max) -> (factor, label)  scale seconds for an axis ("µs", "ms" or "s")
     time_axis(history) -> (t, label, xlim) history times scaled, with x limits
     length_unit(extent) -> (factor, label)
-    run_main(main)                       call main(); turn errors into exit status 2
+    run_main(main, prog)                 call main(); input errors -> exit status 2, a
+                                         closed pipe (`| head`) -> quiet exit 141
     save_figure(fig, path)               write a PNG, creating the directory
     read_series(roots) -> Series         the runs of tools/scaling_series.sh, by rank count
 """
@@ -240,15 +241,38 @@ def save_figure(fig, path, dpi=110, tight=False):
         raise ResultsError(f"{path}: cannot write ({e})") from None
 
 
+# The exit status of a tool whose reader went away (`TOOL | head`): 128 + SIGPIPE, what a
+# shell reports for a command that SIGPIPE ended.
+BROKEN_PIPE_STATUS = 141
+
+
 def run_main(main, prog):
-    """Call main(); print errors from unreadable input as 'PROG: message' and exit 2."""
+    """Call main() and exit with its status.  Errors from unreadable input (ResultsError,
+    VtuError) print as 'PROG: error: message' and exit 2.  A reader that closes the pipe
+    early (`TOOL | head`) ends the tool quietly with BROKEN_PIPE_STATUS, never a traceback:
+    the output is flushed here, where a BrokenPipeError can be caught, and the standard
+    streams are pointed at /dev/null so that the interpreter's own flush at exit fails
+    silently too.  Every tool's entry point (selftest.py included) goes through here."""
     from anvil_vtu import VtuError
 
     try:
-        status = main()
-    except (ResultsError, VtuError) as e:
-        print(f"{prog}: error: {e}", file=sys.stderr)
-        sys.exit(2)
+        try:
+            status = main()
+        except (ResultsError, VtuError) as e:
+            print(f"{prog}: error: {e}", file=sys.stderr)
+            status = 2
+        except SystemExit as e:  # argparse's --help and usage errors
+            status = e.code
+        sys.stdout.flush()
+        sys.stderr.flush()
+    except BrokenPipeError:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                os.dup2(devnull, stream.fileno())
+            except (OSError, ValueError):
+                pass
+        status = BROKEN_PIPE_STATUS
     sys.exit(status or 0)
 
 
