@@ -407,13 +407,25 @@ def read_pvd(path):
     return [PvdEntry(time=t, step=i, path=p) for i, (t, p) in enumerate(rows)]
 
 
-def select_entry(entries, step=None, time=None):
+# Largest accepted distance [s] between a time asked for (--time, --times) and the output
+# chosen for it, unless the tool's --time-tolerance says otherwise.
+DEFAULT_TIME_TOLERANCE = 2e-5
+
+
+def select_entry(entries, step=None, time=None, tolerance=None, source=None):
     """Pick one PvdEntry: by index `step` (negative counts from the end), by nearest `time`,
-    or the last one when neither is given.  Raises VtuError for an out-of-range step."""
+    or the last one when neither is given.  Raises VtuError for an out-of-range step, and
+    for a `time` farther than `tolerance` seconds from every output (when a tolerance is
+    given; the message starts with `source`, the .pvd, and lists the output times)."""
     if step is not None and time is not None:
         raise VtuError("give a step or a time, not both")
     if time is not None:
-        return min(entries, key=lambda e: abs(e.time - time))
+        entry = min(entries, key=lambda e: abs(e.time - time))
+        if tolerance is not None and not abs(entry.time - time) <= tolerance:
+            raise VtuError(f"{source or 'series'}: no output within {tolerance:g} s of "
+                           f"t = {time:g} s (nearest {entry.time:.4g} s; outputs at "
+                           f"{_output_times(entries)})")
+        return entry
     if step is None:
         step = -1
     if not -len(entries) <= step < len(entries):
@@ -421,10 +433,18 @@ def select_entry(entries, step=None, time=None):
     return entries[step]
 
 
-def load_output(outdir, step=None, time=None):
+def _output_times(entries):
+    """The times of a series for a message: all of them, or the range when there are many."""
+    if len(entries) <= 8:
+        return ", ".join(f"{e.time:.4g}" for e in entries) + " s"
+    return f"{len(entries)} times from {entries[0].time:.4g} to {entries[-1].time:.4g} s"
+
+
+def load_output(outdir, step=None, time=None, tolerance=None):
     """Read one field output of an anvil output directory (or a .pvd/.pvtu/.vtu path).
 
-    Returns (PvdEntry, Grid).  For a .pvtu/.vtu path the entry's time is NaN.
+    Returns (PvdEntry, Grid); `step`, `time` and `tolerance` as in select_entry.  For a
+    .pvtu/.vtu path the entry's time is NaN (unknown: only the .pvd records it).
     """
     if not os.path.exists(outdir):
         raise VtuError(f"{outdir}: no such file or directory")
@@ -438,7 +458,8 @@ def load_output(outdir, step=None, time=None):
     else:
         pvd = outdir
     if pvd.endswith(".pvd"):
-        entry = select_entry(read_pvd(pvd), step=step, time=time)
+        entry = select_entry(read_pvd(pvd), step=step, time=time, tolerance=tolerance,
+                             source=pvd)
     else:
         entry = PvdEntry(time=float("nan"), step=0, path=pvd)
     return entry, read_grid(entry.path)
