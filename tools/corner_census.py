@@ -22,7 +22,7 @@ from collections import defaultdict
 import numpy as np
 
 from anvil_results import run_main
-from anvil_vtu import DEFAULT_TIME_TOLERANCE, VTK_HEXAHEDRON, VtuError, load_output
+from anvil_vtu import DEFAULT_TIME_TOLERANCE, VTK_HEXAHEDRON, VtuError, load_output, time_text
 
 HEX_FACES = [(0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7), (0, 3, 2, 1), (4, 5, 6, 7)]
 # The three edge neighbours of each corner, ordered so that an undistorted element has a
@@ -130,7 +130,7 @@ def main(argv=None):
         raise VtuError(f"{entry.path}: no hexahedra in part {args.part}")
     bad, worst = folded_corners(x, conn)
     inside = nodes_inside(x, conn)
-    print(f"{entry.path}: t = {entry.time:g} s, part {args.part}, {len(conn)} elements")
+    print(f"{entry.path}: {time_text(entry.time, ' = ', ' s')}, part {args.part}, {len(conn)} elements")
     print(f"  {int((bad > 0).sum())} with a non-positive corner Jacobian ({int(bad.sum())} corners,"
           f" most negative {worst * 1e9:.3f} mm^3)")
     # Global node ids as the contact search and its messages count them (node_id - 1).
