@@ -608,6 +608,39 @@ def check_broken_pipe(outdir, tmp):
             assert word not in r.stderr, f"{' '.join(args)}: {word}\n{r.stderr}"
 
 
+def check_figures_documented():
+    """Every PNG in docs/figures has the command that makes it in tools/README.md
+    ("Regenerating all figures"; it covered 4 of 14, QA round 16). Skipped outside a
+    source tree."""
+    figures = os.path.join(HERE, os.pardir, "docs", "figures")
+    if not os.path.isdir(figures):
+        return
+    with open(os.path.join(HERE, "README.md"), encoding="utf-8") as f:
+        readme = f.read()
+    section = readme[readme.index("**Regenerating all figures"):]
+    missing = [n for n in sorted(os.listdir(figures))
+               if n.endswith(".png") and f"-o docs/figures/{n}" not in section
+               and f"--phases-output docs/figures/{n}" not in section]
+    assert not missing, f"tools/README.md has no command for {missing}"
+
+
+def check_scaling_usage():
+    """tools/README.md's usage line of scaling_series.sh names every option its --help
+    lists (it lacked --decomposition, --anvil, --mpirun and --mpi-args; QA round 16)."""
+    r = subprocess.run(["bash", os.path.join(HERE, "scaling_series.sh"), "--help"],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    options = [line.split()[0] for line in r.stdout.splitlines()
+               if line.startswith("  --") and not line.startswith("  --help")]
+    assert len(options) >= 13, options
+    with open(os.path.join(HERE, "README.md"), encoding="utf-8") as f:
+        readme = f.read()
+    start = readme.index("**`scaling_series.sh ")
+    usage = readme[start:readme.index("`**", start)]
+    missing = [o for o in options if o not in usage]
+    assert not missing, f"tools/README.md's scaling_series.sh usage lacks {missing}"
+
+
 def check_executable():
     """Every tool with a #! line is executable (the docs run mpi_trace.py, corner_census.py
     and scaling_series.sh directly; the mode comes from git)."""
@@ -746,6 +779,9 @@ def main():
         c.run("one-row history.csv: no matplotlib warning", check_one_row_history, outdir, tmp)
         c.run("--time outside the outputs: exit status 2", check_time_tolerance, outdir, tmp)
         c.run("a closed pipe (TOOL | head): quiet exit 141", check_broken_pipe, outdir, tmp)
+        c.run("every figure in docs/figures has its command in tools/README.md",
+              check_figures_documented)
+        c.run("scaling_series.sh usage line in tools/README.md", check_scaling_usage)
         c.run("tools with #! are executable", check_executable)
     finally:
         if args.keep:
