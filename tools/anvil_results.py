@@ -10,7 +10,8 @@ Public interface:
     time_unit(t_max) -> (factor, label)  scale seconds for an axis ("µs", "ms" or "s")
     time_axis(history) -> (t, label, xlim) history times scaled, with x limits
     length_unit(extent) -> (factor, label)
-    run_main(main)                       call main(); turn errors into exit status 2
+    run_main(main, prog)                 call main(); input errors -> exit status 2, a
+                                         closed pipe (`| head`) -> quiet exit 141
     save_figure(fig, path)               write a PNG, creating the directory
     read_series(roots) -> Series         the runs of tools/scaling_series.sh, by rank count
 """
@@ -240,15 +241,38 @@ def save_figure(fig, path, dpi=110, tight=False):
         raise ResultsError(f"{path}: cannot write ({e})") from None
 
 
+# The exit status of a tool whose reader went away (`TOOL | head`): 128 + SIGPIPE, what a
+# shell reports for a command that SIGPIPE ended.
+BROKEN_PIPE_STATUS = 141
+
+
 def run_main(main, prog):
-    """Call main(); print errors from unreadable input as 'PROG: message' and exit 2."""
+    """Call main() and exit with its status.  Errors from unreadable input (ResultsError,
+    VtuError) print as 'PROG: error: message' and exit 2.  A reader that closes the pipe
+    early (`TOOL | head`) ends the tool quietly with BROKEN_PIPE_STATUS, never a traceback:
+    the output is flushed here, where a BrokenPipeError can be caught, and the standard
+    streams are pointed at /dev/null so that the interpreter's own flush at exit fails
+    silently too.  Every tool's entry point (selftest.py included) goes through here."""
     from anvil_vtu import VtuError
 
     try:
-        status = main()
-    except (ResultsError, VtuError) as e:
-        print(f"{prog}: error: {e}", file=sys.stderr)
-        sys.exit(2)
+        try:
+            status = main()
+        except (ResultsError, VtuError) as e:
+            print(f"{prog}: error: {e}", file=sys.stderr)
+            status = 2
+        except SystemExit as e:  # argparse's --help and usage errors
+            status = e.code
+        sys.stdout.flush()
+        sys.stderr.flush()
+    except BrokenPipeError:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                os.dup2(devnull, stream.fileno())
+            except (OSError, ValueError):
+                pass
+        status = BROKEN_PIPE_STATUS
     sys.exit(status or 0)
 
 
@@ -303,22 +327,24 @@ def read_cpu_seconds(run_dir):
 
 
 def read_series(roots, nproc=None):
-    """Collect ROOT/P<n>/summary.json of every root (a root may also be one run directory).
+    """Collect ROOT/P<n>/summary.json of every root, a series OUTROOT as
+    tools/scaling_series.sh writes it.
 
     Runs with the same rank count: the first root wins and a warning names the other.
     `nproc` overrides the core count of machine.json.  Runs whose summary says failed are
-    skipped with a warning.  Raises ResultsError when no run is found."""
+    skipped with a warning.  Raises ResultsError when no run is found, and when a root is
+    one run directory (summary.json at its top, no P<n>/summary.json): read as a series of
+    one run it gave E = 1.00 and NaN CPU times that looked like results."""
     runs, machine, seen = [], {}, {}
     for root in roots:
         if not os.path.isdir(root):
             raise ResultsError(f"{root}: no such directory")
         if not machine:
             machine = read_machine(root)
-        if os.path.exists(os.path.join(root, "summary.json")):
-            dirs = [root]
-        else:
-            dirs = [d for d in glob.glob(os.path.join(root, "P*")) if re.fullmatch(
-                r"P\d+", os.path.basename(d)) and os.path.isdir(d)]
+        dirs = [d for d in glob.glob(os.path.join(root, "P*")) if re.fullmatch(
+            r"P\d+", os.path.basename(d)) and os.path.isdir(d)]
+        if not any(os.path.exists(os.path.join(d, "summary.json")) for d in dirs):
+            _refuse_single_run(root)
         for d in sorted(dirs, key=lambda d: int(re.sub(r"\D", "", os.path.basename(d)) or 0)):
             s = read_summary(d)
             if s is None:
@@ -349,6 +375,19 @@ def read_series(roots, nproc=None):
     for s in runs:
         s["_oversubscribed"] = bool(nproc) and s["ranks"] > nproc
     return Series(runs, machine, nproc)
+
+
+def _refuse_single_run(root):
+    """Raise ResultsError when ROOT is one run directory rather than a series OUTROOT."""
+    path = os.path.join(root, "summary.json")
+    if not os.path.exists(path):
+        return
+    summary = read_summary(root)
+    ranks = summary.get("ranks")
+    what = f"one run on {ranks} rank{'s' if ranks != 1 else ''}" if ranks else "one run"
+    raise ResultsError(
+        f"{root}: {what} ({path}), not a scaling series: expected a series OUTROOT with "
+        "P<n>/summary.json, as tools/scaling_series.sh writes (OUTROOT/P1, OUTROOT/P2, ...)")
 
 
 def phase_seconds(summary):

@@ -12,11 +12,14 @@ Public interface:
     read_pvtu(path) -> Grid         all pieces of one output, concatenated
     read_grid(path) -> Grid         either of the above, by extension
     read_pvd(path) -> [PvdEntry]    the time series, sorted by time
-    select_entry(entries, step=None, time=None) -> PvdEntry
-    load_output(outdir, step=None, time=None) -> (PvdEntry, Grid)
+    select_entry(entries, step=None, time=None, tolerance=None, source=None) -> PvdEntry
+    load_output(outdir, step=None, time=None, tolerance=None) -> (PvdEntry, Grid)
+    DEFAULT_TIME_TOLERANCE          2e-5 s, the tools' --time-tolerance default
+    time_text(t) -> str             't=T', or 't unknown' for NaN
     exodus_hint(outdir) -> str      why OUTDIR has no results.pvd when it holds Exodus II
 
-Run as a script (anvil_vtu.py OUTDIR|FILE ...), it lists the arrays of the last output.
+Run as a script (anvil_vtu.py OUTDIR|FILE ...), it lists the arrays of the last output
+(for a run directory with particles, the last of results.pvd and of particles.pvd).
 Every failure on malformed or missing input raises VtuError whose message names the file.
 """
 
@@ -407,13 +410,25 @@ def read_pvd(path):
     return [PvdEntry(time=t, step=i, path=p) for i, (t, p) in enumerate(rows)]
 
 
-def select_entry(entries, step=None, time=None):
+# Largest accepted distance [s] between a time asked for (--time, --times) and the output
+# chosen for it, unless the tool's --time-tolerance says otherwise.
+DEFAULT_TIME_TOLERANCE = 2e-5
+
+
+def select_entry(entries, step=None, time=None, tolerance=None, source=None):
     """Pick one PvdEntry: by index `step` (negative counts from the end), by nearest `time`,
-    or the last one when neither is given.  Raises VtuError for an out-of-range step."""
+    or the last one when neither is given.  Raises VtuError for an out-of-range step, and
+    for a `time` farther than `tolerance` seconds from every output (when a tolerance is
+    given; the message starts with `source`, the .pvd, and lists the output times)."""
     if step is not None and time is not None:
         raise VtuError("give a step or a time, not both")
     if time is not None:
-        return min(entries, key=lambda e: abs(e.time - time))
+        entry = min(entries, key=lambda e: abs(e.time - time))
+        if tolerance is not None and not abs(entry.time - time) <= tolerance:
+            raise VtuError(f"{source or 'series'}: no output within {tolerance:g} s of "
+                           f"t = {time:g} s (nearest {entry.time:.4g} s; outputs at "
+                           f"{_output_times(entries)})")
+        return entry
     if step is None:
         step = -1
     if not -len(entries) <= step < len(entries):
@@ -421,10 +436,18 @@ def select_entry(entries, step=None, time=None):
     return entries[step]
 
 
-def load_output(outdir, step=None, time=None):
+def _output_times(entries):
+    """The times of a series for a message: all of them, or the range when there are many."""
+    if len(entries) <= 8:
+        return ", ".join(f"{e.time:.4g}" for e in entries) + " s"
+    return f"{len(entries)} times from {entries[0].time:.4g} to {entries[-1].time:.4g} s"
+
+
+def load_output(outdir, step=None, time=None, tolerance=None):
     """Read one field output of an anvil output directory (or a .pvd/.pvtu/.vtu path).
 
-    Returns (PvdEntry, Grid).  For a .pvtu/.vtu path the entry's time is NaN.
+    Returns (PvdEntry, Grid); `step`, `time` and `tolerance` as in select_entry.  For a
+    .pvtu/.vtu path the entry's time is NaN (unknown: only the .pvd records it).
     """
     if not os.path.exists(outdir):
         raise VtuError(f"{outdir}: no such file or directory")
@@ -438,10 +461,17 @@ def load_output(outdir, step=None, time=None):
     else:
         pvd = outdir
     if pvd.endswith(".pvd"):
-        entry = select_entry(read_pvd(pvd), step=step, time=time)
+        entry = select_entry(read_pvd(pvd), step=step, time=time, tolerance=tolerance,
+                             source=pvd)
     else:
         entry = PvdEntry(time=float("nan"), step=0, path=pvd)
     return entry, read_grid(entry.path)
+
+
+def time_text(t, sep="=", unit=""):
+    """'t=T' (with `sep` and `unit`) for an output's time, or 't unknown' for NaN (a .pvtu
+    or .vtu read directly: only the .pvd records the time)."""
+    return f"t{sep}{t:g}{unit}" if np.isfinite(t) else "t unknown"
 
 
 def exodus_hint(outdir):
@@ -454,29 +484,54 @@ def exodus_hint(outdir):
             f"{os.path.basename(exo[0])} in ParaView, or rerun with --format vtu")
 
 
+def outputs_to_list(arg):
+    """[(label, PvdEntry, Grid)] that `anvil_vtu.py ARG` lists: for a run directory the last
+    output of results.pvd and, when the run has particles, of particles.pvd (a run of
+    particles only has an empty FE output); for a file, that file."""
+    if not os.path.isdir(arg):
+        return [(None,) + load_output(arg)]
+    series = [n for n in ("results.pvd", "particles.pvd") if os.path.exists(os.path.join(arg, n))]
+    if "results.pvd" not in series:
+        if not series:
+            load_output(arg)  # raises: no results.pvd (with the Exodus II hint)
+        hint = exodus_hint(arg)
+        print(f"note: {arg}: no results.pvd{': ' + hint if hint else ''}; listing particles.pvd",
+              file=sys.stderr)
+    out = []
+    for name in series:
+        path = os.path.join(arg, name)
+        entries = read_pvd(path)
+        entry = select_entry(entries)
+        out.append((f"last of {len(entries)} in {name}", entry, read_grid(entry.path)))
+    return out
+
+
 def main(argv=None):
-    """List the arrays of the last field output of each OUTDIR or file; exit 2 on bad input."""
+    """List the arrays of the last field output of each OUTDIR (results.pvd and, if present,
+    particles.pvd) or file; raises VtuError on bad input (run_main: exit status 2)."""
     p = argparse.ArgumentParser(
-        description="List the point and cell arrays of an anvil field output (the last one "
-        "of results.pvd for a run directory).",
+        description="List the point and cell arrays of an anvil field output (for a run "
+        "directory the last one of results.pvd and, when the run has particles, the last "
+        "one of particles.pvd).",
         epilog="example: anvil_vtu.py out/taylor_bar_np3 out/taylor_bar_np3/fields/step_000000.pvtu",
     )
     p.add_argument("paths", nargs="+", metavar="OUTDIR|FILE",
                    help="anvil output directory, or a .pvd, .pvtu or .vtu file")
     args = p.parse_args(argv)
-    try:
-        for arg in args.paths:
-            e, g = load_output(arg)
-            print(f"{e.path}: t={e.time:g} points={g.n_points} cells={g.n_cells}")
+    for arg in args.paths:
+        for label, e, g in outputs_to_list(arg):
+            where = f" ({label})" if label else ""
+            print(f"{e.path}{where}: {time_text(e.time)} points={g.n_points} cells={g.n_cells}")
             for kind, d in (("point", g.point_data), ("cell", g.cell_data)):
                 for name, a in d.items():
                     print(f"  {kind:5s} {name:16s} {str(a.shape):14s} {a.dtype}")
-    except VtuError as err:
-        # Exit status 2 on missing or malformed input, like the other tools (tools/README.md).
-        print(f"anvil_vtu.py: error: {err}", file=sys.stderr)
-        return 2
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    # Run the imported module's main, so that its VtuError is the class run_main catches
+    # (this file run as a script is a second module, __main__, with a VtuError of its own).
+    import anvil_vtu
+    from anvil_results import run_main
+
+    run_main(anvil_vtu.main, "anvil_vtu.py")

@@ -22,7 +22,7 @@ from collections import defaultdict
 import numpy as np
 
 from anvil_results import run_main
-from anvil_vtu import VTK_HEXAHEDRON, VtuError, load_output
+from anvil_vtu import DEFAULT_TIME_TOLERANCE, VTK_HEXAHEDRON, VtuError, load_output, time_text
 
 HEX_FACES = [(0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7), (0, 3, 2, 1), (4, 5, 6, 7)]
 # The three edge neighbours of each corner, ordered so that an undistorted element has a
@@ -35,9 +35,16 @@ def parse_args(argv):
     ap.add_argument("outdir", help="anvil output directory (or a .pvd, .pvtu or .vtu file)")
     which = ap.add_mutually_exclusive_group()
     which.add_argument("--step", type=int, help="field output number (default: the last)")
-    which.add_argument("--time", type=float, help="the field output nearest this time, s")
+    which.add_argument("--time", type=float, help="the field output nearest this time, s; "
+                       "an error when none is within --time-tolerance")
+    ap.add_argument("--time-tolerance", type=float, default=DEFAULT_TIME_TOLERANCE,
+                    metavar="S", help="largest accepted distance between --time and the "
+                    f"output read, s (default {DEFAULT_TIME_TOLERANCE:g})")
     ap.add_argument("--part", type=int, default=0, help="part index (the `part` cell field)")
-    return ap.parse_args(argv)
+    args = ap.parse_args(argv)
+    if not args.time_tolerance >= 0:
+        ap.error(f"--time-tolerance must be >= 0, got {args.time_tolerance:g}")
+    return args
 
 
 def hexahedra(grid, part):
@@ -116,13 +123,14 @@ def nodes_inside(x, conn):
 
 def main(argv=None):
     args = parse_args(argv)
-    entry, grid = load_output(args.outdir, step=args.step, time=args.time)
+    entry, grid = load_output(args.outdir, step=args.step, time=args.time,
+                              tolerance=args.time_tolerance)
     x, conn, node_ids = hexahedra(grid, args.part)
     if len(conn) == 0:
         raise VtuError(f"{entry.path}: no hexahedra in part {args.part}")
     bad, worst = folded_corners(x, conn)
     inside = nodes_inside(x, conn)
-    print(f"{entry.path}: t = {entry.time:g} s, part {args.part}, {len(conn)} elements")
+    print(f"{entry.path}: {time_text(entry.time, ' = ', ' s')}, part {args.part}, {len(conn)} elements")
     print(f"  {int((bad > 0).sum())} with a non-positive corner Jacobian ({int(bad.sum())} corners,"
           f" most negative {worst * 1e9:.3f} mm^3)")
     # Global node ids as the contact search and its messages count them (node_id - 1).

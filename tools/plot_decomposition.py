@@ -32,7 +32,7 @@ from anvil_results import (
     title_of,
     use_agg,
 )
-from anvil_vtu import load_output
+from anvil_vtu import DEFAULT_TIME_TOLERANCE, load_output
 
 # The six faces of a VTK hexahedron in local node order, outward for a positive cell.
 HEX_FACES = np.array(
@@ -78,7 +78,11 @@ def parse_args(argv=None):
     when = p.add_mutually_exclusive_group()
     when.add_argument("--step", type=int, help="field output index in results.pvd "
                       "(0 = first, -1 = last; default last)")
-    when.add_argument("--time", type=float, help="field output nearest to this time [s]")
+    when.add_argument("--time", type=float, help="field output nearest to this time [s]; "
+                      "an error when none is within --time-tolerance")
+    p.add_argument("--time-tolerance", type=float, default=DEFAULT_TIME_TOLERANCE,
+                   metavar="S", help="largest accepted distance between --time and the "
+                   f"output drawn [s] (default {DEFAULT_TIME_TOLERANCE:g}, as plot_figure3.py)")
     p.add_argument("--field", default="fe_rank",
                    help="colouring field: NAME or NAME.COMPONENT (default fe_rank)")
     p.add_argument("--undeformed", action="store_true",
@@ -103,6 +107,8 @@ def parse_args(argv=None):
     args = p.parse_args(argv)
     if args.clim and not args.clim[0] < args.clim[1]:
         p.error("--clim needs MIN < MAX")
+    if not args.time_tolerance >= 0:
+        p.error(f"--time-tolerance must be >= 0, got {args.time_tolerance:g}")
     if args.cut is not None:
         axis, _, value = args.cut.partition("=")
         try:
@@ -426,7 +432,8 @@ def front_faces(surface, elev, azim):
 def main(argv=None):
     """Entry point: read one field output, draw, write the PNG and print its path."""
     args = parse_args(argv)
-    entry, grid = load_output(args.outdir, step=args.step, time=args.time)
+    entry, grid = load_output(args.outdir, step=args.step, time=args.time,
+                              tolerance=args.time_tolerance)
     surf = exterior_surface(grid, args.field, args.undeformed, args.cut, entry.path,
                             args.show_eroded)
     front = front_faces(surf, args.elev, args.azim)  # orthographic view: back faces hidden

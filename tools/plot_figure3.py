@@ -30,7 +30,7 @@ import sys
 import numpy as np
 
 from anvil_results import ResultsError, length_unit, read_summary, run_main, save_figure, use_agg
-from anvil_vtu import load_output, read_pvd
+from anvil_vtu import DEFAULT_TIME_TOLERANCE, load_output
 from plot_decomposition import (
     add_faces,
     exterior_surface,
@@ -59,9 +59,9 @@ def parse_args(argv=None):
     p.add_argument("--times", type=float, nargs=3, metavar=("T0", "T1", "T2"),
                    default=(0.0, 1.6e-3, 3.2e-3),
                    help="the three output times [s] (default 0 1.6e-3 3.2e-3)")
-    p.add_argument("--time-tolerance", type=float, default=2e-5,
+    p.add_argument("--time-tolerance", type=float, default=DEFAULT_TIME_TOLERANCE,
                    help="largest accepted distance between a wanted time and the output's "
-                   "[s] (default 2e-5)")
+                   f"[s] (default {DEFAULT_TIME_TOLERANCE:g})")
     p.add_argument("--elev", type=float, default=20.0, help="view elevation [deg] (default 20)")
     p.add_argument("--azim", type=float, default=-60.0, help="view azimuth [deg] (default -60)")
     p.add_argument("--cut", metavar="AXIS=VALUE",
@@ -72,6 +72,8 @@ def parse_args(argv=None):
     p.add_argument("--dpi", type=int, default=110, help="PNG resolution (default 110)")
     p.add_argument("-o", "--output", help="PNG to write (default OUTDIR/figure3.png)")
     args = p.parse_args(argv)
+    if not args.time_tolerance >= 0:
+        p.error(f"--time-tolerance must be >= 0, got {args.time_tolerance:g}")
     if args.cut is not None:
         axis, _, value = args.cut.partition("=")
         try:
@@ -84,15 +86,9 @@ def parse_args(argv=None):
 
 
 def load_at(outdir, t, tol):
-    """(entry, grid) of the output of `outdir` nearest to time t; ResultsError when the
-    nearest is further than tol (the run may have stopped early)."""
-    entry, grid = load_output(outdir, time=t)
-    if abs(entry.time - t) > tol:
-        path = outdir if not os.path.isdir(outdir) else os.path.join(outdir, "results.pvd")
-        have = ", ".join(f"{e.time:.4g}" for e in read_pvd(path))
-        raise ResultsError(f"{path}: no output at t = {t:g} s (nearest {entry.time:.4g} s; "
-                           f"outputs at {have} s)")
-    return entry, grid
+    """(entry, grid) of the output of `outdir` nearest to time t; VtuError when the nearest
+    is further than tol (the run may have stopped early; anvil_vtu.select_entry)."""
+    return load_output(outdir, time=t, tolerance=tol)
 
 
 def rank_palette(n_ranks):

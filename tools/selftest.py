@@ -8,7 +8,8 @@ the .pvtu indices, results.pvd, history.csv and summary.json -- then checks the 
 and runs every plot script to a PNG and with bad arguments.
 
 Usage: selftest.py [--keep]   (--keep leaves the temporary directory and prints it)
-Exit status 0 when every check passes, 1 otherwise.
+Exit status 0 when every check passes, 1 otherwise (141, quietly, when the reader of its
+output goes away: selftest.py | head).
 """
 
 import argparse
@@ -431,6 +432,14 @@ def check_series_tools(tmp):
                 ["plot_figure2.py", os.path.join(tmp, "run", "fields")],
                 ["plot_parallel_evidence.py", os.path.join(tmp, "no_such_dir")]):
         run_tool(bad, 2)
+    # One run directory, even one of a series, is not a series (it printed E = 1.00 and
+    # nan; QA round 16).
+    run = os.path.join(root, "P2")
+    for tool in ("plot_figure2.py", "plot_parallel_evidence.py"):
+        expect_usage_error([tool, run, "-o", f"{tmp}/x.png", "--table"],
+                           os.path.join(run, "summary.json"), "P<n>/summary.json",
+                           "scaling_series.sh")
+    assert not os.path.exists(os.path.join(tmp, "x.png"))
 
 
 def check_particles(outdir, tmp):
@@ -520,6 +529,28 @@ def check_vtu_cli(outdir, tmp):
     expect_usage_error(["anvil_vtu.py", missing], missing)
     r = run_tool(["anvil_vtu.py", outdir], 0)
     assert "fe_rank" in r.stdout, r.stdout
+    # A .pvtu given directly has no time (only the .pvd has it): no t=nan (QA round 16).
+    pvtu = os.path.join(outdir, "fields", "step_000001.pvtu")
+    r = run_tool(["anvil_vtu.py", pvtu], 0)
+    assert r.stdout.startswith(f"{pvtu}: t unknown points="), r.stdout
+    assert "nan" not in r.stdout, r.stdout
+    # A run with particles lists the last output of particles.pvd too (QA round 16), and a
+    # directory with particles.pvd alone lists it with a note.
+    sph = os.path.join(tmp, "run_sph")
+    write_run(sph)
+    write_particles(sph, [0.0, 1e-5])
+    r = run_tool(["anvil_vtu.py", sph], 0)
+    heads = [line for line in r.stdout.splitlines() if not line.startswith("  ")]
+    assert len(heads) == 2, r.stdout
+    assert heads[0].startswith(os.path.join(sph, "fields", "step_000001.pvtu")), heads
+    assert "(last of 2 in results.pvd): t=1e-05 points=" in heads[0], heads
+    assert "(last of 2 in particles.pvd): t=1e-05 points=24 cells=24" in heads[1], heads
+    assert "particle_id" in r.stdout and "fe_rank" in r.stdout, r.stdout
+    ponly = os.path.join(tmp, "vtu_particles_only")
+    write_particles(ponly, [0.0])
+    r = run_tool(["anvil_vtu.py", ponly], 0)
+    assert "(last of 1 in particles.pvd)" in r.stdout and "sph_rank" in r.stdout, r.stdout
+    assert "no results.pvd" in r.stderr, r.stderr
     exo = os.path.join(tmp, "exodus_only")
     os.makedirs(exo)
     for name in ("results.exo", "history.csv"):
@@ -551,6 +582,63 @@ def check_one_row_history(outdir, tmp):
         r = run_tool(args, 0)
         assert "Warning" not in r.stderr, r.stderr
     check_png(os.path.join(tmp, "one.png"))
+
+
+def check_broken_pipe(outdir, tmp):
+    """A reader that closes the pipe (`TOOL | head`) ends the tool quietly: status 141 and no
+    traceback or 'Exception ignored' line (it printed a BrokenPipeError traceback; QA round
+    16). The read end is closed before the tool starts, so every write fails."""
+    series = os.path.join(tmp, "series_pipe")
+    write_series(series, ranks=(1, 2))
+    for args in (["anvil_vtu.py", outdir, outdir],
+                 ["anvil_vtu.py", "--help"],
+                 ["plot_figure2.py", series, "--table", "-o", f"{tmp}/pipe.png"],
+                 ["plot_parallel_evidence.py", series, "--table", "-o", f"{tmp}/pipe.png"],
+                 ["plot_history.py", outdir, "-o", f"{tmp}/pipe.png"],
+                 ["corner_census.py", outdir]):
+        read_end, write_end = os.pipe()
+        os.close(read_end)
+        try:
+            r = subprocess.run([sys.executable, os.path.join(HERE, args[0])] + args[1:],
+                               stdout=write_end, stderr=subprocess.PIPE, text=True, timeout=300)
+        finally:
+            os.close(write_end)
+        assert r.returncode == 141, f"{' '.join(args)}: exit {r.returncode}\n{r.stderr}"
+        for word in ("Traceback", "Exception ignored", "BrokenPipe"):
+            assert word not in r.stderr, f"{' '.join(args)}: {word}\n{r.stderr}"
+
+
+def check_figures_documented():
+    """Every PNG in docs/figures has the command that makes it in tools/README.md
+    ("Regenerating all figures"; it covered 4 of 14, QA round 16). Skipped outside a
+    source tree."""
+    figures = os.path.join(HERE, os.pardir, "docs", "figures")
+    if not os.path.isdir(figures):
+        return
+    with open(os.path.join(HERE, "README.md"), encoding="utf-8") as f:
+        readme = f.read()
+    section = readme[readme.index("**Regenerating all figures"):]
+    missing = [n for n in sorted(os.listdir(figures))
+               if n.endswith(".png") and f"-o docs/figures/{n}" not in section
+               and f"--phases-output docs/figures/{n}" not in section]
+    assert not missing, f"tools/README.md has no command for {missing}"
+
+
+def check_scaling_usage():
+    """tools/README.md's usage line of scaling_series.sh names every option its --help
+    lists (it lacked --decomposition, --anvil, --mpirun and --mpi-args; QA round 16)."""
+    r = subprocess.run(["bash", os.path.join(HERE, "scaling_series.sh"), "--help"],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    options = [line.split()[0] for line in r.stdout.splitlines()
+               if line.startswith("  --") and not line.startswith("  --help")]
+    assert len(options) >= 13, options
+    with open(os.path.join(HERE, "README.md"), encoding="utf-8") as f:
+        readme = f.read()
+    start = readme.index("**`scaling_series.sh ")
+    usage = readme[start:readme.index("`**", start)]
+    missing = [o for o in options if o not in usage]
+    assert not missing, f"tools/README.md's scaling_series.sh usage lacks {missing}"
 
 
 def check_executable():
@@ -596,10 +684,29 @@ def check_tools(outdir, tmp):
                 ["plot_decomposition.py", outdir, "--field", "nope"],
                 ["plot_decomposition.py", outdir, "--field", "stress"],
                 ["plot_decomposition.py", outdir, "--step", "7"],
+                ["plot_decomposition.py", outdir, "--time-tolerance", "-1"],
                 ["plot_decomposition.py", outdir, "--cut", "w=0"],
                 ["plot_probe.py", outdir, "nope.ux"],
                 ["plot_probe.py", missing, "tip.ux"]):
         run_tool(bad, 2)
+
+
+def check_time_tolerance(outdir, tmp):
+    """--time farther than --time-tolerance from every output is exit status 2 naming the
+    .pvd and the output times (it drew the last output; QA round 16), in plot_decomposition.py
+    as in plot_figure3.py and corner_census.py; within the tolerance it draws."""
+    pvd = os.path.join(outdir, "results.pvd")
+    png = f"{tmp}/late.png"
+    expect_usage_error(["plot_decomposition.py", outdir, "--time", "1", "-o", png],
+                       pvd, "no output within 2e-05 s of t = 1 s", "0, 1e-05 s")
+    assert not os.path.exists(png)
+    expect_usage_error(["plot_decomposition.py", outdir, "--time", "1e-4",
+                        "--time-tolerance", "5e-5", "-o", png], pvd, "5e-05 s")
+    expect_usage_error(["corner_census.py", outdir, "--time", "1"], pvd, "no output within")
+    run_tool(["plot_decomposition.py", outdir, "--time", "2e-5", "-o", png], 0)
+    check_png(png)
+    run_tool(["plot_decomposition.py", outdir, "--time", "1", "--time-tolerance", "2",
+              "-o", png], 0)
 
 
 def check_balance(tmp):
@@ -670,6 +777,11 @@ def main():
         c.run("anvil_vtu.py command line, Exodus-only run", check_vtu_cli, outdir, tmp)
         c.run("plot_parallel_evidence without contact bytes", check_no_contact_series, tmp)
         c.run("one-row history.csv: no matplotlib warning", check_one_row_history, outdir, tmp)
+        c.run("--time outside the outputs: exit status 2", check_time_tolerance, outdir, tmp)
+        c.run("a closed pipe (TOOL | head): quiet exit 141", check_broken_pipe, outdir, tmp)
+        c.run("every figure in docs/figures has its command in tools/README.md",
+              check_figures_documented)
+        c.run("scaling_series.sh usage line in tools/README.md", check_scaling_usage)
         c.run("tools with #! are executable", check_executable)
     finally:
         if args.keep:
@@ -684,4 +796,6 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from anvil_results import run_main  # noqa: E402
+
+    run_main(main, "selftest.py")
