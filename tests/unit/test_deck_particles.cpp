@@ -348,6 +348,28 @@ particles:
   EXPECT_GT(vx, 0.1); // the tube did run
 }
 
+// The lattice-size guard counts cells along the model's dimensions only: a 1-D set whose
+// box is wide in y and z holds 100 particles, not 4e10 (QA round 18: it was refused as
+// "more than 2e9 particles"); the same box in 3-D is refused.
+TEST(DeckParticles, LatticeSizeGuardCountsTheModelsDimensions) {
+  const std::string deck = R"(termination: {cycles: 1}
+sph: {dimensions: 1}
+materials:
+  al: {model: elastic, density: 2700, youngs_modulus: 70.0e9, poissons_ratio: 0.3}
+particles:
+  b: {generate: {shape: box, min: [0, -1, -1], max: [0.01, 1, 1], spacing: 1.0e-4}, material: al}
+)";
+  EXPECT_EQ(test::deck(deck).particles.size(), 1u);
+  std::string three = deck;
+  three.replace(three.find("sph: {dimensions: 1}\n"), 21, "");
+  try {
+    (void)test::deck(three);
+    ADD_FAILURE() << "a 4e10-particle lattice was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("2e9"), std::string::npos) << e.what();
+  }
+}
+
 // The particle step bounds the move per step to 0.3 h (sph.md, "stable step"): two gas
 // streams at +-2000 m/s, out of each other's support, moved 3 h in the first step and
 // the run failed; a cold gas (c = 0) in motion took dt = 9e299 s.
@@ -410,6 +432,11 @@ boundary_conditions:
   // A part listed twice is a slip too (QA round 6: accepted silently).
   e = setup_error(std::string(hybrid) + "contact:\n  - {parts: [plate, ball, plate]}\n");
   EXPECT_NE(e.find("part 'plate' is listed twice"), std::string::npos) << e;
+  // One name where a list belongs (QA round 17: "expected a list" only).
+  e = setup_error(std::string(hybrid) + "contact:\n  - {parts: plate}\n");
+  EXPECT_NE(e.find("give a list of parts or 'all', got 'plate' (write [plate] for one part)"),
+            std::string::npos)
+      << e;
 }
 
 // Particle contact that cannot act is warned of: a contact of particle sets alone, and

@@ -464,7 +464,8 @@ PartConfig parse_part(const std::string& name, const Node& n, const std::string&
 
 // One particle set: `generate: {shape: box|sphere|cylinder, ..., spacing: s}` and the
 // formulation's options (docs/sph.md).
-ParticleSetConfig parse_particle_set(const std::string& name, const Node& n) {
+// `dimensions`: the deck's sph.dimensions (3 unless it gives 1 or 2), for the lattice's size.
+ParticleSetConfig parse_particle_set(const std::string& name, const Node& n, int dimensions) {
   ParticleSetConfig p;
   p.name = name;
   p.where = n.where();
@@ -502,12 +503,15 @@ ParticleSetConfig parse_particle_set(const std::string& name, const Node& n) {
         fmt::format("unknown particle shape '{}' (expected box, sphere or cylinder)", shape));
   }
   l.spacing = g.required("spacing").positive();
-  // A lattice of more than 2^31 particles on one deck line is a typo, not a model.
-  const double extent = shape == "box"
-                            ? (l.max.x - l.min.x) * (l.max.y - l.min.y) * (l.max.z - l.min.z)
-                            : 8 * l.radius * l.radius * std::max(l.radius, l.length);
-  if (extent / (l.spacing * l.spacing * l.spacing) > 2e9)
-    g.child("spacing").fail("the lattice would hold more than 2e9 particles");
+  // A lattice of more than 2^31 particles on one deck line is a typo, not a model. (An
+  // upper bound: the shape's extents along the model's dimensions, x, then y, then z.)
+  const double round = 2 * std::max(l.radius, l.length);
+  const Vec3 extent = shape == "box"      ? l.max - l.min
+                      : shape == "sphere" ? Vec3{2 * l.radius, 2 * l.radius, 2 * l.radius}
+                                          : Vec3{round, round, round};
+  double cells = 1;
+  for (int i = 0; i < dimensions; ++i) cells *= extent[i] / l.spacing;
+  if (cells > 2e9) g.child("spacing").fail("the lattice would hold more than 2e9 particles");
   p.material = n.required("material").str();
   if (n.has("smoothing_ratio")) {
     p.smoothing_ratio = n.child("smoothing_ratio").positive();
@@ -722,12 +726,18 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
   }
 
   if (top.has("particles")) {
+    // (sph.dimensions is checked below; here only to size the lattices.)
+    int dimensions = 3;
+    if (top.has("sph") && top.child("sph").has("dimensions")) {
+      const std::int64_t d = top.child("sph").child("dimensions").integer();
+      if (d == 1 || d == 2) dimensions = static_cast<int>(d);
+    }
     for (const auto& [pname, pn] : top.child("particles").entries()) {
       check_defined_name(pn, pname, "particle set");
       if (std::any_of(c.parts.begin(), c.parts.end(),
                       [&pname = pname](const PartConfig& p) { return p.name == pname; }))
         pn.fail(fmt::format("'{}' is already the name of a part", pname));
-      ParticleSetConfig p = parse_particle_set(pname, pn);
+      ParticleSetConfig p = parse_particle_set(pname, pn, dimensions);
       if (!c.material(p.material))
         pn.child("material")
             .fail(fmt::format("material '{}' is not defined under materials", p.material));
@@ -907,6 +917,10 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
       if (n.has("parts")) {
         const Node p = n.child("parts");
         if (!(p.is_scalar() && p.str() == "all")) {
+          if (!p.is_seq()) // (QA round 17: `parts: a` said only "expected a list")
+            p.fail(fmt::format("give a list of parts or 'all', got '{}' (write [{}] for one part)",
+                               p.is_scalar() ? p.str() : std::string("a map"),
+                               p.is_scalar() ? p.str() : std::string("NAME")));
           for (const auto& it : p.items()) {
             const std::string name = it.str();
             if (!part_exists(name))

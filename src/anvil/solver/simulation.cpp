@@ -272,7 +272,7 @@ void Simulation::warn_of_setup(const Mesh& mesh) {
   // A spin given to particles of a solid with the plain SPH gradient: the plain gradient
   // does not reproduce a rigid rotation where a kernel is cut by the free surface, so
   // the spin turns into spurious strain and the body stops turning (QA round 14: a ball
-  // at 1e4 rad/s lost 99% of its angular momentum in 0.3 ms; docs/sph.md, "Limits").
+  // at 1e4 rad/s lost 99% of its angular momentum in 0.3 ms; docs/sph.md, Verification).
   if (pt)
     for (const auto& ic : config_.initial_conditions) {
       if (norm(ic.angular_velocity) == 0.0) continue;
@@ -289,7 +289,7 @@ void Simulation::warn_of_setup(const Mesh& mesh) {
             "{}: particle set '{}' is given an angular velocity with the plain SPH gradient, "
             "which does not reproduce a rigid rotation near a free surface: the spin turns "
             "into spurious strain and the body stops turning; set corrected_gradient: true "
-            "(docs/sph.md, Limits)",
+            "(docs/sph.md, Verification: spinning ball)",
             ic.where.str(), ps.name));
       }
     }
