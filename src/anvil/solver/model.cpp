@@ -1,8 +1,11 @@
 #include "anvil/solver/model.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
+#include <map>
 #include <new>
 #include <stdexcept>
 
@@ -123,6 +126,98 @@ Mesh build_mesh(const Config& config) {
   for (std::size_t b = 0; b < config.parts.size(); ++b)
     if (config.parts[b].thick_shell.enabled()) orient_thickness_zeta(mesh, b);
   return mesh;
+}
+
+std::vector<std::int64_t> elements_holding(const Mesh& mesh, std::span<const std::size_t> blocks,
+                                           std::span<const Vec3> points,
+                                           std::span<const std::int64_t> node) {
+  std::vector<std::int64_t> holder(points.size(), -1);
+  auto corners = [&](const Hex& e) {
+    std::array<Vec3, 8> x;
+    for (int k = 0; k < 8; ++k) x[k] = mesh.nodes[static_cast<std::size_t>(e[k])];
+    return x;
+  };
+  auto bounds = [](const std::array<Vec3, 8>& x) {
+    Box3 b{x[0], x[0]};
+    for (const Vec3& q : x)
+      for (int i = 0; i < 3; ++i) {
+        b.lo[i] = std::min(b.lo[i], q[i]);
+        b.hi[i] = std::max(b.hi[i], q[i]);
+      }
+    return b;
+  };
+  double extent = 0;
+  std::int64_t elements = 0;
+  for (std::size_t b : blocks)
+    for (const Hex& e : mesh.blocks[b].elements) {
+      const Box3 bb = bounds(corners(e));
+      extent += std::max({bb.hi.x - bb.lo.x, bb.hi.y - bb.lo.y, bb.hi.z - bb.lo.z});
+      ++elements;
+    }
+  if (elements == 0 || !(extent > 0) || points.empty()) return holder;
+  // The faces of these blocks that bound them (one element's, not two): a point on such a
+  // face touches the body; a point on a face between two elements is inside it.
+  auto face_key = [](const Hex& e, int f) {
+    std::array<std::int64_t, 4> k;
+    for (int a = 0; a < 4; ++a) k[a] = e[hex_faces[static_cast<std::size_t>(f)][a]];
+    std::sort(k.begin(), k.end());
+    return k;
+  };
+  std::vector<std::array<std::int64_t, 4>> faces;
+  for (std::size_t b : blocks)
+    for (const Hex& e : mesh.blocks[b].elements)
+      for (int f = 0; f < 6; ++f) faces.push_back(face_key(e, f));
+  std::sort(faces.begin(), faces.end());
+  auto bounding = [&](const std::array<std::int64_t, 4>& k) {
+    const auto [lo, hi] = std::equal_range(faces.begin(), faces.end(), k);
+    return hi - lo == 1;
+  };
+  const double cell = extent / static_cast<double>(elements);
+  auto key = [cell](double a) { return static_cast<std::int64_t>(std::floor(a / cell)); };
+  std::map<std::array<std::int64_t, 3>, std::vector<std::size_t>> grid;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    grid[{key(points[i].x), key(points[i].y), key(points[i].z)}].push_back(i);
+  std::int64_t gid = 0; // the global id of the element (blocks in order)
+  for (std::size_t b = 0; b < mesh.blocks.size(); ++b) {
+    const bool listed = std::find(blocks.begin(), blocks.end(), b) != blocks.end();
+    if (!listed) {
+      gid += static_cast<std::int64_t>(mesh.blocks[b].elements.size());
+      continue;
+    }
+    for (const Hex& e : mesh.blocks[b].elements) {
+      const std::int64_t id = gid++;
+      const auto x = corners(e);
+      const Box3 bb = bounds(x);
+      const double tol = 1e-6 * std::max({bb.hi.x - bb.lo.x, bb.hi.y - bb.lo.y, bb.hi.z - bb.lo.z});
+      Vec3 centre[6], normal[6];
+      double margin[6]; // behind a bounding face by more than tol, an inner one by -tol
+      for (int f = 0; f < 6; ++f) {
+        const auto& q = hex_faces[static_cast<std::size_t>(f)];
+        centre[f] = 0.25 * (x[q[0]] + x[q[1]] + x[q[2]] + x[q[3]]);
+        const Vec3 n = cross(x[q[2]] - x[q[0]], x[q[3]] - x[q[1]]);
+        const double len = norm(n);
+        normal[f] = len > 0 ? n * (1 / len) : n;
+        margin[f] = bounding(face_key(e, f)) ? -tol : tol;
+      }
+      const std::int64_t l[3] = {key(bb.lo.x), key(bb.lo.y), key(bb.lo.z)};
+      const std::int64_t h[3] = {key(bb.hi.x), key(bb.hi.y), key(bb.hi.z)};
+      for (std::int64_t a = l[0]; a <= h[0]; ++a)
+        for (std::int64_t c = l[1]; c <= h[1]; ++c)
+          for (std::int64_t d = l[2]; d <= h[2]; ++d) {
+            const auto it = grid.find({a, c, d});
+            if (it == grid.end()) continue;
+            for (std::size_t i : it->second) {
+              if (holder[i] >= 0) continue; // (the first, the smallest id)
+              if (!node.empty() && std::find(e.begin(), e.end(), node[i]) != e.end()) continue;
+              bool in = true;
+              for (int f = 0; f < 6 && in; ++f)
+                in = dot(points[i] - centre[f], normal[f]) < margin[f];
+              if (in) holder[i] = id;
+            }
+          }
+    }
+  }
+  return holder;
 }
 
 std::vector<std::int64_t> resolve_selection(const Mesh& mesh, const Config& config,

@@ -3,6 +3,9 @@
 // selections against it.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
+#include <span>
 #include <vector>
 
 #include "anvil/io/config.hpp"
@@ -18,6 +21,18 @@ Mesh build_mesh(const Config& config);
 // location) if it names an unknown set or selects nothing.
 std::vector<std::int64_t> resolve_selection(const Mesh& mesh, const Config& config,
                                             const Selection& sel);
+
+// For each point, the smallest global id of an element of `blocks` that holds it inside
+// the body (behind the plane of each of its six faces, through the face's centre with the
+// normal of its diagonals, by more than 1e-6 of the element's size where the face bounds
+// the blocks: a point on the body's surface is not inside, one on a face between two
+// elements is), leaving out the elements of which it is a corner (`node[i]`: the point's
+// global node id, or -1 for a particle); -1 where none does. The points are binned on a
+// grid of the elements' mean size; exact for flat faces, a warning's accuracy for warped
+// ones.
+std::vector<std::int64_t> elements_holding(const Mesh& mesh, std::span<const std::size_t> blocks,
+                                           std::span<const Vec3> points,
+                                           std::span<const std::int64_t> node);
 
 // The static FE decomposition of the model (DESIGN.md section 1; `decomposition` in the
 // deck): the owner rank of every element in global element order, the same on every

@@ -168,6 +168,10 @@ private:
   // Particles of the sets in contact that start inside an element of a part in contact
   // (global count; the setup's warning). Collective.
   std::int64_t particles_inside_contact_parts(const Mesh& mesh) const;
+  // The mesh blocks (parts) in contact, ascending.
+  std::vector<std::size_t> contact_blocks(const Mesh& mesh) const;
+  // Setup warning: owned contact nodes that start inside an element of a part in contact.
+  void warn_of_initial_overlap(const Mesh& mesh);
 
   Config config_;
   const Comm& comm_;

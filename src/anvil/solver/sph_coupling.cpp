@@ -289,78 +289,17 @@ void Simulation::restore_particles(const Checkpoint& c, const std::string& from)
   sph_->redistribute();
 }
 
-// Own particles of the sets in contact are binned on a grid of the mean element size;
-// each element of a part in contact tests the particles in the cells its bounding box
-// covers: inside when behind the plane of every face (through the face's centre, normal
-// the cross product of its diagonals: exact for flat faces, and a warning's accuracy
-// for warped ones). Each particle counts once.
+// Own particles of the sets in contact that an element of a part in contact holds
+// (elements_holding); each counts once.
 std::int64_t Simulation::particles_inside_contact_parts(const Mesh& mesh) const {
   const auto& pt = sph_->particles();
-  const auto& listed = config_.contact[0].parts;
-  std::vector<std::size_t> blocks;
-  for (std::size_t b = 0; b < mesh.blocks.size(); ++b)
-    if (listed.empty() ||
-        std::find(listed.begin(), listed.end(), mesh.blocks[b].name) != listed.end())
-      blocks.push_back(b);
-  auto corners = [&](const Hex& e) {
-    std::array<Vec3, 8> x;
-    for (int k = 0; k < 8; ++k) x[k] = mesh.nodes[static_cast<std::size_t>(e[k])];
-    return x;
-  };
-  auto bounds = [](const std::array<Vec3, 8>& x) {
-    Box3 b{x[0], x[0]};
-    for (const Vec3& q : x)
-      for (int i = 0; i < 3; ++i) {
-        b.lo[i] = std::min(b.lo[i], q[i]);
-        b.hi[i] = std::max(b.hi[i], q[i]);
-      }
-    return b;
-  };
-  double extent = 0;
-  std::int64_t elements = 0;
-  for (std::size_t b : blocks)
-    for (const Hex& e : mesh.blocks[b].elements) {
-      const Box3 bb = bounds(corners(e));
-      extent += std::max({bb.hi.x - bb.lo.x, bb.hi.y - bb.lo.y, bb.hi.z - bb.lo.z});
-      ++elements;
-    }
-  std::int64_t inside = 0;
-  if (elements > 0 && extent > 0) {
-    const double cell = extent / static_cast<double>(elements);
-    auto key = [cell](double a) { return static_cast<std::int64_t>(std::floor(a / cell)); };
-    std::map<std::array<std::int64_t, 3>, std::vector<std::size_t>> grid;
-    for (std::size_t i = 0; i < pt.size(); ++i)
-      if (sph_contact_set_[static_cast<std::size_t>(pt.set[i])])
-        grid[{key(pt.x[0][i]), key(pt.x[1][i]), key(pt.x[2][i])}].push_back(i);
-    std::vector<std::uint8_t> found(pt.size(), 0);
-    for (std::size_t b : blocks)
-      for (const Hex& e : mesh.blocks[b].elements) {
-        const auto x = corners(e);
-        const Box3 bb = bounds(x);
-        Vec3 centre[6], normal[6];
-        for (int f = 0; f < 6; ++f) {
-          const auto& q = hex_faces[static_cast<std::size_t>(f)];
-          centre[f] = 0.25 * (x[q[0]] + x[q[1]] + x[q[2]] + x[q[3]]);
-          normal[f] = cross(x[q[2]] - x[q[0]], x[q[3]] - x[q[1]]);
-        }
-        const std::int64_t l[3] = {key(bb.lo.x), key(bb.lo.y), key(bb.lo.z)};
-        const std::int64_t h[3] = {key(bb.hi.x), key(bb.hi.y), key(bb.hi.z)};
-        for (std::int64_t a = l[0]; a <= h[0]; ++a)
-          for (std::int64_t c = l[1]; c <= h[1]; ++c)
-            for (std::int64_t d = l[2]; d <= h[2]; ++d) {
-              const auto it = grid.find({a, c, d});
-              if (it == grid.end()) continue;
-              for (std::size_t i : it->second) {
-                const Vec3 p{pt.x[0][i], pt.x[1][i], pt.x[2][i]};
-                bool in = true;
-                for (int f = 0; f < 6 && in; ++f) in = dot(p - centre[f], normal[f]) < 0;
-                found[i] |= in ? 1 : 0;
-              }
-            }
-      }
-    inside = static_cast<std::int64_t>(std::count(found.begin(), found.end(), 1));
-  }
-  return comm_.sum(inside);
+  std::vector<Vec3> points;
+  for (std::size_t i = 0; i < pt.size(); ++i)
+    if (sph_contact_set_[static_cast<std::size_t>(pt.set[i])])
+      points.push_back({pt.x[0][i], pt.x[1][i], pt.x[2][i]});
+  const auto holder = elements_holding(mesh, contact_blocks(mesh), points, {});
+  return comm_.sum(static_cast<std::int64_t>(
+      std::count_if(holder.begin(), holder.end(), [](std::int64_t e) { return e >= 0; })));
 }
 
 } // namespace anvil
