@@ -1102,6 +1102,7 @@ void ContactPhase::detect(const ContactNodes& nd, double dt, PhaseTimers& timers
       rcb_.partition(pts);
     partitioned_ = true;
     rebalance_due_ = false;
+    just_rebalanced_ = true;
     rank_box_.resize(static_cast<std::size_t>(comm_.size()));
     for (int r = 0; r < comm_.size(); ++r) rank_box_[static_cast<std::size_t>(r)] = rcb_.box(r);
     ++stats_.rebalances;
@@ -1416,7 +1417,10 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
     stats_.pairs = static_cast<std::int64_t>(pair_sum);
     stats_.max_penetration = std::max(stats_.max_penetration, deep_max);
     stats_.max_penetration_resisted = std::max(stats_.max_penetration_resisted, resisted_max);
-    rebalance_due_ = stats_.imbalance > config_.rebalance_threshold;
+    if (just_rebalanced_) rebalance_floor_ = stats_.imbalance;
+    just_rebalanced_ = false;
+    rebalance_due_ =
+        stats_.imbalance > std::max(config_.rebalance_threshold, 1.05 * rebalance_floor_);
   }
 
   {
