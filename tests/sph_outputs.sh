@@ -39,4 +39,21 @@ mpirun -np 2 --oversubscribe "$anvil" run "$out/ponly.yaml" -o "$out/ponly" -q -
 grep -q "no Exodus II file is written" "$out/ponly.err" || { cat "$out/ponly.err"; exit 1; }
 grep -q "particles_step_" "$out/ponly/particles.pvd"
 ! ls "$out/ponly"/results.exo* 2> /dev/null
+# Particle temperature (QA round 18: not written): a Johnson-Cook ball heats on impact, and
+# particles.pvd lists `temperature` (absent for the elastic ball above).
+/usr/bin/python3 "$src/tools/anvil_vtu.py" "$out/particles.pvd" | grep -q "temperature" &&
+  { echo "temperature listed for an elastic ball"; exit 1; }
+sed -e 's/^  steel: .*/&\n  jc: {model: johnson_cook, density: 7830, youngs_modulus: 200.0e9, poissons_ratio: 0.29, A: 3.0e8, B: 5.0e8, n: 0.3, melt_temperature: 1800, specific_heat: 450}/' \
+  -e 's/         material: steel}/         material: jc}/' -e 's/cycles: 40/cycles: 150/' \
+  "$src/tests/data/decks/sph_tiny.yaml" > "$out/jc.yaml"
+grep -q "material: jc}" "$out/jc.yaml" || { echo "the deck edit did not apply"; exit 1; }
+mpirun -np 2 --oversubscribe "$anvil" run "$out/jc.yaml" -o "$out/jc" -q
+/usr/bin/python3 - "$src/tools" "$out/jc" <<'PY'
+import sys
+sys.path.insert(0, sys.argv[1])
+from anvil_vtu import read_pvd, read_grid
+last = read_pvd(sys.argv[2] + "/particles.pvd")[-1]
+t = read_grid(last.path).point_data["temperature"]
+assert t.min() >= 293.0 and t.max() > 293.0, (t.min(), t.max())
+PY
 echo "sph outputs: ok"

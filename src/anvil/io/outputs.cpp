@@ -101,7 +101,8 @@ VtuPiece particle_piece(const Simulation& sim) {
   VtuArray disp{"displacement", 3}, vel{"velocity", 3}, rho{"density", 1}, pres{"pressure", 1},
       stress{"stress", 6}, vm{"von_mises", 1}, ep{"plastic_strain", 1}, energy{"energy", 1},
       h{"smoothing_length", 1}, rank{"sph_rank", 1, true}, pid{"particle_id", 1, true},
-      set{"particle_set", 1, true};
+      set{"particle_set", 1, true}, temp{"temperature", 1};
+  bool any_temp = false; // (a thermal model starts its particles at room temperature)
   for (std::size_t i = 0; i < n; ++i) {
     for (int k = 0; k < 3; ++k) {
       p.points[3 * i + k] = pt.x[k][i];
@@ -121,6 +122,8 @@ VtuPiece particle_piece(const Simulation& sim) {
     pres.f64.push_back(-m);
     vm.f64.push_back(std::sqrt(3 * j2));
     ep.f64.push_back(pt.plastic_strain[i]);
+    temp.f64.push_back(pt.temperature[i]);
+    any_temp = any_temp || pt.temperature[i] > 0;
     energy.f64.push_back(pt.energy[i]);
     h.f64.push_back(pt.h[i]);
     rank.i64.push_back(sim.comm().rank());
@@ -134,6 +137,10 @@ VtuPiece particle_piece(const Simulation& sim) {
   p.point_data = {std::move(disp),   std::move(vel),  std::move(rho), std::move(pres),
                   std::move(stress), std::move(vm),   std::move(ep),  std::move(energy),
                   std::move(h),      std::move(rank), std::move(pid), std::move(set)};
+  // Every rank must list the same arrays: temperature where some particle has a thermal
+  // model (QA round 18: Johnson-Cook heating of particles was not in the outputs).
+  if (sim.comm().max(static_cast<std::int64_t>(any_temp)) > 0)
+    p.point_data.insert(p.point_data.begin() + 7, std::move(temp));
   return p;
 }
 
