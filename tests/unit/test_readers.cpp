@@ -732,6 +732,29 @@ TEST(ReadersDeck, UnknownSetOfAFilePartListsItsSets) {
   EXPECT_NE(r.output.find("box.top"), std::string::npos) << r.output;
 }
 
+// Ids that repeat across a model's mesh files fall back to 1..N in the outputs, and the
+// setup says so (QA round 13: silently).
+TEST(ReadersDeck, RepeatedFileIdsAreWarnedOf) {
+  TempDir dir;
+  fs::copy_file(data("box_2x2x2.msh"), dir.path / "box_2x2x2.msh");
+  write(dir.path / "deck.yaml", R"(termination: {cycles: 1}
+materials:
+  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+parts:
+  a: {mesh: {file: box_2x2x2.msh}, material: steel}
+  b: {mesh: {file: box_2x2x2.msh}, material: steel}
+)");
+  const CheckRun r = anvil_check(dir.file("deck.yaml"));
+  EXPECT_EQ(r.status, 0) << r.output;
+  for (const char* what : {"node", "element"})
+    EXPECT_NE(r.output.find(fmt::format("the mesh files' {} ids repeat in the model", what)),
+              std::string::npos)
+        << r.output;
+  write(dir.path / "deck.yaml", deck_for("box_2x2x2.msh", "box.top"));
+  const CheckRun one = anvil_check(dir.file("deck.yaml"));
+  EXPECT_EQ(one.output.find("ids repeat"), std::string::npos) << one.output;
+}
+
 TEST(ReadersDeck, BadMeshFilesExitWithStatusTwo) {
   TempDir dir;
   const std::string good = slurp(data("box_2x2x2.msh"));

@@ -104,6 +104,15 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
             element_ids ? mesh.blocks[b].id(static_cast<std::size_t>(gid - block_offsets_[b]))
                         : gid + 1);
       }
+    // (The same on every rank: the global mesh's.) Said, so that ids a user looks for in
+    // the outputs are not silently others (QA round 13).
+    for (const auto& [unique, what] : {std::pair{node_ids, "node"}, {element_ids, "element"}})
+      if (!unique)
+        warnings_.push_back(fmt::format(
+            "{}: the mesh files' {} ids repeat in the model (the same file in two parts, or a "
+            "generated part whose numbers meet a file's): the outputs and messages number the "
+            "{}s 1..N in model order instead (docs/meshes.md, \"Ids in the outputs\")",
+            config_.deck_file, what, what));
     std::int64_t top = 0;
     for (const auto id : node_file_id_) top = std::max(top, id);
     for (const auto& ids : element_file_id_)
