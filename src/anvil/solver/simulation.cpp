@@ -106,8 +106,13 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
       }
     // (The same on every rank: the global mesh's.) Said, so that ids a user looks for in
     // the outputs are not silently others (QA round 13).
-    for (const auto& [unique, what] : {std::pair{node_ids, "node"}, {element_ids, "element"}})
-      if (!unique)
+    // Only where a file gave ids that are dropped: generated parts number their elements
+    // from 1 each, which repeat between parts by design.
+    const bool file_elements = std::any_of(mesh.blocks.begin(), mesh.blocks.end(),
+                                           [](const auto& b) { return !b.ids.empty(); });
+    for (const auto& [dropped, what] : {std::pair{!node_ids && !mesh.node_ids.empty(), "node"},
+                                        {!element_ids && file_elements, "element"}})
+      if (dropped)
         warnings_.push_back(fmt::format(
             "{}: the mesh files' {} ids repeat in the model (the same file in two parts, or a "
             "generated part whose numbers meet a file's): the outputs and messages number the "
