@@ -95,16 +95,22 @@ def read_history(outdir):
     return History(path, columns, {c: table[:, i] for i, c in enumerate(columns)})
 
 
+def read_json(path):
+    """The JSON document at `path`; ResultsError naming the file when it cannot be read or
+    is not JSON."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            return json.load(f)
+    except (OSError, ValueError) as e:
+        raise ResultsError(f"{path}: cannot read ({getattr(e, 'strerror', None) or e})") from None
+
+
 def read_summary(outdir):
     """Return OUTDIR/summary.json as a dict, None if absent; ResultsError if malformed."""
     path = os.path.join(outdir, "summary.json") if os.path.isdir(outdir) else None
     if path is None or not os.path.exists(path):
         return None
-    try:
-        with open(path, encoding="utf-8") as f:
-            summary = json.load(f)
-    except (OSError, ValueError) as e:
-        raise ResultsError(f"{path}: cannot read ({e})") from None
+    summary = read_json(path)
     check_summary(summary, path)
     return summary
 
@@ -302,11 +308,7 @@ def read_machine(root):
     path = os.path.join(root, "machine.json")
     if not os.path.exists(path):
         return {}
-    try:
-        with open(path, encoding="utf-8") as f:
-            machine = json.load(f)
-    except (OSError, ValueError) as e:
-        raise ResultsError(f"{path}: cannot read ({e})") from None
+    machine = read_json(path)
     if not isinstance(machine, dict):
         raise ResultsError(f"{path}: expected a JSON object, found {_json_type(machine)}")
     if "nproc" in machine and not (_is_type(machine["nproc"], _INT) and machine["nproc"] > 0):

@@ -13,9 +13,8 @@ The input JSON is written by bench/rcb_dump (run it on 8 ranks for the paper's p
 Uses Debian's python3-matplotlib: run with /usr/bin/python3.
 """
 import argparse
-import json
 
-from anvil_results import ResultsError, run_main, save_figure, use_agg
+from anvil_results import ResultsError, read_json, run_main, save_figure, use_agg
 
 # Top-level keys of bench/rcb_dump's JSON that the figure uses, with their JSON type.
 RCB_KEYS = {"points_xy_owner": list, "ranks": int, "domain": dict, "cut_segments": list,
@@ -26,11 +25,7 @@ TYPE_NAMES = {list: "a list", int: "an integer", dict: "an object"}
 def read_rcb(path):
     """The rcb_dump JSON at `path` as a dict; ResultsError naming the file when it is
     missing, not JSON, or lacks a key the figure needs."""
-    try:
-        with open(path, encoding="utf-8") as f:
-            d = json.load(f)
-    except (OSError, ValueError) as e:
-        raise ResultsError(f"{path}: cannot read ({getattr(e, 'strerror', None) or e})") from None
+    d = read_json(path)
     if not isinstance(d, dict):
         raise ResultsError(f"{path}: expected a JSON object (the output of bench/rcb_dump)")
     for key, kind in RCB_KEYS.items():
