@@ -173,9 +173,23 @@ contact:
   EXPECT_LT(change, 0.01 * sim.initial_energy());
 }
 
-} // namespace
-
-namespace {
+// An aluminium block (4 mm, 4^3 elements) above a base (12 x 12 x 4 mm, 6 x 6 x 2) whose
+// top is z = 0, the block's bottom at z = `bottom`; `rest` adds the termination,
+// conditions and contact.
+std::string block_on_base(const std::string& bottom, const std::string& rest) {
+  return R"(
+materials:
+  al: {model: elastic, density: 2700, youngs_modulus: 70.0e9, poissons_ratio: 0.3}
+parts:
+  base:
+    mesh: {generate: box, min: [-0.006, -0.006, -0.004], max: [0.006, 0.006, 0.0], divisions: [6, 6, 2]}
+    material: al
+  block:
+    mesh: {generate: box, min: [-0.002, -0.002, )" +
+         bottom + R"(], max: [0.002, 0.002, 0.004], divisions: [4, 4, 4]}
+    material: al
+)" + rest;
+}
 
 // 4. Friction only dissipates (QA round 17): an aluminium block pressed onto a clamped
 //    base (prescribed downward velocity on its top) slides on it with friction 1.0.
@@ -186,17 +200,7 @@ namespace {
 //    among the pairs of an interface it reached -0.31 J (E0 1.1e-3 J) and the block's
 //    kinetic energy rose six-fold.
 TEST(Contact, FrictionNeverCreatesEnergy) {
-  const Config c = test::deck(R"(
-termination: {time: 2.0e-5}
-materials:
-  al: {model: elastic, density: 2700, youngs_modulus: 70.0e9, poissons_ratio: 0.3}
-parts:
-  base:
-    mesh: {generate: box, min: [-0.006, -0.006, -0.004], max: [0.006, 0.006, 0.0], divisions: [6, 6, 2]}
-    material: al
-  block:
-    mesh: {generate: box, min: [-0.002, -0.002, 0.0], max: [0.002, 0.002, 0.004], divisions: [4, 4, 4]}
-    material: al
+  const Config c = test::deck(block_on_base("0.0", R"(termination: {time: 2.0e-5}
 initial_conditions:
   - {part: block, velocity: [3, 0, -2]}
 boundary_conditions:
@@ -204,7 +208,7 @@ boundary_conditions:
   - {set: block.zmax, velocity: [0, 0, -2], components: [z]}
 contact:
   - {parts: all, friction: 1.0, penalty_scale: 1.0}
-)");
+)"));
   const Comm world = Comm::world();
   Simulation sim(c, world);
   double lowest = 0;
@@ -223,10 +227,6 @@ contact:
   EXPECT_GT(s.contact, 0.0);
 }
 
-} // namespace
-
-namespace {
-
 // 5. Bodies that start overlapping are warned of (QA round 17): contact takes a node only
 //    when it comes through a face, so a block that starts 0.3 mm into a base passes
 //    through it. Reference: the geometry: the block's 25 bottom nodes lie inside the
@@ -235,23 +235,10 @@ namespace {
 //    by id node 123 (the base's, in element 78 of the model, the block's 6th). The same
 //    warning on any number of ranks; none for the block resting exactly on the base.
 TEST(Contact, InitialOverlapIsWarnedOf) {
-  const std::string deck = R"(
-termination: {cycles: 1}
-materials:
-  al: {model: elastic, density: 2700, youngs_modulus: 70.0e9, poissons_ratio: 0.3}
-parts:
-  base:
-    mesh: {generate: box, min: [-0.006, -0.006, -0.004], max: [0.006, 0.006, 0.0], divisions: [6, 6, 2]}
-    material: al
-  block:
-    mesh: {generate: box, min: [-0.002, -0.002, -0.0003], max: [0.002, 0.002, 0.004], divisions: [4, 4, 4]}
-    material: al
-contact:
-  - {parts: all}
-)";
+  const std::string rest = "termination: {cycles: 1}\ncontact:\n  - {parts: all}\n";
   const Comm world = Comm::world();
   {
-    Simulation sim(test::deck(deck), world);
+    Simulation sim(test::deck(block_on_base("-0.0003", rest)), world);
     ASSERT_EQ(sim.warnings().size(), 1u);
     const std::string& w = sim.warnings()[0];
     EXPECT_NE(w.find("26 nodes of parts in contact start inside elements"), std::string::npos) << w;
@@ -259,9 +246,7 @@ contact:
               std::string::npos)
         << w;
   }
-  std::string touching = deck;
-  touching.replace(touching.find("-0.0003]"), 8, "0.0]");
-  Simulation sim(test::deck(touching), world);
+  Simulation sim(test::deck(block_on_base("0.0", rest)), world);
   EXPECT_TRUE(sim.warnings().empty()) << sim.warnings()[0];
 }
 
