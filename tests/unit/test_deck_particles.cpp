@@ -30,6 +30,7 @@ particles:
     generate: {shape: sphere, center: [0, 0, 0.02], radius: 5.0e-3, spacing: 1.0e-3}
     material: copper
     smoothing_ratio: 1.2
+    smoothing_bounds: [0.5, 3]
     kernel: wendland_c2
     viscosity: {linear: 0.5, quadratic: 1.0}
     artificial_stress: {epsilon: 0.2, exponent: 3}
@@ -70,6 +71,8 @@ TEST(DeckParticles, ParsesParticleSetsAndEos) {
   EXPECT_EQ(b.lattice.shape, LatticeSpec::Shape::sphere);
   EXPECT_DOUBLE_EQ(b.lattice.radius, 5.0e-3);
   EXPECT_DOUBLE_EQ(b.smoothing_ratio, 1.2);
+  EXPECT_DOUBLE_EQ(b.h_min, 0.5);
+  EXPECT_DOUBLE_EQ(b.h_max, 3);
   EXPECT_EQ(b.kernel, ParticleSetConfig::Kernel::wendland_c2);
   EXPECT_DOUBLE_EQ(b.viscosity_linear, 0.5);
   EXPECT_DOUBLE_EQ(b.viscosity_quadratic, 1.0);
@@ -80,6 +83,8 @@ TEST(DeckParticles, ParsesParticleSetsAndEos) {
   // Defaults.
   const auto& a = c.particles[1];
   EXPECT_DOUBLE_EQ(a.smoothing_ratio, 1.3);
+  EXPECT_DOUBLE_EQ(a.h_min, 0.2); // LS-DYNA's HMIN and HMAX defaults
+  EXPECT_DOUBLE_EQ(a.h_max, 2.0);
   EXPECT_DOUBLE_EQ(a.viscosity_linear, 1.0);
   EXPECT_DOUBLE_EQ(a.viscosity_quadratic, 2.0);
   EXPECT_DOUBLE_EQ(a.artificial_stress, 0.3);
@@ -98,19 +103,27 @@ TEST(DeckParticles, BadInputNamesKeyAndLine) {
   expect_error("radius: 5.0e-3, spacing", "radius: 5.0e-3, spcing: 1, spacing",
                {"deck.yaml:9", "spcing", "unknown key"});
   expect_error("material: copper\n", "material: bronze\n", {"deck.yaml:10", "bronze"});
-  expect_error("kernel: wendland_c2\n", "kernel: gaussian\n", {"deck.yaml:12", "gaussian"});
+  expect_error("kernel: wendland_c2\n", "kernel: gaussian\n", {"deck.yaml:13", "gaussian"});
   expect_error("smoothing_ratio: 1.2", "smoothing_ratio: 5", {"deck.yaml:11", "smoothing_ratio"});
-  expect_error("linear: 0.5", "linear: -0.5", {"deck.yaml:13", "viscosity.linear", "negative"});
-  expect_error("epsilon: 0.2", "epsilon: 2", {"deck.yaml:14", "artificial_stress.epsilon"});
+  expect_error("smoothing_bounds: [0.5, 3]", "smoothing_bounds: [2, 3]",
+               {"deck.yaml:12", "smoothing_bounds[0]", "must not exceed 1"});
+  expect_error("smoothing_bounds: [0.5, 3]", "smoothing_bounds: [0.5, 0.9]",
+               {"deck.yaml:12", "smoothing_bounds[1]", "at least 1"});
+  expect_error("smoothing_bounds: [0.5, 3]", "smoothing_bounds: [0, 3]",
+               {"deck.yaml:12", "smoothing_bounds[0]", "positive"});
+  expect_error("smoothing_bounds: [0.5, 3]", "smoothing_bounds: 2",
+               {"deck.yaml:12", "smoothing_bounds", "two numbers"});
+  expect_error("linear: 0.5", "linear: -0.5", {"deck.yaml:14", "viscosity.linear", "negative"});
+  expect_error("epsilon: 0.2", "epsilon: 2", {"deck.yaml:15", "artificial_stress.epsilon"});
   expect_error("corrected_gradient: true", "corrected_gradient: maybe",
-               {"deck.yaml:15", "corrected_gradient"});
+               {"deck.yaml:16", "corrected_gradient"});
   expect_error("c0: 3940", "c0: -3940", {"deck.yaml:5", "eos.c0", "impossible"});
   expect_error("model: mie_gruneisen", "model: tillotson", {"deck.yaml:5", "tillotson"});
   expect_error("spacing: 1.0e-3}\n    material", "spacing: 1.0e-9}\n    material",
                {"deck.yaml:9", "spacing", "2e9"});
-  expect_error("part: ball", "part: bal", {"deck.yaml:20", "bal"});
+  expect_error("part: ball", "part: bal", {"deck.yaml:21", "bal"});
   expect_error("sph: {rebalance_threshold: 1.5}", "sph: {dimensions: 4}",
-               {"deck.yaml:18", "sph.dimensions"});
+               {"deck.yaml:19", "sph.dimensions"});
 }
 
 TEST(DeckParticles, FluidsAndEquationsOfStateAreForParticlesOnly) {
@@ -405,6 +418,39 @@ initial_conditions:
                   world);
   cold.step();
   EXPECT_NEAR(cold.clock().dt, 0.9 * 0.3 * 1.3 * 5.0e-4 / 10, 1e-12); // scale 0.9
+}
+
+// A summation-density particle with no neighbours has its own kernel term only: its
+// density fell with its growing h and h grew with the falling density, about 1.9 times per
+// cycle without bound (QA round 18: h 1e11 m after 50 cycles, and the neighbour cells,
+// sized by the largest h, slowed the whole particle phase). The set's smoothing_bounds
+// (LS-DYNA's HMIN and HMAX; default [0.2, 2] h0) stop it at 2 h0 with a finite density;
+// the cube's particles stay within the bounds too.
+TEST(DeckParticles, LoneParticleSmoothingLengthStopsAtItsBound) {
+  const Comm world = Comm::world();
+  Simulation sim(test::deck(R"(termination: {cycles: 50}
+materials:
+  gas: {model: ideal_gas, density: 1.0, gamma: 1.4, specific_energy: 2.5e5}
+particles:
+  cube: {generate: {shape: box, min: [0, 0, 0], max: [0.004, 0.004, 0.004], spacing: 1.0e-3},
+         material: gas, summation_density: true}
+  lone: {generate: {shape: box, min: [0.5, 0.5, 0.5], max: [0.501, 0.501, 0.501], spacing: 1.0e-3},
+         material: gas, summation_density: true}
+)"),
+                 world);
+  while (!sim.finished()) sim.step();
+  const double h0 = 1.3e-3;
+  const auto& pt = sim.sph()->particles();
+  int lone = 0;
+  for (std::size_t i = 0; i < pt.h.size(); ++i) {
+    EXPECT_GE(pt.h[i], 0.2 * h0 * (1 - 1e-12)) << "particle " << pt.gid[i];
+    EXPECT_LE(pt.h[i], 2 * h0 * (1 + 1e-12)) << "particle " << pt.gid[i];
+    if (pt.set[i] != 1) continue;
+    ++lone;
+    EXPECT_NEAR(pt.h[i], 2 * h0, 1e-12 * h0); // at its bound: alone, its density only falls
+    EXPECT_TRUE(std::isfinite(pt.rho[i]) && pt.rho[i] > 0) << pt.rho[i];
+  }
+  EXPECT_EQ(lone, 1);
 }
 
 // A node set whose box misses the particle set it names says so (it said "part 'ball'

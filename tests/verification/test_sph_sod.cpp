@@ -9,7 +9,8 @@
 // density by summation (`summation_density: true`: the continuity equation's density
 // drifts from the particles' spacing across the shock and the contact, and its p* error
 // does not shrink with resolution, +5.4/+6.2/+6.2% at 100/200/400 particles per unit
-// length against -1.6/+0.3% for the summation; docs/sph.md).
+// length against -1.6/+0.3% for the summation without bounds on h, +0.14/+0.15% with the
+// default smoothing_bounds [0.2, 2]; docs/sph.md).
 // (A 3-D tube with fixed transverse velocities is no substitute: under uniaxial
 // expansion the 3-D law h ~ rho^(-1/3) lets h / dx along the tube fall to ~0.75 in the
 // rarefaction; docs/sph.md.)

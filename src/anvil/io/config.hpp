@@ -75,6 +75,9 @@ struct ParticleSetConfig {
   LatticeSpec lattice;
   std::string material;
   double smoothing_ratio = 1.3; // h = ratio * (lattice cell volume)^(1/dimensions)
+  // Bounds of h / h0 as the density changes (LS-DYNA's *SECTION_SPH HMIN and HMAX, with
+  // their defaults): h = h0 (rho0 / rho)^(1/d) clamped to [h_min, h_max] h0.
+  double h_min = 0.2, h_max = 2.0;
   Kernel kernel = Kernel::cubic_spline;
   double viscosity_linear = 1.0;    // Monaghan-Gingold alpha
   double viscosity_quadratic = 2.0; // Monaghan-Gingold beta

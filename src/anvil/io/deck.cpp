@@ -469,8 +469,8 @@ ParticleSetConfig parse_particle_set(const std::string& name, const Node& n, int
   ParticleSetConfig p;
   p.name = name;
   p.where = n.where();
-  n.check_keys({"generate", "material", "smoothing_ratio", "kernel", "viscosity",
-                "artificial_stress", "corrected_gradient", "summation_density"});
+  n.check_keys({"generate", "material", "smoothing_ratio", "smoothing_bounds", "kernel",
+                "viscosity", "artificial_stress", "corrected_gradient", "summation_density"});
   const Node g = n.required("generate");
   const std::string shape = g.required("shape").str();
   LatticeSpec& l = p.lattice;
@@ -518,6 +518,16 @@ ParticleSetConfig parse_particle_set(const std::string& name, const Node& n, int
     if (p.smoothing_ratio < 0.8 || p.smoothing_ratio > 3)
       n.child("smoothing_ratio")
           .fail("must be between 0.8 and 3 (h = ratio * (cell volume)^(1/dimensions))");
+  }
+  if (n.has("smoothing_bounds")) {
+    const Node b = n.child("smoothing_bounds");
+    if (!b.is_seq() || b.items().size() != 2)
+      b.fail("expected a list of two numbers [min, max], the bounds of h / h0");
+    const auto it = b.items();
+    p.h_min = it[0].positive();
+    p.h_max = it[1].positive();
+    if (p.h_min > 1) it[0].fail(fmt::format("must not exceed 1 (h0 itself), got {}", p.h_min));
+    if (p.h_max < 1) it[1].fail(fmt::format("must be at least 1 (h0 itself), got {}", p.h_max));
   }
   if (n.has("kernel")) {
     const std::string k = n.child("kernel").str();

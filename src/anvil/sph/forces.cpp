@@ -890,31 +890,25 @@ void smoothing_lengths(std::span<const SetParams> sets, const int* set, const do
                        std::size_t n, double* h) {
   if (n == 0) return;
   const int dim = sets[0].dimensions;
-  auto lengths = [dim](const vdouble& rho0, const vdouble& h0, const vdouble& rho_v) {
-    const vdouble r = rho0 / rho_v;
-    return h0 * (dim == 3 ? simd::cube_root(r) : (dim == 2 ? stdx::sqrt(r) : r));
+  // h0 (rho0 / rho)^(1/d) within [h_min, h_max] of the particles' sets; `at(l)` is the
+  // particle of lane l.
+  auto lengths = [&](auto at, const vdouble& rho_v) {
+    auto of = [&](double SetParams::*field) {
+      return vdouble([&](auto l) { return sets[static_cast<std::size_t>(set[at(l)])].*field; });
+    };
+    const vdouble r = of(&SetParams::rho0) / rho_v;
+    const vdouble scaled =
+        of(&SetParams::h0) * (dim == 3 ? simd::cube_root(r) : (dim == 2 ? stdx::sqrt(r) : r));
+    return stdx::min(stdx::max(scaled, of(&SetParams::h_min)), of(&SetParams::h_max));
   };
   std::size_t i0 = 0;
   for (; i0 + width <= n; i0 += width) {
-    const int s0 = set[i0];
-    bool one_set = true;
-    for (int l = 1; l < width; ++l) one_set = one_set && set[i0 + l] == s0;
-    vdouble rho0, h0;
-    if (one_set) { // the usual case: sets are runs of ascending gid
-      rho0 = sets[static_cast<std::size_t>(s0)].rho0;
-      h0 = sets[static_cast<std::size_t>(s0)].h0;
-    } else {
-      rho0 = vdouble([&](auto l) { return sets[static_cast<std::size_t>(set[i0 + l])].rho0; });
-      h0 = vdouble([&](auto l) { return sets[static_cast<std::size_t>(set[i0 + l])].h0; });
-    }
-    simd::store(lengths(rho0, h0, simd::load(rho + i0)), h + i0);
+    const auto at = [i0](auto l) { return i0 + static_cast<std::size_t>(l); };
+    simd::store(lengths(at, simd::load(rho + i0)), h + i0);
   }
   if (i0 < n) { // the last particles, repeated in the unused lanes
-    auto at = [&](auto l) { return std::min(i0 + static_cast<std::size_t>(l), n - 1); };
-    const vdouble hv =
-        lengths(vdouble([&](auto l) { return sets[static_cast<std::size_t>(set[at(l)])].rho0; }),
-                vdouble([&](auto l) { return sets[static_cast<std::size_t>(set[at(l)])].h0; }),
-                vdouble([&](auto l) { return rho[at(l)]; }));
+    const auto at = [&](auto l) { return std::min(i0 + static_cast<std::size_t>(l), n - 1); };
+    const vdouble hv = lengths(at, vdouble([&](auto l) { return rho[at(l)]; }));
     for (std::size_t l = 0; i0 + l < n; ++l) h[i0 + l] = hv[l];
   }
 }

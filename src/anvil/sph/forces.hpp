@@ -54,6 +54,7 @@ struct SetParams {
   const Material* material = nullptr; // not owned
   double rho0 = 0;                    // reference density, kg/m^3
   double h0 = 0;                      // smoothing length at rho0, m
+  double h_min = 0, h_max = 0;        // bounds of h, m (h_min <= h0 <= h_max)
   double alpha = 1, beta = 2;         // Monaghan-Gingold viscosity coefficients
   double epsilon = 0;                 // artificial stress coefficient (0: off)
   double exponent = 4;                // its exponent n
@@ -203,9 +204,9 @@ void sph_forces(const SphView& v, std::span<const SetParams> sets, KernelType ke
                 SphWorkspace& work, SphResult& result);
 
 // Smoothing lengths at the densities: h[i] = h0 (rho0 / rho[i])^(1/d) (constant mass in
-// the support) of set[i]'s h0 and rho0, for i < n, simd::width particles at a time (the
-// cube root by simd::cube_root: the same operations and bits for every particle). Every
-// set has the same dimensions d.
+// the support) of set[i]'s h0 and rho0, clamped to the set's [h_min, h_max], for i < n,
+// simd::width particles at a time (the cube root by simd::cube_root: the same operations
+// and bits for every particle). Every set has the same dimensions d.
 void smoothing_lengths(std::span<const SetParams> sets, const int* set, const double* rho,
                        std::size_t n, double* h);
 

@@ -58,6 +58,8 @@ SphPhase::SphPhase(const Config& config, const std::function<const Material*(int
     sp.material = m;
     sp.rho0 = m->elastic().density;
     sp.h0 = psets[s].smoothing_ratio * lattices.back().spacing;
+    sp.h_min = psets[s].h_min * sp.h0;
+    sp.h_max = psets[s].h_max * sp.h0;
     sp.alpha = psets[s].viscosity_linear;
     sp.beta = psets[s].viscosity_quadratic;
     sp.epsilon = psets[s].artificial_stress;
