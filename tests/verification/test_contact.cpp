@@ -4,9 +4,10 @@
 // 1. Two deformable blocks collide (an aluminium block at 100 m/s onto a steel block at
 //    50 m/s, meshes not matching, partly overhanging). Momentum is conserved exactly by
 //    the equations (internal forces and every penalty pair sum to zero): tolerance 1e-12
-//    of the initial momentum (round-off). Energy: the balance KE + IE + HG + contact =
-//    E0 + W within 1%, and the contact energy (penalty work, dissipated) is positive.
-//    Penetration: no node deeper than 5% of the element depth behind a face.
+//    of the blocks' momenta |p_a| + |p_b| (round-off on the largest terms summed). Energy: the
+//    balance KE + IE + HG + contact = E0 + W within 1%, and the contact energy (penalty work,
+//    dissipated) is positive. Penetration: no node deeper than 5% of the element depth behind a
+//    face.
 // 2. Self-contact of a folding plate: a 2 mm aluminium strip whose free half is thrown
 //    round a plastic hinge folds over onto its clamped half. Reference: geometry. The
 //    folded half must lie on the base, no flap node below the base's top surface by more
@@ -25,12 +26,15 @@ namespace {
 
 using namespace anvil;
 
-std::array<double, 3> momentum(const Simulation& sim) {
-  std::array<double, 3> p{0, 0, 0};
+// The total momentum and, last, the sum of the nodes' |m v| (for the tolerance).
+std::array<double, 4> momentum(const Simulation& sim) {
+  std::array<double, 4> p{0, 0, 0, 0};
   const auto& nd = sim.nodes();
   for (std::size_t n = 0; n < nd.size(); ++n)
-    if (sim.fe().node_owned[n])
+    if (sim.fe().node_owned[n]) {
       for (int i = 0; i < 3; ++i) p[i] += nd.mass[n] * nd.v[i][n];
+      p[3] += nd.mass[n] * std::hypot(nd.v[0][n], nd.v[1][n], nd.v[2][n]);
+    }
   sim.comm().sum(std::span<double>(p));
   return p;
 }
@@ -59,7 +63,7 @@ contact:
   const auto p0 = momentum(sim);
   while (!sim.finished()) sim.step();
   const auto p1 = momentum(sim);
-  const double scale = std::hypot(p0[0], p0[1], p0[2]) + 0.0157 * 50; // |p| of either block
+  const double scale = p0[3]; // |p_a| + |p_b|: each block moves as a whole at t = 0
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(p1[i], p0[i], 1e-12 * scale) << "component " << i;
   const Sample s = sim.sample();
   EXPECT_LT(sim.balance_error(s), 0.01);
@@ -119,8 +123,9 @@ contact:
   EXPECT_LT(tip_x, 0.01);                       // folded over by more than 150 degrees
   EXPECT_GT(lowest_over_base, 0.002 - 0.1 * t); // resting on the base, not through it
   EXPECT_LT(pen, 0.1 * t);
-  // What the penalty resisted (beyond the allowances) is part of the whole penetration.
-  EXPECT_GE(sim.contact()->stats().max_penetration_resisted, 0.0);
+  // What the penalty resisted (beyond the allowances) is part of the whole penetration,
+  // and some was resisted.
+  EXPECT_GT(sim.contact()->stats().max_penetration_resisted, 0.0);
   EXPECT_LE(sim.contact()->stats().max_penetration_resisted, pen);
   EXPECT_GT(s.contact, 0.0);
   EXPECT_LT(sim.balance_error(s), 0.01);
