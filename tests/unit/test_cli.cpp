@@ -305,6 +305,50 @@ boundary_conditions:
   EXPECT_NE(r.out.find("part c"), std::string::npos) << r.out;
 }
 
+// A 2 x 2 x 2 Johnson-Cook cube whose driven face is pushed 0.2 mm past the fixed one:
+// the plastic (volume-keeping) elements fold so that their exact volumes stay positive
+// while six of the eight turn inside out at their centres. The run went on to exit 0
+// with nodes at 22 times the driven speed (QA round 21); the centre Jacobian's sign now
+// stops it (exit 3, the element named), or erodes the tangled elements with `inverted`.
+TEST(Cli, TangledElementsStopTheRunOrErode) {
+  const std::string deck = R"(termination: {time: 1.2e-05}
+materials:
+  m: {model: johnson_cook, density: 8960, youngs_modulus: 124e9, poissons_ratio: 0.34,
+      A: 90e6, B: 292e6, n: 0.31, C: 0.025, m: 1.09, melt_temperature: 1356, specific_heat: 383}
+parts:
+  b:
+    mesh: {generate: box, min: [0, 0, 0], max: [0.001, 0.001, 0.001], divisions: [2, 2, 2]}
+    material: m
+    hourglass: {model: viscous, coefficient: 0.1}
+EROSION
+boundary_conditions:
+  - {set: b.xmin, fix: [x]}
+  - {set: b.ymin, fix: [y]}
+  - {set: b.zmin, fix: [z]}
+  - {set: b.xmax, velocity: [-100.0, 0, 0], components: [x]}
+)";
+  auto with = [&](const std::string& erosion) {
+    std::string d = deck;
+    d.replace(d.find("EROSION"), 7, erosion);
+    return d;
+  };
+  const auto dir = (std::filesystem::temp_directory_path() / "anvil_cli_tangled").string();
+  std::filesystem::remove_all(dir);
+  auto r = run("run " + write_temp("tangled.yaml", with("")) + " -o " + dir + " -q");
+  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_NE(r.out.find("(part b, element 7 of the part) at time 1.027"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("inverted element (non-positive volume or centre Jacobian)"),
+            std::string::npos)
+      << r.out;
+  r = run("run " + write_temp("tangled.yaml", with("    erosion: {inverted: true}")) + " -o " +
+          dir + " -q");
+  EXPECT_EQ(r.status, 0) << r.out;
+  std::stringstream summary;
+  summary << std::ifstream(dir + "/summary.json").rdbuf();
+  EXPECT_NE(summary.str().find("\"eroded_elements\": 6,"), std::string::npos) << summary.str();
+}
+
 // QA D11: an unknown subcommand or option was reported as "A subcommand is required";
 // --cycles -1 printed the 309 digits of the largest double, and a huge --cycles a line of a
 // deck the user never wrote.

@@ -171,6 +171,32 @@ TEST(Keyword, FreeFormatFieldsAreAllReadOrRefused) {
                {"model.k:30: *ELEMENT_SOLID.card", "12 comma-separated fields", "at most 10"});
 }
 
+// A tangled element (exact volume 0.276, Jacobian at the centre -0.030: QA round 21) is
+// refused at its own card, as an inverted one is.
+TEST(Keyword, TangledElementIsRefusedAtItsCard) {
+  const Comm world = Comm::world();
+  const char* tangled[8][3] = {{"0.3", "0.01", "-0.69"},   {"1.88", "0.56", "1.05"},
+                               {"0.46", "1.95", "1.0"},    {"-1.0", "2.28", "-1.01"},
+                               {"0.63", "-0.09", "0.79"},  {"1.63", "-0.51", "1.86"},
+                               {"1.47", "-0.22", "-0.48"}, {"0.67", "0.66", "0.44"}};
+  std::string text = good;
+  for (int a = 0; a < 8; ++a) { // nodes 1-8, element 1's corners
+    const auto at = text.find(fmt::format("\n{:>8}  ", a + 1)) + 1;
+    const auto end = text.find('\n', at);
+    text.replace(
+        at, end - at,
+        fmt::format("{:>8}{:>16}{:>16}{:>16}", a + 1, tangled[a][0], tangled[a][1], tangled[a][2]));
+  }
+  try {
+    Simulation sim(kw(text), world);
+    ADD_FAILURE() << "no error for a tangled element";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("element 1 of part part1 is tangled"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("*ELEMENT_SOLID"), std::string::npos) << e.what();
+  }
+}
+
 // An inverted element is named by its EID, not by its position in the part, at its own
 // card's line (QA round 5: the part's *PART line was given).
 TEST(Keyword, InvertedElementIsNamedByItsId) {

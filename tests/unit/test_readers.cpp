@@ -755,6 +755,30 @@ parts:
   EXPECT_EQ(one.output.find("ids repeat"), std::string::npos) << one.output;
 }
 
+// A tangled element: its exact volume is positive (0.276) but its Jacobian at the centre,
+// which the one-point element integrates with, is not (-0.030; QA round 21). The setup
+// refuses it as it refuses an inverted one, naming it (`anvil check`, exit 2).
+TEST(ReadersDeck, TangledElementIsRefused) {
+  TempDir dir;
+  write(dir.path / "tangled.msh",
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n8\n"
+        "1 0.3 0.01 -0.69\n2 1.88 0.56 1.05\n3 0.46 1.95 1.0\n4 -1.0 2.28 -1.01\n"
+        "5 0.63 -0.09 0.79\n6 1.63 -0.51 1.86\n7 1.47 -0.22 -0.48\n8 0.67 0.66 0.44\n"
+        "$EndNodes\n$Elements\n1\n7 5 2 0 1 1 2 3 4 5 6 7 8\n$EndElements\n");
+  write(dir.path / "deck.yaml", R"(termination: {cycles: 1}
+materials:
+  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+parts:
+  t: {mesh: {file: tangled.msh}, material: steel}
+)");
+  const CheckRun r = anvil_check(dir.file("deck.yaml"));
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("deck.yaml:5: parts.t.mesh"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("element 7 of part t is tangled: its volume is positive (0.276"),
+            std::string::npos)
+      << r.output;
+}
+
 TEST(ReadersDeck, BadMeshFilesExitWithStatusTwo) {
   TempDir dir;
   const std::string good = slurp(data("box_2x2x2.msh"));

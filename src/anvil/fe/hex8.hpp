@@ -164,6 +164,14 @@ ANVIL_HEX8_INLINE void natural_sums(const V (&w)[8], V (&out)[3]) {
   out[2] = (p45 + p67) - (p01 + p23);
 }
 
+// Determinant of a 3 x 3 matrix (scalars or vectors of them).
+template <class V>
+ANVIL_HEX8_INLINE V determinant(const V (&J)[3][3]) {
+  return J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) -
+         J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0]) +
+         J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
+}
+
 // The element's co-rotational frame: orthonormal axes e[d] (components e[d][i]) from the
 // centre Jacobian's columns (J[i][d] = 8 dx_i/dxi_d, natural_sums of the positions) by
 // Gram-Schmidt in the order xi, eta, zeta, and the element's extents along them,

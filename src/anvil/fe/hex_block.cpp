@@ -339,6 +339,16 @@ int element_cost(const HourglassControl& hourglass, const ThickShell& thick_shel
   return 148;
 }
 
+double HexBlock::centre_jacobian(std::size_t e, const double* const x[3]) const {
+  double J[3][3];
+  for (int i = 0; i < 3; ++i) {
+    double col[8];
+    for (int a = 0; a < 8; ++a) col[a] = x[i][conn[a][e]];
+    hex8::natural_sums(col, J[i]); // 8 dx_i / dxi_d
+  }
+  return hex8::determinant(J) / 512.0;
+}
+
 int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array<int, 8>> corners,
                    const double* const x[3], std::size_t base) {
   const int n = static_cast<int>(ids.size());
@@ -368,7 +378,8 @@ int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array
   mass.assign(p, 0.0);
   int bad = -1;
   for (std::size_t e = 0; e < p; ++e) {
-    if (static_cast<int>(e) < n && !(volume[e] > 0) && bad < 0) bad = static_cast<int>(e);
+    if (static_cast<int>(e) < n && bad < 0 && !(volume[e] > 0 && centre_jacobian(e, x) > 0))
+      bad = static_cast<int>(e);
     mass[e] = rho * volume[e];
   }
   for (auto& s : stress) s.assign(p, 0.0);
@@ -685,7 +696,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         vdouble col[8], out[4];
         _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a) col[a] = xc(a, i, l);
         hex8::gamma_sums(col, out);
-        if constexpr (Asq) hex8::natural_sums(col, J[i]);
+        hex8::natural_sums(col, J[i]); // (all forms: the centre Jacobian's sign, below)
         _Pragma("GCC unroll 12") for (int al = 0; al < 4; ++al) h[al][i] = out[al] * inv;
         _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a) col[a] = vc(a, i, l);
         hex8::gamma_sums(col, vg[i]);
@@ -800,27 +811,87 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       // element's step, at least that, cannot be the smallest. The step is therefore
       // min(cheap, Gershgorin)'s wherever it matters, on any decomposition.
       vdouble dte;
-      if (!stiff && !Asq) {
+      if (!Asq) {
+        // Both forms bound lambda, the largest eigenvalue of sum_al gamma_al gamma_al^T.
+        // Viscous: the damping rate r = kv lambda / (m / 8) joins the rate term (below).
+        // Stiffness: K_h = ks sum_al gamma_al gamma_al^T ("1 ks" in each direction) has
+        // omega_h^2 <= ks lambda / (m / 8), next to the plain omega_p^2 = 4 c^2 / lc^2.
+        // Their sum's largest eigenvalue is at most that of [[p, k sqrt(ph)], [k sqrt(ph),
+        // h]], with k the cosine of the smallest angle between the two operators' ranges
+        // (span B and span gamma, in each direction): max(p, h) where they are orthogonal
+        // (any parallelepiped), p + h where they meet. The gammas span the complement of
+        // {1, x_0, x_1, x_2}, and with S = xc^T xc (centred positions) and G = B^T B,
+        // cos^2 of any B c to span {1, x} is V^2 c^T S^-1 c / c^T G c, whose least value
+        // is V^2 / lambda_max(S G); lambda_max(S G) <= V^2 + e, e the largest absolute
+        // row sum of S G - V^2 I (Gershgorin), so k^2 <= e / (V^2 + e). In the step's
+        // terms, the sound speed becomes
+        // c_e^2 = (c^2 + w) / 2 + sqrt((c^2 - w)^2 / 4 + k^2 c^2 w), w = 2 ks lambda lc^2 / m.
+        // (The plain step alone was up to 1.63 times the stable one at coefficient 1,
+        // 1.13 at 0.3; QA round 19, test_element_step.cpp.)
         const vdouble kr = (0.25 * 8.0) * kv * lc / mass;
+        vdouble kc = 0.0, k2 = 0.0;
+        if (stiff) {
+          kc = (2.0 * lc * lc / mass) * ks;
+          // S from the natural and gamma sums the kernel has formed (the positions'
+          // coordinates in the orthogonal basis 1, xi, eta, zeta, Gamma_al, each of
+          // squared norm 8: S = (J J^T + V^2 h^T h) / 8), G from B.
+          vdouble S[3][3], G[3][3];
+          const vdouble v2 = vol * vol;
+          _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i)
+              _Pragma("GCC unroll 3") for (int j = i; j < 3; ++j) {
+            const vdouble jj = J[i][0] * J[j][0] + J[i][1] * J[j][1] + J[i][2] * J[j][2];
+            const vdouble hh_ij =
+                h[0][i] * h[0][j] + h[1][i] * h[1][j] + h[2][i] * h[2][j] + h[3][i] * h[3][j];
+            S[i][j] = 0.125 * (jj + v2 * hh_ij);
+            if (i == j) {
+              G[i][i] = bbd[i] * (1.0 / 144.0);
+            } else {
+              G[i][j] = Bt(0, i) * Bt(0, j);
+              _Pragma("GCC unroll 8") for (int a = 1; a < 8; ++a) G[i][j] += Bt(a, i) * Bt(a, j);
+              G[i][j] *= 1.0 / 144.0;
+            }
+            S[j][i] = S[i][j];
+            G[j][i] = G[i][j];
+          }
+          vdouble e = 0.0; // Gershgorin: |mu| <= the largest absolute row sum of S G - V^2 I
+          _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) {
+            vdouble row = 0.0;
+            _Pragma("GCC unroll 3") for (int j = 0; j < 3; ++j) {
+              vdouble sg = S[i][0] * G[0][j] + S[i][1] * G[1][j] + S[i][2] * G[2][j];
+              if (i == j) sg -= v2;
+              row += stdx::abs(sg);
+            }
+            e = stdx::max(e, row);
+          }
+          k2 = e / (v2 + e);
+        }
+        auto step = [&](const vdouble& lambda) {
+          if (stiff) {
+            const vdouble w = kc * lambda, cc = c * c, half = 0.5 * (cc - w);
+            const vdouble ce2 = 0.5 * (cc + w) + stdx::sqrt(half * half + k2 * cc * w);
+            return lc / (qv + stdx::sqrt(qv * qv + ce2));
+          }
+          const vdouble qh = qv + kr * lambda;
+          return lc / (qh + stdx::sqrt(qh * qh + c * c));
+        };
         vdouble hhd[3]; // sum of h_al,i^2, by direction
         _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) hhd[i] =
             ((h[0][i] * h[0][i] + h[1][i] * h[1][i]) + h[2][i] * h[2][i]) + h[3][i] * h[3][i];
         const vdouble hh = (hhd[0] + hhd[1]) + hhd[2];
         const vdouble cheap = hex8::hourglass_damping_bound_frobenius(bb, hh);
-        vdouble qh = qv + kr * cheap;
-        dte = lc / (qh + stdx::sqrt(qh * qh + c * c));
+        dte = step(cheap);
         if (stdx::any_of(dte <= best_dt)) {
           vdouble Bc[3][8];
           _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a)
               _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) Bc[i][a] =
                   Bt(a, i) * (1.0 / 12.0);
-          qh = qv + kr * stdx::min(cheap, hex8::hourglass_damping_bound(Bc, h));
-          dte = lc / (qh + stdx::sqrt(qh * qh + c * c));
+          dte = step(stdx::min(cheap, hex8::hourglass_damping_bound(Bc, h)));
         }
       } else {
-        // The stiffness forms take the plain step: their hourglass stiffness raises the
-        // element's largest frequency by under 2% even on warped elements, within the
-        // plain step's margin (test_element_step.cpp, docs/element.md).
+        // The assumed-strain forms take the plain step: their hourglass stiffness, the
+        // physical one of the bending modes, raises the element's largest frequency by
+        // under 2% even on warped elements, within the plain step's margin
+        // (test_element_step.cpp, docs/element.md).
         dte = lc / (qv + stdx::sqrt(qv * qv + c * c));
       }
 
@@ -881,7 +952,14 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       // the scalar path.
       const auto real = lane < static_cast<double>(n - e); // not padding
       const auto live = (!dead) && real;
-      auto report = !(vol > 0.0) || !(stdx::abs(check) <= std::numeric_limits<double>::max());
+      // Inverted: a non-positive volume, or a non-positive Jacobian at the centre. The
+      // volume is the exact integral of det J, which a tangled element keeps positive
+      // where its folded parts' volumes cancel, as a plastic (volume-keeping) element
+      // does (QA round 21: six of eight elements turned inside out at their centres ran
+      // on to exit 0 with nodes at 22 times the driven speed). J holds the natural sums,
+      // 8 times the centre Jacobian's columns.
+      const auto inverted = !(vol > 0.0) || !(hex8::determinant(J) > 0.0);
+      auto report = inverted || !(stdx::abs(check) <= std::numeric_limits<double>::max());
       if (erode_ep) report = report || simd::load(&b.plastic_strain[e]) >= b.erosion.plastic_strain;
       const int lanes = std::min(width, n - e);
       double* rows_of[3]; // where the rows went (corner slots or stage scratch)
@@ -922,7 +1000,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         // An element crushed flat reaches a volume that is positive by round-off, and
         // forces that are not finite, before its volume turns negative: with `inverted`
         // it erodes then too (QA round 7: the run stopped instead).
-        const bool erode = (b.erosion.inverted && (!(vol[k] > 0.0) || !std::isfinite(check[k]))) ||
+        const bool erode = (b.erosion.inverted && (inverted[k] || !std::isfinite(check[k]))) ||
                            (erode_ep && b.plastic_strain[e + k] >= b.erosion.plastic_strain);
         if (erode) { // delete it now: this cycle's forces already leave it out
           b.alive[e + k] = 0.0;
@@ -939,7 +1017,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
           ++result.eroded;
           continue;
         }
-        if (!(vol[k] > 0.0)) {
+        if (inverted[k]) {
           if (result.inverted_gid < 0 || id < result.inverted_gid) result.inverted_gid = id;
         } else if (!std::isfinite(check[k])) {
           if (result.nonfinite_gid < 0 || id < result.nonfinite_gid) result.nonfinite_gid = id;

@@ -105,9 +105,12 @@ struct HexBlock {
   // Sets the elements (ascending global ids and their corners as local node indices)
   // and the corner slot base, sizes and zeroes the state (padded to whole vectors), and
   // sets each element's mass from the material density and its volume at positions x.
-  // Returns the index of the first element with a non-positive volume, or -1.
+  // Returns the index of the first element with a non-positive volume or centre Jacobian
+  // (inverted or tangled), or -1.
   int init(std::span<const std::int64_t> ids, std::span<const std::array<int, 8>> corners,
            const double* const x[3], std::size_t base);
+  // det J at the centre of element e (V / 8 on a parallelepiped) at positions x.
+  double centre_jacobian(std::size_t e, const double* const x[3]) const;
 };
 
 struct NodalView {
@@ -142,7 +145,8 @@ struct CornerView {
 struct HexResult {
   double dt_stable = 1e300;        // smallest element stable time step, s
   std::int64_t stable_gid = -1;    // element that controls it
-  std::int64_t inverted_gid = -1;  // first element (by gid) with non-positive volume, or -1
+  std::int64_t inverted_gid = -1;  // first element (by gid) with non-positive volume or
+                                   // centre Jacobian, or -1
   std::int64_t nonfinite_gid = -1; // first element with a non-finite force or stress, or -1
   std::int64_t eroded = 0;         // elements eroded in this call
 };

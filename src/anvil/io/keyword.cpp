@@ -1546,6 +1546,12 @@ private:
                          fmt::format("element {} of part {} has a non-positive volume ({:.3g} "
                                      "m^3): check the node order",
                                      e.eid, part_name(e.pid), v));
+      else if (!(hex_centre_jacobian(x) > 0))
+        throw InputError(e.at.loc("*ELEMENT_SOLID"),
+                         fmt::format("element {} of part {} is tangled: its volume is positive "
+                                     "({:.3g} m^3) but its Jacobian at the centre is not: "
+                                     "check the node order",
+                                     e.eid, part_name(e.pid), v));
       m.blocks[b->second].elements.push_back(h);
       m.blocks[b->second].ids.push_back(e.eid);
     }

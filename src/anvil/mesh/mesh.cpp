@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "anvil/core/hash.hpp"
+#include "anvil/fe/hex8.hpp"
 
 namespace anvil {
 
@@ -109,6 +110,23 @@ namespace {
 constexpr int corner_xi[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
                                  {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
 
+// det J of the trilinear map at the natural coordinates xi.
+double det_jacobian(const std::array<Vec3, 8>& x, const double (&xi)[3]) {
+  const auto& s = corner_xi;
+  double J[3][3] = {};
+  for (int a = 0; a < 8; ++a) {
+    double dN[3];
+    for (int d = 0; d < 3; ++d) {
+      dN[d] = 0.125 * s[a][d];
+      for (int e = 0; e < 3; ++e)
+        if (e != d) dN[d] *= (1 + s[a][e] * xi[e]);
+    }
+    for (int i = 0; i < 3; ++i)
+      for (int d = 0; d < 3; ++d) J[i][d] += x[a][i] * dN[d];
+  }
+  return hex8::determinant(J);
+}
+
 } // namespace
 
 double hex_volume(const std::array<Vec3, 8>& x) {
@@ -117,24 +135,12 @@ double hex_volume(const std::array<Vec3, 8>& x) {
   const auto& s = corner_xi;
   const double g = 1.0 / std::sqrt(3.0);
   double v = 0;
-  for (int q = 0; q < 8; ++q) {
-    const double xi[3] = {s[q][0] * g, s[q][1] * g, s[q][2] * g};
-    double J[3][3] = {};
-    for (int a = 0; a < 8; ++a) {
-      double dN[3];
-      for (int d = 0; d < 3; ++d) {
-        dN[d] = 0.125 * s[a][d];
-        for (int e = 0; e < 3; ++e)
-          if (e != d) dN[d] *= (1 + s[a][e] * xi[e]);
-      }
-      for (int i = 0; i < 3; ++i)
-        for (int d = 0; d < 3; ++d) J[i][d] += x[a][i] * dN[d];
-    }
-    v += J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) -
-         J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0]) +
-         J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
-  }
+  for (int q = 0; q < 8; ++q) v += det_jacobian(x, {s[q][0] * g, s[q][1] * g, s[q][2] * g});
   return v;
+}
+
+double hex_centre_jacobian(const std::array<Vec3, 8>& x) {
+  return det_jacobian(x, {0, 0, 0});
 }
 
 std::vector<std::int64_t> select_nodes(const Mesh& mesh, const Box3& box,

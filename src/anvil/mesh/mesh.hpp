@@ -86,6 +86,9 @@ std::uint64_t mesh_fingerprint(const Mesh& mesh);
 
 // Signed volume of a hexahedron (exact for the trilinear map).
 double hex_volume(const std::array<Vec3, 8>& x);
+// det J of the trilinear map at the hexahedron's centre (V / 8 on a parallelepiped): the
+// one-point element's volume measure, which a tangled element's volume can hide.
+double hex_centre_jacobian(const std::array<Vec3, 8>& x);
 
 // Sorted, unique ids of the nodes inside `box` (boundary included), optionally only
 // among `candidates` (sorted); an empty candidate list means all nodes.

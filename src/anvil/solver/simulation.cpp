@@ -71,12 +71,18 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     const std::int64_t bad_gid = comm_.min(bad >= 0 ? hb.gid[bad] : none);
     if (bad_gid != none) {
       const double v = comm_.min(bad >= 0 && hb.gid[bad] == bad_gid ? hb.volume[bad] : 1e300);
-      throw InputError(
-          part.mesh.where,
-          fmt::format("element {} of part {} has a non-positive volume ({:.3g} m^3): "
-                      "check the node order",
-                      mesh.blocks[b].id(static_cast<std::size_t>(bad_gid - block_offsets_[b])),
-                      part.name, v));
+      const std::int64_t id =
+          mesh.blocks[b].id(static_cast<std::size_t>(bad_gid - block_offsets_[b]));
+      if (!(v > 0))
+        throw InputError(part.mesh.where,
+                         fmt::format("element {} of part {} has a non-positive volume ({:.3g} "
+                                     "m^3): check the node order",
+                                     id, part.name, v));
+      throw InputError(part.mesh.where,
+                       fmt::format("element {} of part {} is tangled: its volume is positive "
+                                   "({:.3g} m^3) but its Jacobian at the centre is not: check "
+                                   "the node order",
+                                   id, part.name, v));
     }
     for (int e = 0; e < hb.size(); ++e)
       for (int a = 0; a < 8; ++a)
@@ -551,7 +557,7 @@ void Simulation::fe_forces() {
     if (red[4] == 0.0) share_eroded(); // some element eroded somewhere
     if (red[1] != none)
       throw PhysicsError(describe_element(static_cast<std::int64_t>(red[1])), clock_.time,
-                         "inverted element (non-positive volume)");
+                         "inverted element (non-positive volume or centre Jacobian)");
     if (red[2] != none || !std::isfinite(red[0]))
       throw PhysicsError(red[2] != none ? describe_element(static_cast<std::int64_t>(red[2]))
                                         : "the model",
