@@ -8,6 +8,7 @@
 
 #include "anvil/contact/rigid_wall.hpp"
 #include "anvil/core/hash.hpp"
+#include "anvil/core/nearest.hpp"
 #include "anvil/core/simd.hpp"
 #include "anvil/io/checkpoint.hpp"
 #include "anvil/solver/model.hpp"
@@ -428,47 +429,49 @@ void Simulation::apply_boundary_conditions(const Mesh& mesh) {
 
 void Simulation::locate_probes(const Mesh& mesh) {
   (void)mesh;
-  probe_node_.assign(config_.probes.size(), -1);
-  probe_particle_.assign(config_.probes.size(), -1);
-  for (std::size_t p = 0; p < config_.probes.size(); ++p) {
-    const Vec3 at = config_.probes[p].at;
-    double best = std::numeric_limits<double>::infinity();
-    std::int64_t best_gid = std::numeric_limits<std::int64_t>::max();
-    int best_local = -1;
-    for (std::size_t n = 0; n < fe_.node_gid.size(); ++n) {
-      if (!fe_.node_owned[n]) continue;
-      const Vec3 d = Vec3{nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]} - at;
-      const double r2 = dot(d, d);
-      if (r2 < best || (r2 == best && fe_.node_gid[n] < best_gid)) {
-        best = r2;
-        best_gid = fe_.node_gid[n];
-        best_local = static_cast<int>(n);
-      }
+  const std::size_t np = config_.probes.size();
+  probe_node_.assign(np, -1);
+  probe_particle_.assign(np, -1);
+  if (np == 0) return;
+  // Each rank's nearest owned node and nearest particle to every probe (grids of cells),
+  // then two reductions for all the probes: the nearest distances, then the lowest id at
+  // the nearest distance. The nearest particle competes with the nearest node (a node wins
+  // a tie).
+  std::vector<int> owned;
+  for (std::size_t n = 0; n < fe_.node_gid.size(); ++n)
+    if (fe_.node_owned[n]) owned.push_back(static_cast<int>(n));
+  const NearestGrid nodes(nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data(),
+                          fe_.node_gid.data(), owned);
+  std::vector<NearestGrid::Hit> node_hit(np), particle_hit(np);
+  std::vector<double> r2(2 * np);
+  {
+    std::vector<int> all;
+    const auto* pt = sph_ ? &sph_->particles() : nullptr;
+    if (pt)
+      for (std::size_t i = 0; i < pt->size(); ++i) all.push_back(static_cast<int>(i));
+    const NearestGrid particles(pt ? pt->x[0].data() : nullptr, pt ? pt->x[1].data() : nullptr,
+                                pt ? pt->x[2].data() : nullptr, pt ? pt->gid.data() : nullptr, all);
+    for (std::size_t p = 0; p < np; ++p) {
+      node_hit[p] = nodes.nearest(config_.probes[p].at);
+      particle_hit[p] = particles.nearest(config_.probes[p].at);
+      r2[p] = node_hit[p].r2;
+      r2[np + p] = particle_hit[p].r2;
     }
-    // The nearest particle competes with the nearest node (a node wins a tie).
-    double pbest = std::numeric_limits<double>::infinity();
-    std::int64_t pbest_gid = std::numeric_limits<std::int64_t>::max();
-    if (sph_) {
-      const auto& pt = sph_->particles();
-      for (std::size_t i = 0; i < pt.size(); ++i) {
-        const Vec3 d = Vec3{pt.x[0][i], pt.x[1][i], pt.x[2][i]} - at;
-        const double r2 = dot(d, d);
-        if (r2 < pbest || (r2 == pbest && pt.gid[i] < pbest_gid)) {
-          pbest = r2;
-          pbest_gid = pt.gid[i];
-        }
-      }
-    }
-    const double global_best = comm_.min(best);
-    const double global_pbest = comm_.min(pbest);
-    if (global_pbest < global_best) {
-      probe_particle_[p] =
-          comm_.min(pbest == global_pbest ? pbest_gid : std::numeric_limits<std::int64_t>::max());
-      continue;
-    }
-    const std::int64_t winner =
-        comm_.min(best == global_best ? best_gid : std::numeric_limits<std::int64_t>::max());
-    if (best_local >= 0 && best_gid == winner) probe_node_[p] = best_local;
+  }
+  comm_.min(std::span<double>(r2));
+  constexpr std::int64_t none = std::numeric_limits<std::int64_t>::max();
+  std::vector<std::int64_t> winner(np);
+  for (std::size_t p = 0; p < np; ++p) {
+    const bool particle = r2[np + p] < r2[p];
+    const NearestGrid::Hit& h = particle ? particle_hit[p] : node_hit[p];
+    winner[p] = h.index >= 0 && h.r2 == r2[particle ? np + p : p] ? h.id : none;
+  }
+  comm_.min(std::span<std::int64_t>(winner));
+  for (std::size_t p = 0; p < np; ++p) {
+    if (r2[np + p] < r2[p])
+      probe_particle_[p] = winner[p];
+    else if (node_hit[p].index >= 0 && node_hit[p].id == winner[p])
+      probe_node_[p] = node_hit[p].index;
   }
 }
 
