@@ -312,6 +312,9 @@ MaterialConfig parse_material(const std::string& name, const Node& n) {
   if (model == "johnson_cook" && !(m.params["melt_temperature"] > m.params["room_temperature"]))
     throw InputError({m.where.file, m.where.line, m.where.key + ".melt_temperature"},
                      "melt_temperature must exceed room_temperature");
+  if (m.params.count("youngs_modulus"))
+    if (const std::string why = elastic_wave_problem(m.params); !why.empty())
+      throw InputError({m.where.file, m.where.line, m.where.key + ".density"}, why);
   return m;
 }
 

@@ -1662,6 +1662,9 @@ void complete_material(MaterialConfig& m) {
       throw InputError(m.where,
                        fmt::format("{} = {} is outside the range of anvil's {}", name, x, m.model));
   }
+  if (m.params.count("youngs_modulus"))
+    if (const std::string why = elastic_wave_problem(m.params); !why.empty())
+      throw InputError(m.where, why);
 }
 
 Config KeywordReader::config(const std::string& deck_file) {

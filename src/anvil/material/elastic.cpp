@@ -1,6 +1,9 @@
 #include "anvil/material/elastic.hpp"
 
 #include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
 
 namespace anvil {
 
@@ -22,6 +25,16 @@ ElasticConstants ElasticConstants::from(const ParamValues& p) {
   c.bulk = E / (3 * (1 - 2 * nu));
   c.lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
   return c;
+}
+
+std::string elastic_wave_problem(const ParamValues& p) {
+  const ElasticConstants c = ElasticConstants::from(p);
+  const double speed = std::sqrt(c.plane_wave_modulus() / c.density);
+  if (std::isfinite(speed) && speed > 0 && c.density >= std::numeric_limits<double>::min())
+    return {};
+  return fmt::format("density {} and youngs_modulus {} give a wave speed of {} m/s, which the "
+                     "time step cannot use (check their units)",
+                     c.density, c.youngs_modulus, speed);
 }
 
 std::span<const ParamSpec> Elastic::params() {
