@@ -11,8 +11,8 @@
 // - The rounded coordinates change element sizes (about 0.3 mm) by up to 1.7e-8 relative,
 //   and with them the stable time step: after 300 cycles the node positions of the two
 //   runs must agree within 2e-8 of the largest displacement, time and energies within 2e-8
-//   relative. Measured on 2 ranks: 1.07e-9 of the displacement (2.9e-12 m of 2.73 mm),
-//   time 1.1e-9, internal energy 1.2e-9.
+//   relative. Measured on 2 ranks: 1.05e-9 of the displacement (2.7e-12 m of 2.57 mm),
+//   time 1.04e-9, internal energy 9.8e-10 (2026-11-24).
 // - With the keyword file's own mesh in the YAML deck (`mesh: {file: taylor_bar_mesh.k}`)
 //   and the hardening modulus the keyword reader derives, the two runs are the same bits.
 #include <gtest/gtest.h>

@@ -161,7 +161,7 @@ TEST_P(Patch, DrivenBoundaryCarriesInteriorAlongHomogeneousDeformation) {
       lo = std::min(lo, rig.block.stress[k][e]);
       hi = std::max(hi, rig.block.stress[k][e]);
     }
-    EXPECT_LE(hi - lo, 1e-9 * std::max(std::abs(hi), std::abs(lo))) << "component " << k;
+    EXPECT_LE(hi - lo, 1e-10 * std::max(std::abs(hi), std::abs(lo))) << "component " << k;
   }
 }
 

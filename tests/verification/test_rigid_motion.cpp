@@ -172,6 +172,7 @@ initial_conditions:
   const auto& v = sim.nodes().v;
   for (std::size_t n = 0; n < sim.nodes().size(); ++n) {
     EXPECT_NEAR(v[0][n], 120.0, 1e-9);
+    EXPECT_NEAR(v[1][n], -35.0, 1e-9);
     EXPECT_NEAR(v[2][n], 240.0, 1e-9);
   }
 }
