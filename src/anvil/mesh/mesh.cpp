@@ -157,11 +157,19 @@ std::vector<std::int64_t> select_nodes(const Mesh& mesh, const Box3& box,
 }
 
 std::vector<std::int64_t> block_nodes(const Mesh& mesh, std::size_t b) {
+  // A mark per node, read in order: O(corners + nodes), no sort of the corners (QA round
+  // 20: 0.5 s per part-scoped node set at 2 M elements, on every rank).
+  std::vector<unsigned char> used(static_cast<std::size_t>(mesh.num_nodes()), 0);
+  std::size_t count = 0;
+  for (const auto& h : mesh.blocks[b].elements)
+    for (const std::int64_t n : h) {
+      count += used[static_cast<std::size_t>(n)] == 0;
+      used[static_cast<std::size_t>(n)] = 1;
+    }
   std::vector<std::int64_t> ids;
-  ids.reserve(mesh.blocks[b].elements.size() * 8);
-  for (const auto& h : mesh.blocks[b].elements) ids.insert(ids.end(), h.begin(), h.end());
-  std::sort(ids.begin(), ids.end());
-  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  ids.reserve(count);
+  for (std::size_t n = 0; n < used.size(); ++n)
+    if (used[n]) ids.push_back(static_cast<std::int64_t>(n));
   return ids;
 }
 
