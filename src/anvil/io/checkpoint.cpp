@@ -1,11 +1,11 @@
 #include "anvil/io/checkpoint.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <limits>
-#include <sstream>
 #include <string_view>
 
 #include <fmt/format.h>
@@ -28,66 +28,155 @@ constexpr std::size_t magic_version = 7;
 constexpr std::size_t payload_start = sizeof magic + 2 * sizeof(std::uint64_t); // length, sum
 static_assert(Checkpoint::point_values == 8 * ThickShell::max_points);
 
-// Sends this rank's records to rank 0, which keeps them in ascending global id.
-template <int Width>
+// Records travel to rank 0, and files are read, in pieces of at most this many bytes: an
+// MPI message counts its bytes in an int, and a piece bounds the buffers either side.
+constexpr std::size_t piece_bytes = std::size_t{8} << 20;
+
+// Sends `n` values to rank 0 in pieces; recv_pieces receives them (the same pieces).
+template <class T>
+void send_pieces(const Comm& comm, const T* v, std::size_t n, int tag) {
+  constexpr std::size_t piece = piece_bytes / sizeof(T);
+  for (std::size_t i = 0; i < n; i += piece)
+    comm.send_bytes(v + i, std::min(piece, n - i) * sizeof(T), 0, tag);
+}
+template <class T>
+void recv_pieces(const Comm& comm, T* v, std::size_t n, int source, int tag) {
+  constexpr std::size_t piece = piece_bytes / sizeof(T);
+  for (std::size_t i = 0; i < n; i += piece)
+    comm.recv_bytes(v + i, std::min(piece, n - i) * sizeof(T), source, tag);
+}
+
+// One section of the checkpoint, gathered on rank 0 in ascending global id: every rank's
+// records, each with its global id `gid[i]`, one integer `extra[i]` and the Width values
+// that fill(i, out) writes for this rank's record i. Rank 0 gathers the ids and sorts
+// them first, then puts each record's values straight at their place in the section
+// (its own as fill writes them, the others' as they arrive, a piece at a time): it holds
+// the section once, with the ids' order, and no rank builds its values whole.
+template <int Width, class Fill>
 void gather_sorted(const Comm& comm, const std::vector<std::int64_t>& gid,
-                   const std::vector<double>& data, const std::vector<std::int64_t>& extra,
+                   const std::vector<std::int64_t>& extra, const Fill& fill,
                    std::vector<std::int64_t>& out_gid, std::vector<double>& out_data,
                    std::vector<std::int64_t>& out_extra) {
-  const auto counts = comm.allgather(static_cast<std::int64_t>(gid.size()));
+  constexpr std::size_t piece = std::max<std::size_t>(1, piece_bytes / (Width * sizeof(double)));
+  const std::size_t mine = gid.size();
+  const auto counts = comm.allgather(static_cast<std::int64_t>(mine));
   if (comm.rank() != 0) {
-    if (!gid.empty()) {
-      comm.send_bytes(gid.data(), gid.size() * sizeof(std::int64_t), 0, 21);
-      comm.send_bytes(data.data(), data.size() * sizeof(double), 0, 22);
-      comm.send_bytes(extra.data(), extra.size() * sizeof(std::int64_t), 0, 23);
+    send_pieces(comm, gid.data(), mine, 21);
+    send_pieces(comm, extra.data(), mine, 23);
+    std::vector<double> buffer(std::min(piece, mine) * Width);
+    for (std::size_t i0 = 0; i0 < mine; i0 += piece) {
+      const std::size_t n = std::min(piece, mine - i0);
+      for (std::size_t i = 0; i < n; ++i) fill(i0 + i, &buffer[i * Width]);
+      comm.send_bytes(buffer.data(), n * Width * sizeof(double), 0, 22);
     }
     return;
   }
-  std::vector<std::int64_t> all_gid(gid), all_extra(extra);
-  std::vector<double> all_data(data);
+  // Every rank's ids and extras in rank order, then their order by id.
+  std::vector<std::size_t> first(counts.size() + 1, 0); // each rank's first record
+  for (std::size_t r = 0; r < counts.size(); ++r)
+    first[r + 1] = first[r] + static_cast<std::size_t>(counts[r]);
+  const std::size_t total = first.back();
+  std::vector<std::int64_t> all_gid(total), all_extra(total);
+  std::copy(gid.begin(), gid.end(), all_gid.begin());
+  std::copy(extra.begin(), extra.end(), all_extra.begin());
   for (int r = 1; r < comm.size(); ++r) {
-    const auto n = static_cast<std::size_t>(counts[static_cast<std::size_t>(r)]);
-    if (n == 0) continue;
-    const std::size_t g0 = all_gid.size(), d0 = all_data.size();
-    all_gid.resize(g0 + n);
-    all_extra.resize(g0 + n);
-    all_data.resize(d0 + n * Width);
-    comm.recv_bytes(all_gid.data() + g0, n * sizeof(std::int64_t), r, 21);
-    comm.recv_bytes(all_data.data() + d0, n * Width * sizeof(double), r, 22);
-    comm.recv_bytes(all_extra.data() + g0, n * sizeof(std::int64_t), r, 23);
+    const std::size_t at = first[static_cast<std::size_t>(r)];
+    const std::size_t n = first[static_cast<std::size_t>(r) + 1] - at;
+    recv_pieces(comm, all_gid.data() + at, n, r, 21);
+    recv_pieces(comm, all_extra.data() + at, n, r, 23);
   }
-  std::vector<std::size_t> order(all_gid.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::vector<std::size_t> order(total);
+  for (std::size_t i = 0; i < total; ++i) order[i] = i;
   std::sort(order.begin(), order.end(),
             [&](std::size_t a, std::size_t b) { return all_gid[a] < all_gid[b]; });
-  out_gid.resize(order.size());
-  out_extra.resize(order.size());
-  out_data.resize(order.size() * Width);
-  for (std::size_t k = 0; k < order.size(); ++k) {
+  out_gid.resize(total);
+  out_extra.resize(total);
+  for (std::size_t k = 0; k < total; ++k) {
     out_gid[k] = all_gid[order[k]];
     out_extra[k] = all_extra[order[k]];
-    std::memcpy(&out_data[k * Width], &all_data[order[k] * Width], Width * sizeof(double));
+  }
+  all_extra = {};
+  // Where each record goes: all_gid's room, its ids being in out_gid now.
+  std::vector<std::int64_t>& place = all_gid;
+  for (std::size_t k = 0; k < total; ++k) place[order[k]] = static_cast<std::int64_t>(k);
+  order = {};
+  out_data.resize(total * Width);
+  auto at = [&](std::size_t i) { return &out_data[static_cast<std::size_t>(place[i]) * Width]; };
+  for (std::size_t i = 0; i < mine; ++i) fill(i, at(i));
+  std::vector<double> buffer;
+  for (int r = 1; r < comm.size(); ++r) {
+    const std::size_t r0 = first[static_cast<std::size_t>(r)];
+    const std::size_t n = first[static_cast<std::size_t>(r) + 1] - r0;
+    buffer.resize(std::min(piece, n) * Width);
+    for (std::size_t i0 = 0; i0 < n; i0 += piece) {
+      const std::size_t m = std::min(piece, n - i0);
+      comm.recv_bytes(buffer.data(), m * Width * sizeof(double), r, 22);
+      for (std::size_t i = 0; i < m; ++i)
+        std::memcpy(at(r0 + i0 + i), &buffer[i * Width], Width * sizeof(double));
+    }
   }
 }
 
-template <class T>
-void put(std::string& s, const std::vector<T>& v) {
-  const std::uint64_t n = v.size();
-  s.append(reinterpret_cast<const char*>(&n), sizeof n);
-  if (n) s.append(reinterpret_cast<const char*>(v.data()), n * sizeof(T));
-}
+// Reads a checkpoint's payload section by section, straight into the vectors that keep
+// it, and its FNV-1a checksum over the bytes as they come: no copy of the file is held.
+class PayloadReader {
+public:
+  PayloadReader(std::ifstream& in, std::uint64_t size, std::uint64_t sum, const std::string& path)
+      : in_(in), size_(size), sum_(sum), path_(path) {}
 
-template <class T>
-void get(const std::string& s, std::size_t& pos, std::vector<T>& v, const std::string& path) {
-  std::uint64_t n = 0;
-  if (pos + sizeof n > s.size()) throw InputError("checkpoint '" + path + "' is truncated");
-  std::memcpy(&n, s.data() + pos, sizeof n);
-  pos += sizeof n;
-  if (n > (s.size() - pos) / sizeof(T)) throw InputError("checkpoint '" + path + "' is truncated");
-  v.resize(n);
-  if (n) std::memcpy(v.data(), s.data() + pos, n * sizeof(T));
-  pos += n * sizeof(T);
-}
+  // The next section: its number of items, then the items.
+  template <class T>
+  void get(std::vector<T>& v) {
+    std::uint64_t n = 0;
+    if (size_ - pos_ < sizeof n) truncated();
+    read(&n, sizeof n);
+    if (n > (size_ - pos_) / sizeof(T)) truncated();
+    v.resize(n);
+    read(v.data(), n * sizeof(T));
+  }
+
+  // Reads what is left (nothing, in a checkpoint as written) and checks the checksum:
+  // InputError unless it matches. Returns whether bytes were left.
+  bool finish() {
+    const bool left = pos_ < size_;
+    std::vector<char> rest(
+        static_cast<std::size_t>(std::min<std::uint64_t>(size_ - pos_, piece_bytes)));
+    while (pos_ < size_)
+      read(rest.data(),
+           static_cast<std::size_t>(std::min<std::uint64_t>(size_ - pos_, rest.size())));
+    if (hash_.value() != sum_)
+      throw InputError(fmt::format("checkpoint '{}' is corrupt: its checksum does not match its "
+                                   "contents",
+                                   path_));
+    return left;
+  }
+
+private:
+  // A section that runs past the file's end: a damaged file (the checksum says so), else
+  // truncated.
+  [[noreturn]] void truncated() {
+    finish();
+    throw InputError("checkpoint '" + path_ + "' is truncated");
+  }
+
+  void read(void* data, std::size_t bytes) {
+    auto* p = static_cast<char*>(data);
+    for (std::size_t done = 0; done < bytes;) {
+      const std::size_t n = std::min(piece_bytes, bytes - done);
+      in_.read(p + done, static_cast<std::streamsize>(n));
+      if (static_cast<std::size_t>(in_.gcount()) != n)
+        throw InputError("cannot read checkpoint '" + path_ + "'");
+      hash_.bytes(p + done, n); // (while the piece is in the cache)
+      done += n;
+    }
+    pos_ += bytes;
+  }
+
+  std::ifstream& in_;
+  std::uint64_t size_, sum_, pos_ = payload_start;
+  const std::string& path_;
+  Fnv1a hash_;
+};
 
 } // namespace
 
@@ -111,73 +200,100 @@ Checkpoint capture(const Simulation& sim, const OutputState& outputs) {
   c.external_work = diag[0];
   c.contact_energy = diag[1];
 
-  std::vector<std::int64_t> gid, face;
-  std::vector<double> data;
+  // Each section: this rank's records' ids and extras, where their values are, and how
+  // to write a record's values (gather_sorted asks for them a piece at a time).
+  std::vector<std::int64_t> gid, extra;
   const auto& nd = sim.nodes();
   const ContactPhase* cp = sim.contact();
-  for (std::size_t n = 0; n < nd.size(); ++n) {
-    if (!sim.fe().node_owned[n]) continue;
-    gid.push_back(sim.fe().node_gid[n]);
-    for (int i = 0; i < 3; ++i) data.push_back(nd.x[i][n]);
-    for (int i = 0; i < 3; ++i) data.push_back(nd.v[i][n]);
-    data.push_back(cp ? cp->allowance()[n] : 0.0);
-    face.push_back(cp ? cp->last_face()[n] : -1);
+  {
+    std::vector<std::size_t> node; // this rank's owned nodes
+    node.reserve(nd.size());
+    gid.reserve(nd.size());
+    extra.reserve(nd.size());
+    for (std::size_t n = 0; n < nd.size(); ++n) {
+      if (!sim.fe().node_owned[n]) continue;
+      node.push_back(n);
+      gid.push_back(sim.fe().node_gid[n]);
+      extra.push_back(cp ? cp->last_face()[n] : -1);
+    }
+    auto fill = [&](std::size_t i, double* d) {
+      const std::size_t n = node[i];
+      for (int k = 0; k < 3; ++k) d[k] = nd.x[k][n];
+      for (int k = 0; k < 3; ++k) d[3 + k] = nd.v[k][n];
+      d[6] = cp ? cp->allowance()[n] : 0.0;
+    };
+    gather_sorted<Checkpoint::node_values>(comm, gid, extra, fill, c.node_gid, c.node_data,
+                                           c.node_face);
   }
-  gather_sorted<Checkpoint::node_values>(comm, gid, data, face, c.node_gid, c.node_data,
-                                         c.node_face);
-  gid.clear();
-  data.clear();
-  face.clear();
-  for (const auto& b : sim.blocks())
-    for (int e = 0; e < b.size(); ++e) {
-      gid.push_back(b.gid[e]);
-      for (int k = 0; k < 6; ++k) data.push_back(b.stress[k][e]);
-      data.push_back(b.plastic_strain.empty() ? 0.0 : b.plastic_strain[e]);
-      data.push_back(b.temperature.empty() ? 0.0 : b.temperature[e]);
-      data.push_back(b.internal_energy[e]);
-      data.push_back(b.hourglass_energy[e]);
-      for (int k = 0; k < 12; ++k)
-        data.push_back(b.hourglass_force[k].empty() ? 0.0 : b.hourglass_force[k][e]);
-      face.push_back(b.alive[e] == 0.0 ? 1 : 0);
-    }
-  gather_sorted<Checkpoint::element_values>(comm, gid, data, face, c.element_gid, c.element_data,
-                                            c.element_eroded);
-  gid.clear();
-  data.clear();
-  face.clear();
-  for (const auto& b : sim.blocks())
-    for (int e = 0; b.thick_shell.enabled() && e < b.size(); ++e) {
-      gid.push_back(b.gid[e]);
-      for (int p = 0; p < ThickShell::max_points; ++p) {
-        const bool in = p < b.thick_shell.points;
-        for (int k = 0; k < 6; ++k) data.push_back(in ? b.point_stress[p][k][e] : 0.0);
-        data.push_back(in && !b.point_plastic_strain.empty() ? b.point_plastic_strain[p][e] : 0.0);
-        data.push_back(in && !b.point_temperature.empty() ? b.point_temperature[p][e] : 0.0);
+  // This rank's elements (of every block, or of the thick-shell blocks): block, element.
+  std::vector<std::array<int, 2>> element;
+  auto list_elements = [&](bool thick_shells_only) {
+    std::size_t n = 0;
+    for (const auto& b : sim.blocks())
+      if (!thick_shells_only || b.thick_shell.enabled()) n += static_cast<std::size_t>(b.size());
+    gid.clear();
+    extra.clear();
+    element.clear();
+    gid.reserve(n);
+    extra.reserve(n);
+    element.reserve(n);
+    const auto& blocks = sim.blocks();
+    for (std::size_t ib = 0; ib < blocks.size(); ++ib) {
+      const auto& b = blocks[ib];
+      if (thick_shells_only && !b.thick_shell.enabled()) continue;
+      for (int e = 0; e < b.size(); ++e) {
+        gid.push_back(b.gid[e]);
+        extra.push_back(thick_shells_only ? b.thick_shell.points : b.alive[e] == 0.0 ? 1 : 0);
+        element.push_back({static_cast<int>(ib), e});
       }
-      face.push_back(b.thick_shell.points);
     }
-  gather_sorted<Checkpoint::point_values>(comm, gid, data, face, c.point_gid, c.point_data,
+  };
+  list_elements(false);
+  auto fill_element = [&](std::size_t i, double* d) {
+    const auto& b = sim.blocks()[static_cast<std::size_t>(element[i][0])];
+    const int e = element[i][1];
+    for (int k = 0; k < 6; ++k) d[k] = b.stress[k][e];
+    d[6] = b.plastic_strain.empty() ? 0.0 : b.plastic_strain[e];
+    d[7] = b.temperature.empty() ? 0.0 : b.temperature[e];
+    d[8] = b.internal_energy[e];
+    d[9] = b.hourglass_energy[e];
+    for (int k = 0; k < 12; ++k)
+      d[10 + k] = b.hourglass_force[k].empty() ? 0.0 : b.hourglass_force[k][e];
+  };
+  gather_sorted<Checkpoint::element_values>(comm, gid, extra, fill_element, c.element_gid,
+                                            c.element_data, c.element_eroded);
+  list_elements(true);
+  auto fill_points = [&](std::size_t i, double* d) {
+    const auto& b = sim.blocks()[static_cast<std::size_t>(element[i][0])];
+    const int e = element[i][1];
+    for (int p = 0; p < ThickShell::max_points; ++p, d += 8) {
+      const bool in = p < b.thick_shell.points;
+      for (int k = 0; k < 6; ++k) d[k] = in ? b.point_stress[p][k][e] : 0.0;
+      d[6] = in && !b.point_plastic_strain.empty() ? b.point_plastic_strain[p][e] : 0.0;
+      d[7] = in && !b.point_temperature.empty() ? b.point_temperature[p][e] : 0.0;
+    }
+  };
+  gather_sorted<Checkpoint::point_values>(comm, gid, extra, fill_points, c.point_gid, c.point_data,
                                           c.point_count);
+  element = {};
   if (const sph::SphPhase* sph = sim.sph()) {
     c.model_particles = sph->global_count();
-    gid.clear();
-    data.clear();
-    face.clear();
     const sph::Particles& pt = sph->particles();
-    for (std::size_t i = 0; i < pt.size(); ++i) {
-      gid.push_back(pt.gid[i]);
-      for (int k = 0; k < 3; ++k) data.push_back(pt.x[k][i]);
-      for (int k = 0; k < 3; ++k) data.push_back(pt.v[k][i]);
-      data.push_back(pt.rho[i]);
-      data.push_back(pt.h[i]);
-      for (int k = 0; k < 6; ++k) data.push_back(pt.stress[k][i]);
-      data.push_back(pt.energy[i]);
-      data.push_back(pt.plastic_strain[i]);
-      data.push_back(pt.temperature[i]);
-      data.push_back(pt.wave_speed[i]);
-      face.push_back(pt.last_face[i]);
-    }
-    gather_sorted<Checkpoint::particle_values>(comm, gid, data, face, c.particle_gid,
+    gid.assign(pt.gid.begin(), pt.gid.begin() + static_cast<std::ptrdiff_t>(pt.size()));
+    extra.assign(pt.last_face.begin(),
+                 pt.last_face.begin() + static_cast<std::ptrdiff_t>(pt.size()));
+    auto fill = [&](std::size_t i, double* d) {
+      for (int k = 0; k < 3; ++k) d[k] = pt.x[k][i];
+      for (int k = 0; k < 3; ++k) d[3 + k] = pt.v[k][i];
+      d[6] = pt.rho[i];
+      d[7] = pt.h[i];
+      for (int k = 0; k < 6; ++k) d[8 + k] = pt.stress[k][i];
+      d[14] = pt.energy[i];
+      d[15] = pt.plastic_strain[i];
+      d[16] = pt.temperature[i];
+      d[17] = pt.wave_speed[i];
+    };
+    gather_sorted<Checkpoint::particle_values>(comm, gid, extra, fill, c.particle_gid,
                                                c.particle_data, c.particle_face);
   }
   return c;
@@ -215,28 +331,47 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
                            c.contact_energy,
                            c.outputs.next_fields,
                            c.outputs.next_history};
-  std::string s(payload_start, '\0');
-  std::memcpy(s.data(), magic, sizeof magic);
   const std::string header = json_text(h);
-  put(s, std::vector<char>(header.begin(), header.end()));
-  put(s, std::vector<double>(exact, exact + 8));
-  put(s, std::vector<double>{c.outputs.next_checkpoint});
-  put(s, c.node_gid);
-  put(s, c.node_data);
-  put(s, c.node_face);
-  put(s, c.element_gid);
-  put(s, c.element_data);
-  put(s, c.particle_gid);
-  put(s, c.particle_data);
-  put(s, c.particle_face);
-  put(s, c.element_eroded);
-  put(s, c.point_gid);
-  put(s, c.point_data);
-  put(s, c.point_count);
-  const std::string_view payload = std::string_view(s).substr(payload_start);
-  const std::uint64_t trailer[2] = {payload.size(), Fnv1a().bytes(payload).value()};
-  std::memcpy(s.data() + sizeof magic, trailer, sizeof trailer);
-  write_file_atomic(path, s);
+  // The file is the magic, the payload's length and checksum, then the payload: sections,
+  // each its number of items and the items. It is written from where the sections lie,
+  // piece by piece, with no copy of it in memory.
+  constexpr std::size_t sections = 15;
+  std::array<std::uint64_t, sections> items{};
+  std::uint64_t trailer[2] = {}; // the payload's length and checksum
+  std::vector<std::string_view> pieces;
+  pieces.reserve(2 + 2 * sections);
+  pieces.emplace_back(magic, sizeof magic);
+  pieces.emplace_back(reinterpret_cast<const char*>(trailer), sizeof trailer);
+  std::size_t section = 0;
+  auto put = [&]<class T>(const T* v, std::size_t n) {
+    items[section] = n;
+    pieces.emplace_back(reinterpret_cast<const char*>(&items[section]), sizeof(std::uint64_t));
+    ++section;
+    if (n) pieces.emplace_back(reinterpret_cast<const char*>(v), n * sizeof(T));
+  };
+  auto put_vector = [&](const auto& v) { put(v.data(), v.size()); };
+  put(header.data(), header.size());
+  put(exact, 8);
+  put(&c.outputs.next_checkpoint, 1);
+  put_vector(c.node_gid);
+  put_vector(c.node_data);
+  put_vector(c.node_face);
+  put_vector(c.element_gid);
+  put_vector(c.element_data);
+  put_vector(c.particle_gid);
+  put_vector(c.particle_data);
+  put_vector(c.particle_face);
+  put_vector(c.element_eroded);
+  put_vector(c.point_gid);
+  put_vector(c.point_data);
+  put_vector(c.point_count);
+  Fnv1a sum;
+  for (std::size_t k = 2; k < pieces.size(); ++k) {
+    trailer[0] += pieces[k].size();
+    sum.bytes(pieces[k]);
+  }
+  trailer[1] = sum.value();
+  write_file_atomic(path, pieces);
 }
 
 namespace {
@@ -265,12 +400,12 @@ void check_finite(const std::vector<double>& data, int width, const char* what,
 Checkpoint read_checkpoint(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError("cannot open checkpoint '" + path + "'");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string s = ss.str();
-  if (s.size() < sizeof magic || std::memcmp(s.data(), magic, magic_version) != 0)
+  char start[payload_start] = {};
+  in.read(start, sizeof start);
+  const auto got = static_cast<std::size_t>(in.gcount());
+  if (got < sizeof magic || std::memcmp(start, magic, magic_version) != 0)
     throw InputError("'" + path + "' is not an anvil checkpoint");
-  const char version = s[magic_version];
+  const char version = start[magic_version];
   if (version >= '1' && version < magic[magic_version])
     throw InputError(fmt::format("checkpoint '{}' was written by an older anvil (format version "
                                  "{}); this anvil reads version {} only: run the deck again to "
@@ -280,40 +415,43 @@ Checkpoint read_checkpoint(const std::string& path) {
     throw InputError(
         fmt::format("checkpoint '{}' has format version {}; this anvil reads version {}", path,
                     version, magic[magic_version]));
-  if (s.size() < payload_start) throw InputError("checkpoint '" + path + "' is truncated");
+  if (got < payload_start) throw InputError("checkpoint '" + path + "' is truncated");
+  in.seekg(0, std::ios::end);
+  const std::streamoff end = in.tellg();
+  in.seekg(static_cast<std::streamoff>(payload_start));
+  if (end < static_cast<std::streamoff>(payload_start) || !in)
+    throw InputError("cannot read checkpoint '" + path + "'");
+  const auto size = static_cast<std::uint64_t>(end);
   std::uint64_t trailer[2] = {};
-  std::memcpy(trailer, s.data() + sizeof magic, sizeof trailer);
-  const std::string_view payload = std::string_view(s).substr(payload_start);
-  if (payload.size() < trailer[0])
-    throw InputError(fmt::format("checkpoint '{}' is truncated: {} of its {} bytes", path, s.size(),
+  std::memcpy(trailer, start + sizeof magic, sizeof trailer);
+  const std::uint64_t payload = size - payload_start;
+  if (payload < trailer[0])
+    throw InputError(fmt::format("checkpoint '{}' is truncated: {} of its {} bytes", path, size,
                                  trailer[0] + payload_start));
-  if (payload.size() > trailer[0])
+  if (payload > trailer[0])
     throw InputError(fmt::format("checkpoint '{}' is corrupt: {} bytes follow its end", path,
-                                 payload.size() - trailer[0]));
-  if (Fnv1a().bytes(payload).value() != trailer[1])
-    throw InputError(fmt::format("checkpoint '{}' is corrupt: its checksum does not match its "
-                                 "contents",
-                                 path));
-  std::size_t pos = payload_start;
+                                 payload - trailer[0]));
   Checkpoint c;
   c.file = path;
   std::vector<char> header;
   std::vector<double> exact, next_checkpoint;
-  get(s, pos, header, path);
-  get(s, pos, exact, path);
-  get(s, pos, next_checkpoint, path);
-  get(s, pos, c.node_gid, path);
-  get(s, pos, c.node_data, path);
-  get(s, pos, c.node_face, path);
-  get(s, pos, c.element_gid, path);
-  get(s, pos, c.element_data, path);
-  get(s, pos, c.particle_gid, path);
-  get(s, pos, c.particle_data, path);
-  get(s, pos, c.particle_face, path);
-  get(s, pos, c.element_eroded, path);
-  get(s, pos, c.point_gid, path);
-  get(s, pos, c.point_data, path);
-  get(s, pos, c.point_count, path);
+  PayloadReader r(in, size, trailer[1], path);
+  r.get(header);
+  r.get(exact);
+  r.get(next_checkpoint);
+  r.get(c.node_gid);
+  r.get(c.node_data);
+  r.get(c.node_face);
+  r.get(c.element_gid);
+  r.get(c.element_data);
+  r.get(c.particle_gid);
+  r.get(c.particle_data);
+  r.get(c.particle_face);
+  r.get(c.element_eroded);
+  r.get(c.point_gid);
+  r.get(c.point_data);
+  r.get(c.point_count);
+  const bool bytes_left = r.finish(); // (the checksum: before anything is believed)
   try {
     const auto h = nlohmann::json::parse(std::string(header.begin(), header.end()));
     c.deck = h.at("deck").get<std::string>();
@@ -334,7 +472,7 @@ Checkpoint read_checkpoint(const std::string& path) {
   } catch (const std::exception& e) {
     throw InputError("checkpoint '" + path + "' has a damaged header: " + e.what());
   }
-  if (pos != s.size() || exact.size() != 8 || next_checkpoint.size() != 1 ||
+  if (bytes_left || exact.size() != 8 || next_checkpoint.size() != 1 ||
       c.node_data.size() != c.node_gid.size() * Checkpoint::node_values ||
       c.node_face.size() != c.node_gid.size() ||
       c.element_data.size() != c.element_gid.size() * Checkpoint::element_values ||

@@ -16,26 +16,30 @@
 
 namespace anvil {
 
-void write_file_atomic(const std::string& path, std::string_view content) {
+void write_file_atomic(const std::string& path, std::span<const std::string_view> pieces) {
   const std::string tmp = path + ".tmp";
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw InputError("cannot write '" + tmp + "'");
-  std::size_t done = 0;
-  while (done < content.size()) {
-    const auto n = ::write(fd, content.data() + done, content.size() - done);
-    if (n <= 0) {
-      ::close(fd);
-      std::remove(tmp.c_str()); // (a partial file is no use; the previous one stays)
-      throw InputError("cannot write '" + tmp + "' (disk full?)");
+  for (const std::string_view piece : pieces)
+    for (std::size_t done = 0; done < piece.size();) {
+      const auto n = ::write(fd, piece.data() + done, piece.size() - done);
+      if (n <= 0) {
+        ::close(fd);
+        std::remove(tmp.c_str()); // (a partial file is no use; the previous one stays)
+        throw InputError("cannot write '" + tmp + "' (disk full?)");
+      }
+      done += static_cast<std::size_t>(n);
     }
-    done += static_cast<std::size_t>(n);
-  }
   ::fsync(fd);
   ::close(fd);
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     std::remove(tmp.c_str());
     throw InputError("cannot rename '" + tmp + "' to '" + path + "'");
   }
+}
+
+void write_file_atomic(const std::string& path, std::string_view content) {
+  write_file_atomic(path, std::span<const std::string_view>(&content, 1));
 }
 
 std::string json_text(const nlohmann::json& j, int indent) {

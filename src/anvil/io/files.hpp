@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -12,6 +13,9 @@ namespace anvil {
 // Writes `content` to `path` through a temporary file in the same directory, flushed to
 // disk and renamed over the target, so readers see the old file or the new one.
 void write_file_atomic(const std::string& path, std::string_view content);
+// The same for a file made of `pieces` in order, written from where they lie (a large
+// file need not be copied into one string first).
+void write_file_atomic(const std::string& path, std::span<const std::string_view> pieces);
 
 // `j` as JSON text (`indent` < 0: one line), with any bytes that are not UTF-8 (a deck or
 // file name in Latin-1) replaced by U+FFFD rather than thrown at, after a completed run.
