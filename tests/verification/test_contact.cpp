@@ -70,12 +70,19 @@ contact:
   EXPECT_GT(s.contact, 0.0);
   EXPECT_GT(s.internal, 0.1 * sim.initial_energy()); // the blocks really collided
   const double depth = 0.002; // smallest element depth normal to the contact faces
-  EXPECT_LT(sim.contact()->stats().max_penetration, 0.05 * depth);
+  // The largest penetration is what the penalty resisted (78.4 um) plus the depth a node
+  // had reached when its pair was first found, its allowance: 0 to v dt (16.5 um here),
+  // by where the impact falls within a step (it moved from 2.9 to 15.1 um when the step
+  // grew 6%, commit c8f6ba3). Both are held to the limit.
+  const auto& cs = sim.contact()->stats();
+  EXPECT_LT(cs.max_penetration, 0.05 * depth);
+  EXPECT_GT(cs.max_penetration_resisted, 0.0);
+  EXPECT_LE(cs.max_penetration_resisted, cs.max_penetration);
   if (world.rank() == 0)
     std::printf("two blocks: momentum change %.2e, balance error %.2e, contact energy %.4g J, max "
-                "penetration %.3g m\n",
+                "penetration %.3g m (resisted %.3g m)\n",
                 std::hypot(p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]) / scale,
-                sim.balance_error(s), s.contact, sim.contact()->stats().max_penetration);
+                sim.balance_error(s), s.contact, cs.max_penetration, cs.max_penetration_resisted);
 }
 
 TEST(Contact, FoldingPlateContactsItself) {
