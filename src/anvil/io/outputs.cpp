@@ -18,6 +18,9 @@
 
 namespace anvil {
 
+// Both pieces reserve every array (each would otherwise hold up to twice its size while it
+// grows) and move the arrays into the piece (a braced list copies them): the piece is the
+// one copy of the fields an output holds (QA round 20).
 VtuPiece fe_piece(const Simulation& sim) {
   VtuPiece p;
   const auto& nd = sim.nodes();
@@ -36,12 +39,29 @@ VtuPiece fe_piece(const Simulation& sim) {
     }
     nid.i64[n] = sim.node_file_id(n);
   }
-  p.point_data = {std::move(disp), std::move(vel), std::move(nid)};
+  p.point_data.reserve(3);
+  p.point_data.push_back(std::move(disp));
+  p.point_data.push_back(std::move(vel));
+  p.point_data.push_back(std::move(nid));
 
+  std::size_t nc = 0;
+  bool any_temp = false;
+  for (const HexBlock& b : sim.blocks()) {
+    nc += static_cast<std::size_t>(b.size());
+    any_temp = any_temp || (b.size() > 0 && !b.temperature.empty());
+  }
+  // Every rank must list the same arrays: temperature appears when any part has it.
+  const bool temp_anywhere = sim.comm().max(static_cast<std::int64_t>(any_temp)) > 0;
   VtuArray stress{"stress", 6}, vm{"von_mises", 1}, pres{"pressure", 1}, ep{"plastic_strain", 1},
       temp{"temperature", 1}, rank{"fe_rank", 1}, eid{"element_id", 1}, part{"part", 1};
   rank.is_int = eid.is_int = part.is_int = true;
-  bool any_temp = false;
+  p.connectivity.reserve(8 * nc);
+  p.offsets.reserve(nc);
+  p.types.reserve(nc);
+  stress.f64.reserve(6 * nc);
+  for (auto* v : {&vm.f64, &pres.f64, &ep.f64}) v->reserve(nc);
+  if (temp_anywhere) temp.f64.reserve(nc);
+  for (auto* v : {&rank.i64, &eid.i64, &part.i64}) v->reserve(nc);
   for (std::size_t bi = 0; bi < sim.blocks().size(); ++bi) {
     const HexBlock& b = sim.blocks()[bi];
     for (int e = 0; e < b.size(); ++e) {
@@ -60,30 +80,31 @@ VtuPiece fe_piece(const Simulation& sim) {
       vm.f64.push_back(std::sqrt(3 * j2));
       pres.f64.push_back(-m);
       ep.f64.push_back(b.plastic_strain.empty() ? 0.0 : b.plastic_strain[e]);
-      temp.f64.push_back(b.temperature.empty() ? 0.0 : b.temperature[e]);
-      any_temp = any_temp || !b.temperature.empty();
+      if (temp_anywhere) temp.f64.push_back(b.temperature.empty() ? 0.0 : b.temperature[e]);
       rank.i64.push_back(sim.comm().rank());
       eid.i64.push_back(sim.element_file_id(bi, static_cast<std::size_t>(e)));
       part.i64.push_back(b.part);
     }
   }
-  // Contact decomposition: the RCB rank of the element's (first) exterior face, -1 for
-  // elements without one.
-  VtuArray contact_rank{"contact_rank", 1, true};
-  if (sim.contact())
-    for (const auto& per_block : sim.contact()->element_contact_rank(sim.blocks()))
-      for (int r : per_block) contact_rank.i64.push_back(r);
-  // Every rank must list the same arrays: temperature appears when any part has it.
-  const bool temp_anywhere = sim.comm().max(static_cast<std::int64_t>(any_temp)) > 0;
-  p.cell_data = {std::move(stress), std::move(vm), std::move(pres), std::move(ep)};
+  p.cell_data.reserve(10);
+  for (auto* a : {&stress, &vm, &pres, &ep}) p.cell_data.push_back(std::move(*a));
   if (temp_anywhere) p.cell_data.push_back(std::move(temp));
   p.cell_data.push_back(std::move(rank));
-  if (sim.contact()) p.cell_data.push_back(std::move(contact_rank));
+  // Contact decomposition: the RCB rank of the element's (first) exterior face, -1 for
+  // elements without one.
+  if (sim.contact()) {
+    VtuArray contact_rank{"contact_rank", 1, true};
+    contact_rank.i64.reserve(nc);
+    for (const auto& per_block : sim.contact()->element_contact_rank(sim.blocks()))
+      for (int r : per_block) contact_rank.i64.push_back(r);
+    p.cell_data.push_back(std::move(contact_rank));
+  }
   // Eroded elements (1), when any part erodes: threshold them away in ParaView.
   const auto& parts = sim.config().parts;
   if (std::any_of(parts.begin(), parts.end(),
                   [](const PartConfig& q) { return q.erosion.enabled(); })) {
     VtuArray er{"eroded", 1, true};
+    er.i64.reserve(nc);
     for (const auto& b : sim.blocks())
       for (int e = 0; e < b.size(); ++e) er.i64.push_back(b.alive[e] == 0.0 ? 1 : 0);
     p.cell_data.push_back(std::move(er));
@@ -97,12 +118,23 @@ VtuPiece particle_piece(const Simulation& sim) {
   VtuPiece p;
   const auto& pt = sim.sph()->particles();
   const std::size_t n = pt.size();
+  // Every rank must list the same arrays: temperature where some particle has a thermal
+  // model (QA round 18: Johnson-Cook heating of particles was not in the outputs); a
+  // thermal model starts its particles at room temperature.
+  bool any_temp = false;
+  for (std::size_t i = 0; i < n && !any_temp; ++i) any_temp = pt.temperature[i] > 0;
+  const bool temp_anywhere = sim.comm().max(static_cast<std::int64_t>(any_temp)) > 0;
   p.points.resize(3 * n);
   VtuArray disp{"displacement", 3}, vel{"velocity", 3}, rho{"density", 1}, pres{"pressure", 1},
       stress{"stress", 6}, vm{"von_mises", 1}, ep{"plastic_strain", 1}, energy{"energy", 1},
       h{"smoothing_length", 1}, rank{"sph_rank", 1, true}, pid{"particle_id", 1, true},
       set{"particle_set", 1, true}, temp{"temperature", 1};
-  bool any_temp = false; // (a thermal model starts its particles at room temperature)
+  for (auto* v : {&disp.f64, &vel.f64}) v->reserve(3 * n);
+  stress.f64.reserve(6 * n);
+  for (auto* v : {&rho.f64, &pres.f64, &vm.f64, &ep.f64, &energy.f64, &h.f64}) v->reserve(n);
+  if (temp_anywhere) temp.f64.reserve(n);
+  for (auto* v : {&rank.i64, &pid.i64, &set.i64, &p.connectivity, &p.offsets}) v->reserve(n);
+  p.types.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
     for (int k = 0; k < 3; ++k) {
       p.points[3 * i + k] = pt.x[k][i];
@@ -122,8 +154,7 @@ VtuPiece particle_piece(const Simulation& sim) {
     pres.f64.push_back(-m);
     vm.f64.push_back(std::sqrt(3 * j2));
     ep.f64.push_back(pt.plastic_strain[i]);
-    temp.f64.push_back(pt.temperature[i]);
-    any_temp = any_temp || pt.temperature[i] > 0;
+    if (temp_anywhere) temp.f64.push_back(pt.temperature[i]);
     energy.f64.push_back(pt.energy[i]);
     h.f64.push_back(pt.h[i]);
     rank.i64.push_back(sim.comm().rank());
@@ -134,13 +165,11 @@ VtuPiece particle_piece(const Simulation& sim) {
     p.offsets.push_back(static_cast<std::int64_t>(i + 1));
     p.types.push_back(1);
   }
-  p.point_data = {std::move(disp),   std::move(vel),  std::move(rho), std::move(pres),
-                  std::move(stress), std::move(vm),   std::move(ep),  std::move(energy),
-                  std::move(h),      std::move(rank), std::move(pid), std::move(set)};
-  // Every rank must list the same arrays: temperature where some particle has a thermal
-  // model (QA round 18: Johnson-Cook heating of particles was not in the outputs).
-  if (sim.comm().max(static_cast<std::int64_t>(any_temp)) > 0)
-    p.point_data.insert(p.point_data.begin() + 7, std::move(temp));
+  p.point_data.reserve(13);
+  for (auto* a : {&disp, &vel, &rho, &pres, &stress, &vm, &ep})
+    p.point_data.push_back(std::move(*a));
+  if (temp_anywhere) p.point_data.push_back(std::move(temp));
+  for (auto* a : {&energy, &h, &rank, &pid, &set}) p.point_data.push_back(std::move(*a));
   return p;
 }
 
