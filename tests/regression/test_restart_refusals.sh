@@ -7,7 +7,8 @@
 #    the ranks holding that part only: this hung on 2 ranks);
 #  - of a deck without the thick shell, or whose termination comes before the checkpoint;
 #  - of another mesh with the same numbers of nodes and elements;
-# and a checkpoint that cannot be written stops the run with exit 2 and a failed summary.
+# and a checkpoint or a field piece that cannot be written stops the run with exit 2 and
+# a failed summary.
 set -euo pipefail
 anvil=$1
 work=$(mktemp -d)
@@ -90,6 +91,22 @@ if [ "$status" -ne 2 ] || ! grep -q "checkpoint.anvil" err.txt; then
 fi
 grep -q '"status": "failed"' blocked/summary.json
 grep -q 'checkpoint.anvil' blocked/summary.json
+
+# A field piece that one rank cannot write (its temporary's path taken by a directory)
+# stops every rank with exit 2 naming it (alone, that rank left the other waiting: QA
+# round 20), the summary says so, and results.pvd lists the complete outputs only.
+mkdir -p piece/fields/step_000001_r0001.vtu.tmp/keep
+set +e
+run 2 "$anvil" run deck.yaml -o piece -q 2> err.txt
+status=$?
+set -e
+if [ "$status" -ne 2 ] || ! grep -q "step_000001_r0001.vtu.tmp" err.txt; then
+  echo "unwritable field piece: exit $status (expected 2 naming the file):"; cat err.txt; exit 1
+fi
+grep -q '"status": "failed"' piece/summary.json
+grep -q 'step_000001_r0001.vtu.tmp' piece/summary.json
+grep -q 'step_000000.pvtu' piece/results.pvd
+if grep -q 'step_000001' piece/results.pvd; then echo "results.pvd names the failed output"; exit 1; fi
 
 # The checkpoint itself still continues the run.
 run 2 "$anvil" run deck.yaml -o first -q --restart first/checkpoint.anvil

@@ -3,7 +3,9 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -19,22 +21,32 @@ namespace anvil {
 void write_file_atomic(const std::string& path, std::span<const std::string_view> pieces) {
   const std::string tmp = path + ".tmp";
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw InputError("cannot write '" + tmp + "'");
+  if (fd < 0) throw InputError(fmt::format("cannot write '{}': {}", tmp, std::strerror(errno)));
+  // A failure at any point leaves no temporary (a partial file is no use; the previous
+  // file stays). fsync's and close's errors count too: a write the disk refuses late is
+  // reported there (QA round 20), not taken for a complete file.
+  auto fail = [&](const char* what, int err) {
+    ::close(fd);
+    std::remove(tmp.c_str());
+    throw InputError(fmt::format("cannot {} '{}': {}", what, tmp, std::strerror(err)));
+  };
   for (const std::string_view piece : pieces)
     for (std::size_t done = 0; done < piece.size();) {
       const auto n = ::write(fd, piece.data() + done, piece.size() - done);
-      if (n <= 0) {
-        ::close(fd);
-        std::remove(tmp.c_str()); // (a partial file is no use; the previous one stays)
-        throw InputError("cannot write '" + tmp + "' (disk full?)");
-      }
+      if (n < 0 && errno == EINTR) continue; // (a signal, caught for a checkpoint)
+      if (n <= 0) fail("write", n < 0 ? errno : ENOSPC);
       done += static_cast<std::size_t>(n);
     }
-  ::fsync(fd);
-  ::close(fd);
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+  if (::fsync(fd) != 0) fail("write", errno);
+  if (::close(fd) != 0) {
+    const int err = errno;
     std::remove(tmp.c_str());
-    throw InputError("cannot rename '" + tmp + "' to '" + path + "'");
+    throw InputError(fmt::format("cannot write '{}': {}", tmp, std::strerror(err)));
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    std::remove(tmp.c_str());
+    throw InputError(fmt::format("cannot rename '{}' to '{}': {}", tmp, path, std::strerror(err)));
   }
 }
 

@@ -237,6 +237,7 @@ void Outputs::begin() {
   // state the deck gave stands in if no step completes (collective).
   initial_ = sim_.sample();
   initial_row_due_ = true;
+  ScopedPhase t(output_timer_, Phase::output); // (the t = 0 fields: QA round 20)
   if (c.output_format != OutputFormat::vtu) open_exodus("results");
   write_fields();
   next_fields_ = c.fields_every > 0 ? c.fields_every : std::numeric_limits<double>::infinity();
@@ -271,6 +272,7 @@ void Outputs::resume(const OutputState& state, const std::string& from) {
   // cannot be extended: the continuation goes to results-sCYCLE.exo[.P.R], starting with
   // the checkpoint's state (the earlier files stay as they were).
   if (sim_.config().output_format != OutputFormat::vtu) {
+    ScopedPhase t(output_timer_, Phase::output);
     open_exodus(fmt::format("results-s{:06d}", sim_.clock().cycle));
     VtuPiece piece = fe_piece(sim_);
     if (exodus_)
@@ -442,17 +444,22 @@ void Outputs::write_fields() {
   // Particles have no place in the Exodus files: they are always written as VTU.
   if (sim_.sph()) write_particles(stem);
   if (sim_.config().output_format == OutputFormat::exodus) return;
-  write_vtu(fmt::format("{}/fields/{}_r{:04d}.vtu", opt_.directory, stem, sim_.comm().rank()),
-            piece);
-  sim_.comm().barrier(); // every piece is complete before the index names it
-  if (sim_.comm().rank() == 0) {
+  // Every piece is complete before the index names it; a rank that cannot write its piece
+  // stops every rank with its message (alone, it left the others waiting in the next
+  // collective).
+  collective_write(sim_.comm(), [&] {
+    write_vtu(fmt::format("{}/fields/{}_r{:04d}.vtu", opt_.directory, stem, sim_.comm().rank()),
+              piece);
+  });
+  collective_write(sim_.comm(), [&] {
+    if (sim_.comm().rank() != 0) return;
     std::vector<std::string> pieces;
     for (int r = 0; r < sim_.comm().size(); ++r)
       pieces.push_back(fmt::format("{}_r{:04d}.vtu", stem, r));
     write_pvtu(fmt::format("{}/fields/{}.pvtu", opt_.directory, stem), pieces, piece);
     pvd_.emplace_back(clk.time, fmt::format("fields/{}.pvtu", stem));
     write_pvd(opt_.directory + "/results.pvd", pvd_);
-  }
+  });
 }
 
 // The particles of the same output as their own series (particles.pvd): one .vtu piece
@@ -461,18 +468,20 @@ void Outputs::write_particles(const std::string& stem) {
   const Clock& clk = sim_.clock();
   VtuPiece piece = particle_piece(sim_);
   piece.time = clk.time;
-  write_vtu(
-      fmt::format("{}/fields/particles_{}_r{:04d}.vtu", opt_.directory, stem, sim_.comm().rank()),
-      piece);
-  sim_.comm().barrier();
-  if (sim_.comm().rank() == 0) {
+  collective_write(sim_.comm(), [&] {
+    write_vtu(
+        fmt::format("{}/fields/particles_{}_r{:04d}.vtu", opt_.directory, stem, sim_.comm().rank()),
+        piece);
+  });
+  collective_write(sim_.comm(), [&] {
+    if (sim_.comm().rank() != 0) return;
     std::vector<std::string> pieces;
     for (int r = 0; r < sim_.comm().size(); ++r)
       pieces.push_back(fmt::format("particles_{}_r{:04d}.vtu", stem, r));
     write_pvtu(fmt::format("{}/fields/particles_{}.pvtu", opt_.directory, stem), pieces, piece);
     particle_pvd_.emplace_back(clk.time, fmt::format("fields/particles_{}.pvtu", stem));
     write_pvd(opt_.directory + "/particles.pvd", particle_pvd_);
-  }
+  });
 }
 
 double Outputs::fraction_done() const {

@@ -67,6 +67,9 @@ public:
   // `message` the failure (empty on success).
   void finish(int status, const std::string& message);
 
+  // The `output` phase's timer: the run loop counts its checkpoints there.
+  PhaseTimers& output_timer() { return output_timer_; }
+
   double loop_seconds() const;
   double fraction_done() const; // of the run to its end time or cycle count
 

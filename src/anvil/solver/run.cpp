@@ -71,6 +71,7 @@ int run(const Config& config, const RunOptions& options, const Comm& comm) {
     out.begin();
   }
   auto checkpoint = [&] {
+    ScopedPhase t(out.output_timer(), Phase::output); // (summary.json: `output`)
     OutputState st = out.state();
     st.next_checkpoint = next_checkpoint;
     const Checkpoint c = capture(sim, st);
@@ -85,15 +86,7 @@ int run(const Config& config, const RunOptions& options, const Comm& comm) {
       }
     }
     comm.broadcast(error, 0);
-    if (error.empty()) return;
-    // The run stops, but its outputs say why: the last fields and a failed summary.
-    try {
-      out.finish(exit_bad_input, error);
-    } catch (const InputError&) {
-      // The outputs could not be written either (a full disk): the checkpoint's error
-      // is the one to report.
-    }
-    throw InputError(error);
+    if (!error.empty()) throw InputError(error); // (on every rank: see the catch below)
   };
 
   try {
@@ -126,6 +119,16 @@ int run(const Config& config, const RunOptions& options, const Comm& comm) {
     if (comm.rank() == 0) std::fprintf(stderr, "\nanvil: run failed: %s\n", e.what());
     out.finish(exit_physics, e.what());
     return exit_physics;
+  } catch (const InputError& e) {
+    // A checkpoint or field output that could not be written (a full disk): every rank
+    // stops (those writes are collective), and the outputs say why where they can: the
+    // last fields and a failed summary.
+    try {
+      out.finish(exit_bad_input, e.what());
+    } catch (const InputError&) {
+      // The outputs could not be written either: the first error is the one to report.
+    }
+    throw;
   }
   if (config.checkpoint_every > 0) checkpoint(); // the final state, for continuing later
   out.finish(exit_ok, "");
