@@ -79,32 +79,31 @@ refused short.yaml first/checkpoint.anvil "past the deck's termination (10 cycle
 sed -e 's/divisions: \[4, 4, 16\]/divisions: [16, 4, 4]/' deck.yaml > other_mesh.yaml
 refused other_mesh.yaml first/checkpoint.anvil "was written for another mesh"
 
-# A checkpoint that cannot be written (its path taken by a directory) stops the run
-# with exit 2 naming it, and the summary says so.
+# Expects `anvil run deck.yaml -o OUTDIR ARGS...` on 2 ranks to exit 2 naming FILE, with
+# a failed summary naming it too (an output that cannot be written).
+unwritable() {
+  local outdir=$1 file=$2
+  shift 2
+  set +e
+  run 2 "$anvil" run deck.yaml -o "$outdir" -q "$@" 2> err.txt
+  local status=$?
+  set -e
+  if [ "$status" -ne 2 ] || ! grep -q "$file" err.txt; then
+    echo "unwritable $file: exit $status (expected 2 naming the file):"; cat err.txt; exit 1
+  fi
+  grep -q '"status": "failed"' "$outdir/summary.json"
+  grep -q "$file" "$outdir/summary.json"
+}
+
+# A checkpoint that cannot be written (its path taken by a directory) stops the run.
 mkdir -p blocked/checkpoint.anvil
-set +e
-run 2 "$anvil" run deck.yaml -o blocked -q --stop-at-cycle 20 2> err.txt
-status=$?
-set -e
-if [ "$status" -ne 2 ] || ! grep -q "checkpoint.anvil" err.txt; then
-  echo "unwritable checkpoint: exit $status (expected 2 naming the file):"; cat err.txt; exit 1
-fi
-grep -q '"status": "failed"' blocked/summary.json
-grep -q 'checkpoint.anvil' blocked/summary.json
+unwritable blocked checkpoint.anvil --stop-at-cycle 20
 
 # A field piece that one rank cannot write (its temporary's path taken by a directory)
-# stops every rank with exit 2 naming it (alone, that rank left the other waiting: QA
-# round 20), the summary says so, and results.pvd lists the complete outputs only.
+# stops every rank (alone, that rank left the other waiting: QA round 20), and
+# results.pvd lists the complete outputs only.
 mkdir -p piece/fields/step_000001_r0001.vtu.tmp/keep
-set +e
-run 2 "$anvil" run deck.yaml -o piece -q 2> err.txt
-status=$?
-set -e
-if [ "$status" -ne 2 ] || ! grep -q "step_000001_r0001.vtu.tmp" err.txt; then
-  echo "unwritable field piece: exit $status (expected 2 naming the file):"; cat err.txt; exit 1
-fi
-grep -q '"status": "failed"' piece/summary.json
-grep -q 'step_000001_r0001.vtu.tmp' piece/summary.json
+unwritable piece step_000001_r0001.vtu.tmp
 grep -q 'step_000000.pvtu' piece/results.pvd
 if grep -q 'step_000001' piece/results.pvd; then echo "results.pvd names the failed output"; exit 1; fi
 

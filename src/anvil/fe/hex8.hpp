@@ -172,6 +172,20 @@ ANVIL_HEX8_INLINE V determinant(const V (&J)[3][3]) {
          J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
 }
 
+// det J at the element's centre (V on a parallelepiped is 8 times it), from the corner
+// positions x[a][i]: the one-point element's measure of its volume, which a tangled
+// element's exact volume can hide.
+template <class V>
+ANVIL_HEX8_INLINE V centre_jacobian(const V (&x)[8][3]) {
+  V J[3][3];
+  for (int i = 0; i < 3; ++i) {
+    V col[8];
+    for (int a = 0; a < 8; ++a) col[a] = x[a][i];
+    natural_sums(col, J[i]); // 8 dx_i / dxi_d
+  }
+  return determinant(J) / 512.0;
+}
+
 // The element's co-rotational frame: orthonormal axes e[d] (components e[d][i]) from the
 // centre Jacobian's columns (J[i][d] = 8 dx_i/dxi_d, natural_sums of the positions) by
 // Gram-Schmidt in the order xi, eta, zeta, and the element's extents along them,

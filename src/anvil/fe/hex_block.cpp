@@ -339,16 +339,6 @@ int element_cost(const HourglassControl& hourglass, const ThickShell& thick_shel
   return 148;
 }
 
-double HexBlock::centre_jacobian(std::size_t e, const double* const x[3]) const {
-  double J[3][3];
-  for (int i = 0; i < 3; ++i) {
-    double col[8];
-    for (int a = 0; a < 8; ++a) col[a] = x[i][conn[a][e]];
-    hex8::natural_sums(col, J[i]); // 8 dx_i / dxi_d
-  }
-  return hex8::determinant(J) / 512.0;
-}
-
 int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array<int, 8>> corners,
                    const double* const x[3], std::size_t base) {
   const int n = static_cast<int>(ids.size());
@@ -378,8 +368,12 @@ int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array
   mass.assign(p, 0.0);
   int bad = -1;
   for (std::size_t e = 0; e < p; ++e) {
-    if (static_cast<int>(e) < n && bad < 0 && !(volume[e] > 0 && centre_jacobian(e, x) > 0))
-      bad = static_cast<int>(e);
+    if (static_cast<int>(e) < n && bad < 0) {
+      double xe[8][3];
+      for (int a = 0; a < 8; ++a)
+        for (int i = 0; i < 3; ++i) xe[a][i] = x[i][conn[a][e]];
+      if (!(volume[e] > 0 && hex8::centre_jacobian(xe) > 0)) bad = static_cast<int>(e);
+    }
     mass[e] = rho * volume[e];
   }
   for (auto& s : stress) s.assign(p, 0.0);

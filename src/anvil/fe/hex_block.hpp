@@ -109,8 +109,6 @@ struct HexBlock {
   // (inverted or tangled), or -1.
   int init(std::span<const std::int64_t> ids, std::span<const std::array<int, 8>> corners,
            const double* const x[3], std::size_t base);
-  // det J at the centre of element e (V / 8 on a parallelepiped) at positions x.
-  double centre_jacobian(std::size_t e, const double* const x[3]) const;
 };
 
 struct NodalView {

@@ -444,21 +444,28 @@ void Outputs::write_fields() {
   // Particles have no place in the Exodus files: they are always written as VTU.
   if (sim_.sph()) write_particles(stem);
   if (sim_.config().output_format == OutputFormat::exodus) return;
-  // Every piece is complete before the index names it; a rank that cannot write its piece
-  // stops every rank with its message (alone, it left the others waiting in the next
-  // collective).
+  write_series(stem, piece, pvd_, "results.pvd");
+}
+
+// One output of a VTU series: this rank's piece fields/NAME_rRRRR.vtu, then on rank 0
+// fields/NAME.pvtu and the series' .pvd. Every piece is complete before the index names
+// it; a rank that cannot write its piece stops every rank with its message (alone, it
+// left the others waiting in the next collective: QA round 20).
+void Outputs::write_series(const std::string& name, const VtuPiece& piece,
+                           std::vector<std::pair<double, std::string>>& series,
+                           const std::string& pvd) {
   collective_write(sim_.comm(), [&] {
-    write_vtu(fmt::format("{}/fields/{}_r{:04d}.vtu", opt_.directory, stem, sim_.comm().rank()),
+    write_vtu(fmt::format("{}/fields/{}_r{:04d}.vtu", opt_.directory, name, sim_.comm().rank()),
               piece);
   });
   collective_write(sim_.comm(), [&] {
     if (sim_.comm().rank() != 0) return;
     std::vector<std::string> pieces;
     for (int r = 0; r < sim_.comm().size(); ++r)
-      pieces.push_back(fmt::format("{}_r{:04d}.vtu", stem, r));
-    write_pvtu(fmt::format("{}/fields/{}.pvtu", opt_.directory, stem), pieces, piece);
-    pvd_.emplace_back(clk.time, fmt::format("fields/{}.pvtu", stem));
-    write_pvd(opt_.directory + "/results.pvd", pvd_);
+      pieces.push_back(fmt::format("{}_r{:04d}.vtu", name, r));
+    write_pvtu(fmt::format("{}/fields/{}.pvtu", opt_.directory, name), pieces, piece);
+    series.emplace_back(piece.time, fmt::format("fields/{}.pvtu", name));
+    write_pvd(opt_.directory + "/" + pvd, series);
   });
 }
 
@@ -468,20 +475,7 @@ void Outputs::write_particles(const std::string& stem) {
   const Clock& clk = sim_.clock();
   VtuPiece piece = particle_piece(sim_);
   piece.time = clk.time;
-  collective_write(sim_.comm(), [&] {
-    write_vtu(
-        fmt::format("{}/fields/particles_{}_r{:04d}.vtu", opt_.directory, stem, sim_.comm().rank()),
-        piece);
-  });
-  collective_write(sim_.comm(), [&] {
-    if (sim_.comm().rank() != 0) return;
-    std::vector<std::string> pieces;
-    for (int r = 0; r < sim_.comm().size(); ++r)
-      pieces.push_back(fmt::format("particles_{}_r{:04d}.vtu", stem, r));
-    write_pvtu(fmt::format("{}/fields/particles_{}.pvtu", opt_.directory, stem), pieces, piece);
-    particle_pvd_.emplace_back(clk.time, fmt::format("fields/particles_{}.pvtu", stem));
-    write_pvd(opt_.directory + "/particles.pvd", particle_pvd_);
-  });
+  write_series("particles_" + stem, piece, particle_pvd_, "particles.pvd");
 }
 
 double Outputs::fraction_done() const {

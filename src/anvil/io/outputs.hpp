@@ -77,6 +77,8 @@ private:
   void write_fields();
   std::string history_header() const;
   void write_particles(const std::string& stem);
+  void write_series(const std::string& name, const VtuPiece& piece,
+                    std::vector<std::pair<double, std::string>>& series, const std::string& pvd);
   void open_exodus(const std::string& stem);
   void write_history_row(const Sample& s);
   void write_summary(int status, const std::string& message);

@@ -140,7 +140,10 @@ double hex_volume(const std::array<Vec3, 8>& x) {
 }
 
 double hex_centre_jacobian(const std::array<Vec3, 8>& x) {
-  return det_jacobian(x, {0, 0, 0});
+  double xe[8][3];
+  for (int a = 0; a < 8; ++a)
+    for (int i = 0; i < 3; ++i) xe[a][i] = x[a][i];
+  return hex8::centre_jacobian(xe);
 }
 
 std::vector<std::int64_t> select_nodes(const Mesh& mesh, const Box3& box,
