@@ -290,6 +290,43 @@ TEST(Deck, EmptyComponentListsAreErrors) {
                {"deck.yaml:18", "boundary_conditions[1].components", "at least one"});
 }
 
+// A prescribed motion's time history: `curve: [[t, value], ...]` scales a velocity, and is
+// required by a displacement, which starts from the initial position (deck.md).
+TEST(Deck, PrescribedMotionCurves) {
+  const std::string bc = "{set: bar.top, velocity: [0, 0, 1.0], components: [z]}";
+  std::string text = good;
+  text.replace(text.find(bc), bc.size(),
+               "{set: bar.top, displacement: [0, 0, 1.0e-3], components: [z], "
+               "curve: [[0, 0], [1.0e-5, 1], [2.0e-5, 0.5]]}");
+  const Config c = test::deck(text);
+  const BoundaryCondition& d = c.boundary_conditions[1];
+  EXPECT_EQ(d.motion, BoundaryCondition::Motion::displacement);
+  EXPECT_EQ(d.value, (Vec3{0, 0, 1e-3}));
+  ASSERT_TRUE(d.curve);
+  EXPECT_EQ(d.curve->at(-1.0), 0.0);
+  EXPECT_EQ(d.curve->at(0.5e-5), 0.5);
+  EXPECT_EQ(d.curve->at(1.5e-5), 0.75);
+  EXPECT_EQ(d.curve->at(1.0), 0.5); // held after the last point
+  EXPECT_DOUBLE_EQ(d.curve->slope_after(1.0e-5), -0.5e5);
+  EXPECT_EQ(d.curve->slope_after(2.0e-5), 0.0);
+  EXPECT_FALSE(c.boundary_conditions[0].curve);
+
+  expect_error(bc, "{set: bar.top, velocity: [0, 0, 1.0], curve: [[0, 0], [0, 1]]}",
+               {"deck.yaml:18", "boundary_conditions[1].curve[1][0]", "times must increase"});
+  expect_error(bc, "{set: bar.top, velocity: [0, 0, 1.0], curve: [[0, 0, 1]]}",
+               {"deck.yaml:18", "curve[0]", "a point [time, value]"});
+  expect_error(bc, "{set: bar.top, velocity: [0, 0, 1.0], curve: []}",
+               {"deck.yaml:18", "curve", "at least one"});
+  expect_error(bc, "{set: bar.top, displacement: [0, 0, 1.0]}",
+               {"deck.yaml:18", "boundary_conditions[1]", "needs its time history"});
+  expect_error(bc, "{set: bar.top, displacement: [0, 0, 1.0], curve: [[0, 1], [1, 1]]}",
+               {"deck.yaml:18", "boundary_conditions[1].curve", "value at t = 0 must be 0"});
+  expect_error(bc, "{set: bar.top, velocity: [0, 0, 1.0], displacement: [0, 0, 1.0]}",
+               {"deck.yaml:18", "exactly one of 'fix', 'velocity' or 'displacement'"});
+  expect_error("{set: impact_face, fix: [z]}", "{set: impact_face, fix: [z], curve: [[0, 1]]}",
+               {"deck.yaml:17", "boundary_conditions[0].curve", "goes with velocity"});
+}
+
 // QA D9: a deck set named like a generated one (bar.top) replaced it without a word.
 TEST(Deck, NodeSetNamesHaveNoDots) {
   expect_error("  impact_face: {part", "  bar.top: {part",

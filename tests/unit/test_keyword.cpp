@@ -493,7 +493,9 @@ shell part
   ASSERT_EQ(about_keywords.size(), 1u);
   const std::string& w = about_keywords[0];
   EXPECT_NE(w.find("*LOAD_NODE_SET (2x, first at model.k:"), std::string::npos) << w;
-  EXPECT_NE(w.find("*DEFINE_CURVE (1x"), std::string::npos) << w;
+  // A curve no prescribed motion names is not read (its card here is not even in LS-DYNA's
+  // columns) and changes nothing: not listed.
+  EXPECT_EQ(w.find("*DEFINE_CURVE"), std::string::npos) << w;
   EXPECT_NE(w.find("*MAT_RIGID (1x"), std::string::npos) << w;
   EXPECT_NE(w.find("*SECTION_SHELL (1x"), std::string::npos) << w;
   // The part without solid elements is left out, with a warning of its own.
@@ -604,6 +606,87 @@ TEST(Keyword, SpcIdCardComesOnceBeforeTheConstraints) {
   EXPECT_NO_THROW(kw(with(good, "*END",
                           "*BOUNDARY_SPC_NODE_ID\n         1\n        11         0         1\n"
                           "        12         0         1\n*END")));
+}
+
+// *BOUNDARY_PRESCRIBED_MOTION_SET/_NODE with *DEFINE_CURVE (LS-DYNA manual): DOF 1-3,
+// VAD 0 (velocity) or 2 (displacement), SF times the curve; the curve's points in fields of
+// 20 columns, t = SFA (A + OFFA), value = SFO (O + OFFO). Single nodes with the same motion
+// share one set, as constraints do.
+const std::string motion_cards = R"(*BOUNDARY_PRESCRIBED_MOTION_SET
+         7         3         2         5      0.01
+*BOUNDARY_PRESCRIBED_MOTION_NODE
+        12         1         0         6
+        11         1         0         6
+*DEFINE_CURVE_TITLE
+displacement ramp
+         5         0    1.0E-6       2.0       1.0       0.5
+                -1.0                -0.5
+               199.0                 0.5
+*DEFINE_CURVE
+         6
+                 0.0                 0.0
+              1.0E-4                 3.0
+*END)";
+
+TEST(Keyword, PrescribedMotionsAndTheirCurves) {
+  const Config c = kw(with(good, "*END", motion_cards));
+  ASSERT_EQ(c.boundary_conditions.size(), 3u); // the SPC, then the two motions
+  EXPECT_TRUE(c.warnings.empty());
+  const BoundaryCondition& d = c.boundary_conditions[1];
+  EXPECT_EQ(d.nodes.name, "nodeset_7");
+  EXPECT_TRUE(d.prescribed);
+  EXPECT_EQ(d.motion, BoundaryCondition::Motion::displacement);
+  EXPECT_EQ(d.components, (std::array<bool, 3>{false, false, true}));
+  EXPECT_EQ(d.value, (Vec3{0, 0, 0.01}));
+  ASSERT_TRUE(d.curve);
+  // t = 1e-6 (A + 1), value = 2 (O + 0.5): a ramp from 0 at t = 0 to 2 at t = 2e-4.
+  ASSERT_EQ(d.curve->t.size(), 2u);
+  EXPECT_EQ(d.curve->t[0], 0.0);
+  EXPECT_DOUBLE_EQ(d.curve->t[1], 2e-4);
+  EXPECT_EQ(d.curve->value, (std::vector<double>{0.0, 2.0}));
+  const BoundaryCondition& v = c.boundary_conditions[2];
+  EXPECT_EQ(v.nodes.name, "motion_nodes_1");
+  EXPECT_EQ(v.motion, BoundaryCondition::Motion::velocity);
+  EXPECT_EQ(v.value, (Vec3{1, 0, 0})); // SF blank: 1
+  EXPECT_EQ(v.curve->value, (std::vector<double>{0.0, 3.0}));
+  EXPECT_EQ(build_mesh(c).node_sets.at("motion_nodes_1"), (std::vector<std::int64_t>{10, 11}));
+}
+
+TEST(Keyword, PrescribedMotionErrors) {
+  const std::string ok = with(good, "*END", motion_cards);
+  const int set_card = line_of(ok, "*BOUNDARY_PRESCRIBED_MOTION_SET") + 1;
+  // Without OFFO the displacement curve starts at -1: not from the initial position.
+  expect_error(with(ok, "       1.0       0.5", "       1.0       0.0"),
+               {fmt::format("model.k:{}: *BOUNDARY_PRESCRIBED_MOTION_SET.LCID", set_card),
+                "curve 5 (VAD 2)", "found -1"});
+  expect_error(with(ok, "         3         2         5", "         3         1         5"),
+               {"*BOUNDARY_PRESCRIBED_MOTION_SET.VAD", "VAD = 1 is not supported"});
+  expect_error(with(ok, "         3         2         5", "         4         2         5"),
+               {"*BOUNDARY_PRESCRIBED_MOTION_SET.DOF", "DOF = 4"});
+  expect_error(with(ok, "         3         2         5", "         3         2         8"),
+               {fmt::format("model.k:{}: *BOUNDARY_PRESCRIBED_MOTION_SET.LCID", set_card),
+                "curve 8 is not defined"});
+  expect_error(with(ok, "*DEFINE_CURVE\n         6\n", "*DEFINE_CURVE\n         5\n"),
+               {"*DEFINE_CURVE.LCID", "curve 5 is defined twice (first at model.k:"});
+  expect_error(with(ok, "               199.0", "                -5.0"),
+               {"*DEFINE_CURVE_TITLE.A1", "must increase"});
+  expect_error(with(ok, "         5         0    1.0E-6", "         5         1    1.0E-6"),
+               {"*DEFINE_CURVE_TITLE.SIDR", "dynamic relaxation"});
+  // Fields 7 and 8 (columns 61-80): DEATH and BIRTH.
+  const std::string node_card = "        12         1         0         6";
+  const std::string sf_vid(20, ' ');
+  expect_error(with(ok, node_card, node_card + sf_vid + "       0.0    1.0E-5"),
+               {"*BOUNDARY_PRESCRIBED_MOTION_NODE.BIRTH"});
+  expect_error(with(ok, node_card, node_card + sf_vid + "    5.0E-5"),
+               {"*BOUNDARY_PRESCRIBED_MOTION_NODE.DEATH", "before the end time"});
+  EXPECT_NO_THROW(kw(with(ok, node_card, node_card + sf_vid + "    1.0E-4")));
+  // A curve that ends before ENDTIM while still changing: held, with a warning (LS-DYNA
+  // extrapolates its last slope).
+  const Config c = kw(with(ok, "              1.0E-4", "              5.0E-5"));
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("curve 6 ends at t = 5e-05 before the end time 0.0001"),
+            std::string::npos)
+      << c.warnings[0];
 }
 
 // keyword.md: *MAT_JOHNSON_COOK with G alone takes the bulk modulus rho C^2 of the part's

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "anvil/core/error.hpp"
+#include "anvil/core/time_curve.hpp"
 #include "anvil/core/vec3.hpp"
 #include "anvil/fe/hex_block.hpp"
 #include "anvil/material/material.hpp"
@@ -116,9 +117,13 @@ struct InitialCondition {
 
 struct BoundaryCondition {
   Selection nodes;
-  std::array<bool, 3> fix{false, false, false};        // fixed components (velocity 0)
-  bool prescribed = false;                             // a prescribed velocity
-  Vec3 velocity;                                       // its value, m/s
+  std::array<bool, 3> fix{false, false, false}; // fixed components (velocity 0)
+  bool prescribed = false;                      // a prescribed motion
+  // A prescribed velocity (m/s), or a prescribed displacement from the initial position
+  // (m, with a curve): `value` times the curve's value at the time (1 without a curve).
+  enum class Motion { velocity, displacement } motion = Motion::velocity;
+  Vec3 value;
+  std::optional<TimeCurve> curve;
   std::array<bool, 3> components{false, false, false}; // components it prescribes
   SourceLocation where;
 };

@@ -205,6 +205,24 @@ private:
   int fallback_line_;
 };
 
+// A time history `[[t0, v0], [t1, v1], ...]`, times strictly increasing.
+TimeCurve parse_curve(const Node& n) {
+  TimeCurve c;
+  const auto points = n.items();
+  if (points.empty()) n.fail("expected a list of [time, value] points, at least one");
+  for (const auto& p : points) {
+    if (!p.is_seq() || p.items().size() != 2) p.fail("expected a point [time, value]");
+    const auto tv = p.items();
+    const double t = tv[0].number();
+    if (!c.t.empty() && !(t > c.t.back()))
+      tv[0].fail(
+          fmt::format("times must increase from point to point: {} follows {}", t, c.t.back()));
+    c.t.push_back(t);
+    c.value.push_back(tv[1].number());
+  }
+  return c;
+}
+
 // Generated meshes define these sets; file meshes define their own (checked at setup).
 std::vector<std::string> generated_sets(MeshConfig::Kind kind) {
   switch (kind) {
@@ -875,22 +893,33 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 
   if (top.has("boundary_conditions")) {
     for (const auto& n : top.child("boundary_conditions").items()) {
-      n.check_keys({"set", "fix", "velocity", "components"});
+      n.check_keys({"set", "fix", "velocity", "displacement", "curve", "components"});
       BoundaryCondition bc;
       bc.where = n.where();
       bc.nodes = parse_set_ref(n.required("set"));
       check_name(bc.nodes);
-      if (n.has("fix") == n.has("velocity")) n.fail("give exactly one of 'fix' or 'velocity'");
+      if (int(n.has("fix")) + int(n.has("velocity")) + int(n.has("displacement")) != 1)
+        n.fail("give exactly one of 'fix', 'velocity' or 'displacement'");
       if (n.has("fix")) {
         bc.fix = n.child("fix").components();
-        if (n.has("components"))
-          n.child("components")
-              .fail("components goes with velocity; list fixed components under fix");
+        for (const char* key : {"components", "curve"})
+          if (n.has(key))
+            n.child(key).fail(fmt::format(
+                "{} goes with velocity or displacement; list fixed components under fix", key));
       } else {
         bc.prescribed = true;
-        bc.velocity = n.child("velocity").vec3();
+        const bool moved = n.has("displacement");
+        bc.motion =
+            moved ? BoundaryCondition::Motion::displacement : BoundaryCondition::Motion::velocity;
+        bc.value = n.child(moved ? "displacement" : "velocity").vec3();
         bc.components = n.has("components") ? n.child("components").components()
                                             : std::array<bool, 3>{true, true, true};
+        if (n.has("curve")) bc.curve = parse_curve(n.child("curve"));
+        if (moved && !bc.curve)
+          n.fail("a displacement needs its time history: add curve: [[t0, 0], [t1, 1], ...]");
+        if (const auto problem = moved ? displacement_history_problem(*bc.curve) : "";
+            !problem.empty())
+          n.child("curve").fail(problem);
       }
       c.boundary_conditions.push_back(bc);
     }

@@ -591,6 +591,25 @@ struct Spc {
   std::string keyword;
 };
 
+// *DEFINE_CURVE, scaled and offset: a time history for prescribed motions.
+struct CurveCard {
+  std::int64_t lcid = 0;
+  TimeCurve curve;
+  Where at;
+};
+
+// *BOUNDARY_PRESCRIBED_MOTION_SET/_NODE: one component of a node set's (a node's)
+// velocity or displacement, SF times curve LCID.
+struct MotionCard {
+  std::int64_t set = 0, node = 0; // one of them
+  int dof = 0;                    // 0, 1, 2: x, y, z
+  bool displacement = false;      // VAD 2 (else 0, velocity)
+  std::int64_t lcid = 0;
+  double sf = 1, death = 0;
+  Where at;
+  std::string keyword;
+};
+
 struct VelocityGen {
   int styp; // 1 part set, 2 part, 3 node set, 0: all parts (*INITIAL_VELOCITY with NSID 0)
   std::int64_t id;
@@ -695,6 +714,15 @@ private:
     if (n == "HOURGLASS" || n == "HOURGLASS_TITLE") return hourglass(b);
     if (n == "BOUNDARY_SPC_SET" || n == "BOUNDARY_SPC_SET_ID") return spc(b, true);
     if (n == "BOUNDARY_SPC_NODE" || n == "BOUNDARY_SPC_NODE_ID") return spc(b, false);
+    if (n == "BOUNDARY_PRESCRIBED_MOTION_SET" || n == "BOUNDARY_PRESCRIBED_MOTION_SET_ID")
+      return prescribed_motion(b, true);
+    if (n == "BOUNDARY_PRESCRIBED_MOTION_NODE" || n == "BOUNDARY_PRESCRIBED_MOTION_NODE_ID")
+      return prescribed_motion(b, false);
+    if (n == "DEFINE_CURVE" || n == "DEFINE_CURVE_TITLE") {
+      Cursor(b).skip_rest(); // read when a motion names it
+      curve_blocks_.push_back(&b);
+      return;
+    }
     if (n == "INITIAL_VELOCITY_GENERATION") return velocity_generation(b);
     if (n == "INITIAL_VELOCITY") return initial_velocity(b);
     if (n == "CONTACT_AUTOMATIC_SINGLE_SURFACE" || n == "CONTACT_AUTOMATIC_SINGLE_SURFACE_ID" ||
@@ -1245,6 +1273,100 @@ private:
     }
   }
 
+  // Any number of cards NSID (NID), DOF, VAD, LCID, SF, VID, DEATH, BIRTH (LS-DYNA
+  // manual, *BOUNDARY_PRESCRIBED_MOTION), after the ID card of the _ID option. anvil
+  // prescribes translations (DOF 1-3) by velocity (VAD 0) or displacement (VAD 2) from
+  // t = 0 to the end; anything else would run another problem, so it is an error.
+  void prescribed_motion(const Block& b, bool set) {
+    Cursor c(b);
+    if (ends_with(b.name, "_ID")) c.next();
+    while (auto l = c.next_record()) {
+      const Card card(b, *l, {10, 10, 10, 10, 10, 10, 10, 10});
+      const char* what = set ? "NSID" : "NID";
+      MotionCard m;
+      (set ? m.set : m.node) = card.integer(0, what, 0);
+      if ((set ? m.set : m.node) <= 0)
+        card.fail(what, fmt::format("{} must be a positive id", what));
+      const auto dof = card.integer(1, "DOF", 0);
+      if (dof < 1 || dof > 3)
+        card.fail("DOF", fmt::format("DOF = {} is not supported: anvil prescribes the "
+                                     "translations x, y, z (DOF 1, 2, 3) of solid nodes",
+                                     dof));
+      m.dof = static_cast<int>(dof - 1);
+      const auto vad = card.integer(2, "VAD", 0);
+      if (vad != 0 && vad != 2)
+        card.fail("VAD", fmt::format("VAD = {} is not supported: anvil prescribes a velocity "
+                                     "(VAD 0) or a displacement (VAD 2)",
+                                     vad));
+      m.displacement = vad == 2;
+      m.lcid = card.integer(3, "LCID", 0);
+      if (m.lcid <= 0) card.fail("LCID", "LCID must be the id of a *DEFINE_CURVE");
+      m.sf = card.real(4, "SF", 1.0);
+      m.death = card.real(6, "DEATH", 0);
+      if (card.real(7, "BIRTH", 0) > 0)
+        card.fail("BIRTH", "BIRTH > 0 is not supported: anvil prescribes the motion from t = 0");
+      m.at = where_of(*l);
+      m.keyword = b.name;
+      motions_.push_back(m);
+    }
+  }
+
+  // LCID, SIDR, SFA, SFO, OFFA, OFFO, DATTYP, LCINT, then one point (A, O) per card in
+  // fields of 20 columns; the offsets are applied before the scale factors (LS-DYNA
+  // manual, *DEFINE_CURVE): t = SFA (A + OFFA), value = SFO (O + OFFO). Read only when a
+  // prescribed motion names the curve (curve()): decks carry curves for materials and
+  // loads anvil does not model, and those are no concern of the run.
+  static CurveCard read_curve(const Block& b) {
+    Cursor c(b);
+    skip_title(b, c);
+    const Line l = c.next();
+    const Card c1(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+    CurveCard cc;
+    cc.lcid = c1.integer(0, "LCID", 0);
+    cc.at = where_of(l);
+    const auto sidr = c1.integer(1, "SIDR", 0);
+    if (sidr == 1)
+      c1.fail("SIDR", "SIDR = 1 (a curve for dynamic relaxation only) is not supported: anvil "
+                      "has no dynamic relaxation phase");
+    if (sidr != 0 && sidr != 2) c1.fail("SIDR", "SIDR must be 0, 1 or 2");
+    // A scale factor of 0 is LS-DYNA's default, 1.
+    const double sfa = c1.real(2, "SFA", 1) == 0 ? 1 : c1.real(2, "SFA", 1);
+    const double sfo = c1.real(3, "SFO", 1) == 0 ? 1 : c1.real(3, "SFO", 1);
+    const double offa = c1.real(4, "OFFA", 0), offo = c1.real(5, "OFFO", 0);
+    if (c1.integer(6, "DATTYP", 0) != 0)
+      c1.fail("DATTYP", "DATTYP other than 0 (a general curve) is not supported");
+    while (auto p = c.next_record()) {
+      const Card pt(b, *p, {20, 20});
+      const double t = sfa * (pt.real(0, "A1") + offa);
+      if (!cc.curve.t.empty() && !(t > cc.curve.t.back()))
+        pt.fail("A1", fmt::format("the abscissae must increase from point to point: {} "
+                                  "follows {}",
+                                  t, cc.curve.t.back()));
+      cc.curve.t.push_back(t);
+      cc.curve.value.push_back(sfo * (pt.real(1, "O1") + offo));
+    }
+    if (cc.curve.t.empty()) c1.fail("LCID", fmt::format("curve {} has no points", cc.lcid));
+    return cc;
+  }
+
+  // Curve `lcid`, read from the first *DEFINE_CURVE that defines it; an error at `at`
+  // when none does, at the curve when it is defined twice.
+  const CurveCard& curve(std::int64_t lcid, const SourceLocation& at) {
+    if (const auto it = curves_.find(lcid); it != curves_.end()) return it->second;
+    const CurveCard* found = nullptr;
+    for (const Block* b : curve_blocks_) {
+      CurveCard cc = read_curve(*b);
+      if (cc.lcid != lcid) continue;
+      if (found)
+        throw InputError(
+            cc.at.loc("*" + b->name + ".LCID"),
+            fmt::format("curve {} is defined twice (first at {})", lcid, found->at.str()));
+      found = &curves_.emplace(lcid, std::move(cc)).first->second;
+    }
+    if (!found) throw InputError(at, fmt::format("curve {} is not defined (*DEFINE_CURVE)", lcid));
+    return *found;
+  }
+
   void velocity_generation(const Block& b) {
     Cursor c(b);
     while (!c.done()) {
@@ -1616,6 +1738,9 @@ private:
   std::map<std::int64_t, HourglassCard> hourglass_;
   std::map<std::int64_t, IdSet> node_sets_, part_sets_;
   std::vector<Spc> spcs_;
+  std::vector<MotionCard> motions_;
+  std::vector<const Block*> curve_blocks_;   // *DEFINE_CURVE, read by curve()
+  std::map<std::int64_t, CurveCard> curves_; // those read
   std::vector<VelocityGen> velocities_;
   std::vector<ContactCard> contacts_;
   std::vector<WallCard> walls_;
@@ -1933,6 +2058,65 @@ Config KeywordReader::config(const std::string& deck_file) {
     bc.fix = {(mask & 1) != 0, (mask & 2) != 0, (mask & 4) != 0};
     bc.where = bc.nodes.where;
     c.boundary_conditions.push_back(bc);
+  }
+
+  // Prescribed motions: one condition per card by set; single nodes grouped by what they
+  // prescribe, one set each, as the constraints are.
+  std::set<std::int64_t> curves_warned;
+  auto motion_condition = [&](const MotionCard& m, const std::string& set_name) {
+    const std::string key = "*" + m.keyword;
+    const CurveCard& cc = curve(m.lcid, m.at.loc(key + ".LCID"));
+    const TimeCurve& tc = cc.curve;
+    if (m.displacement)
+      if (const auto problem = displacement_history_problem(tc); !problem.empty())
+        throw InputError(m.at.loc(key + ".LCID"),
+                         fmt::format("curve {} (VAD 2): {}", m.lcid, problem));
+    if (m.death != 0 && endtim_ > 0 && m.death < endtim_)
+      throw InputError(m.at.loc(key + ".DEATH"),
+                       fmt::format("DEATH = {} before the end time {} is not supported: anvil "
+                                   "prescribes the motion to the end of the run",
+                                   m.death, endtim_));
+    const std::size_t last = tc.t.size() - 1;
+    if (endtim_ > tc.t[last] && last > 0 && tc.value[last] != tc.value[last - 1] &&
+        curves_warned.insert(m.lcid).second)
+      warnings.push_back(fmt::format(
+          "{}: curve {} ends at t = {} before the end time {}: anvil holds its last value "
+          "there, where LS-DYNA would extrapolate its last slope (extend the curve to the end "
+          "time to have the same run in both)",
+          cc.at.str(), m.lcid, tc.t[last], endtim_));
+    BoundaryCondition bc;
+    bc.nodes.name = set_name;
+    bc.nodes.where = m.at.loc(key);
+    bc.prescribed = true;
+    bc.motion = m.displacement ? BoundaryCondition::Motion::displacement
+                               : BoundaryCondition::Motion::velocity;
+    bc.components[static_cast<std::size_t>(m.dof)] = true;
+    bc.value[m.dof] = m.sf;
+    bc.curve = tc;
+    bc.where = bc.nodes.where;
+    c.boundary_conditions.push_back(bc);
+  };
+  std::map<std::tuple<int, bool, std::int64_t, double>,
+           std::pair<std::vector<std::int64_t>, MotionCard>>
+      moved; // single nodes by (DOF, VAD, LCID, SF): their nodes and first card
+  for (const auto& m : motions_) {
+    if (m.set != 0) {
+      motion_condition(m, node_set_name(m.set, m.at, "*" + m.keyword + ".NSID"));
+    } else {
+      const auto pos = node_position(m.node, m.at, "*" + m.keyword + ".NID", "the motion");
+      auto& [ids, first] = moved[{m.dof, m.displacement, m.lcid, m.sf}];
+      if (ids.empty()) first = m;
+      ids.push_back(pos);
+    }
+  }
+  int group = 0;
+  for (auto& [what, entry] : moved) {
+    auto& [ids, first] = entry;
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    const std::string name = fmt::format("motion_nodes_{}", ++group);
+    mesh.node_sets[name] = ids;
+    motion_condition(first, name);
   }
 
   const auto shared = std::make_shared<const Mesh>(std::move(mesh));

@@ -404,9 +404,16 @@ void Simulation::apply_initial_conditions(const Mesh& mesh) {
 
 void Simulation::apply_boundary_conditions(const Mesh& mesh) {
   const std::size_t nn = fe_.node_gid.size();
+  const auto& bcs = config_.boundary_conditions;
+  curved_components_.clear();
+  update_prescribed_motions(0.0, 0.0); // the factors at t = 0
   constrained_.assign(nn, 0);
   for (int i = 0; i < 3; ++i) v_bc_[i].assign(nn, 0.0);
-  for (const auto& bc : config_.boundary_conditions) {
+  // The condition that prescribes each node component last (-1: none or fixed).
+  std::array<std::vector<int>, 3> source;
+  for (auto& s : source) s.assign(nn, -1);
+  for (std::size_t b = 0; b < bcs.size(); ++b) {
+    const auto& bc = bcs[b];
     const auto ids = selected_nodes(mesh, bc.nodes);
     for (std::size_t n = 0; n < nn; ++n) {
       if (!std::binary_search(ids.begin(), ids.end(), fe_.node_gid[n])) continue;
@@ -414,7 +421,8 @@ void Simulation::apply_boundary_conditions(const Mesh& mesh) {
         const bool on = bc.prescribed ? bc.components[i] : bc.fix[i];
         if (!on) continue;
         constrained_[n] |= static_cast<std::uint8_t>(1u << i);
-        v_bc_[i][n] = bc.prescribed ? bc.velocity[i] : 0.0;
+        v_bc_[i][n] = bc.prescribed ? bc.value[i] * motion_factor_[b] : 0.0;
+        source[i][n] = bc.prescribed ? static_cast<int>(b) : -1;
       }
     }
   }
@@ -422,10 +430,35 @@ void Simulation::apply_boundary_conditions(const Mesh& mesh) {
   for (std::size_t n = 0; n < nn; ++n)
     if (constrained_[n]) {
       constrained_nodes_.push_back(static_cast<int>(n));
-      for (int i = 0; i < 3; ++i)
+      for (int i = 0; i < 3; ++i) {
         if (constrained_[n] & (1u << i)) nodes_.v[i][n] = v_bc_[i][n];
+        const int b = source[i][n];
+        if (b >= 0 && bcs[static_cast<std::size_t>(b)].curve)
+          curved_components_.push_back({static_cast<int>(n), i, b});
+      }
     }
   apply_particle_boundary_conditions();
+}
+
+// The prescribed motions' factors for the step from t to t + dt: a velocity history at
+// the mid-step, where central difference places v(n+1/2); a displacement history as the
+// velocity that carries the node from d(t) to d(t + dt) exactly, so that the displacement
+// follows the curve without drift (with dt = 0, at setup: the rate just after t).
+void Simulation::update_prescribed_motions(double t, double dt) {
+  const auto& bcs = config_.boundary_conditions;
+  motion_factor_.resize(bcs.size());
+  for (std::size_t b = 0; b < bcs.size(); ++b) {
+    const auto& c = bcs[b].curve;
+    if (!c)
+      motion_factor_[b] = 1.0;
+    else if (bcs[b].motion == BoundaryCondition::Motion::velocity)
+      motion_factor_[b] = c->at(t + 0.5 * dt);
+    else
+      motion_factor_[b] = dt > 0 ? (c->at(t + dt) - c->at(t)) / dt : c->slope_after(t);
+  }
+  for (const auto& cc : curved_components_)
+    v_bc_[cc.component][cc.node] = config_.boundary_conditions[cc.condition].value[cc.component] *
+                                   motion_factor_[cc.condition];
 }
 
 void Simulation::locate_probes(const Mesh& mesh) {
@@ -634,6 +667,7 @@ void Simulation::predict() {
   // summed in a local whose address is not taken (work's is, below: the sum went through
   // memory at every term, a quarter of this function's time on the can crush).
   double work_bc = 0;
+  update_prescribed_motions(clock_.time, dt);
   for (int n : constrained_nodes_) {
     for (int i = 0; i < 3; ++i) {
       if (!(constrained_[n] & (1u << i))) continue;

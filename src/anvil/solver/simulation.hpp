@@ -146,6 +146,7 @@ private:
   void update();
   void apply_initial_conditions(const Mesh& mesh);
   void apply_boundary_conditions(const Mesh& mesh);
+  void update_prescribed_motions(double t, double dt);
   void locate_probes(const Mesh& mesh);
   double owned_kinetic_energy() const;
   // Particles: selection (mask over own particles), conditions, their part of predict,
@@ -156,6 +157,7 @@ private:
   std::vector<std::int64_t> selected_nodes(const Mesh& mesh, const Selection& sel) const;
   void apply_particle_conditions();
   void apply_particle_boundary_conditions();
+  double particle_bc_velocity(int k, std::size_t i) const;
   double particle_kinetic_energy() const;
   double particle_internal_energy() const;
   void predict_particles(double dt_avg, double& ke, double& work);
@@ -191,6 +193,16 @@ private:
   std::vector<std::uint8_t> constrained_;
   std::array<std::vector<double>, 3> v_bc_;
   std::vector<int> constrained_nodes_; // local nodes with any constraint
+  // Prescribed motions with a time history: each condition's factor on its value for the
+  // current step (1 without a curve; update_prescribed_motions), and the node components
+  // whose v_bc_ follows one (the condition that prescribes them last in the deck).
+  struct CurvedComponent {
+    int node;
+    int component;
+    int condition;
+  };
+  std::vector<double> motion_factor_;
+  std::vector<CurvedComponent> curved_components_;
 
   // Contact (null without a contact definition): the contact decomposition and the
   // contact force per local node of the current cycle.

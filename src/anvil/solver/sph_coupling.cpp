@@ -117,11 +117,13 @@ double Simulation::particle_internal_energy() const {
 }
 
 // Boundary conditions on particles: fixed or prescribed velocity components, set up
-// once; the masks travel with the particles.
+// once; the masks, values and time histories travel with the particles.
 void Simulation::apply_particle_boundary_conditions() {
   if (!sph_) return;
   auto& pt = sph_->particles();
-  for (const auto& bc : config_.boundary_conditions) {
+  const auto& bcs = config_.boundary_conditions;
+  for (std::size_t b = 0; b < bcs.size(); ++b) {
+    const auto& bc = bcs[b];
     const auto mask = select_particles(bc.nodes);
     for (std::size_t i = 0; i < pt.size(); ++i) {
       if (!mask[i]) continue;
@@ -129,7 +131,8 @@ void Simulation::apply_particle_boundary_conditions() {
         const bool on = bc.prescribed ? bc.components[k] : bc.fix[k];
         if (!on) continue;
         pt.constrained[i] |= static_cast<std::uint8_t>(1u << k);
-        pt.v_bc[k][i] = bc.prescribed ? bc.velocity[k] : 0.0;
+        pt.v_bc[k][i] = bc.prescribed ? bc.value[k] : 0.0;
+        pt.bc_curve[k][i] = bc.prescribed && bc.curve ? static_cast<int>(b) : -1;
       }
     }
   }
@@ -143,7 +146,15 @@ void Simulation::apply_particle_boundary_conditions() {
     }
   for (std::size_t i = 0; i < pt.size(); ++i)
     for (int k = 0; k < 3; ++k)
-      if (pt.constrained[i] & (1u << k)) pt.v[k][i] = pt.v_bc[k][i];
+      if (pt.constrained[i] & (1u << k)) pt.v[k][i] = particle_bc_velocity(k, i);
+}
+
+// A constrained particle component's velocity over the current step: its value, times
+// its condition's time history factor (update_prescribed_motions).
+double Simulation::particle_bc_velocity(int k, std::size_t i) const {
+  const auto& pt = sph_->particles();
+  const int b = pt.bc_curve[k][i];
+  return b < 0 ? pt.v_bc[k][i] : pt.v_bc[k][i] * motion_factor_[static_cast<std::size_t>(b)];
 }
 
 // Cycle step 3 for the particles: v(n+1/2) = v(n-1/2) + dt_avg f / m (prescribed
@@ -164,7 +175,7 @@ void Simulation::predict_particles(double dt_avg, double& ke, double& work) {
       const double free = old + dt_avg * pt.f[k][i] * inv_m;
       double nv = free;
       if (pt.constrained[i] & (1u << k)) {
-        nv = pt.v_bc[k][i];
+        nv = particle_bc_velocity(k, i);
         work += pt.mass[i] * (nv - free) * 0.5 * (old + nv);
       }
       pt.v[k][i] = nv;

@@ -32,7 +32,9 @@ struct Particles {
   std::vector<double> wave_speed;            // m/s, from the last material update
   std::vector<std::uint8_t> constrained;     // bit i: velocity component i is prescribed
   std::array<std::vector<double>, 3> v_bc;   // the prescribed value, m/s
-  std::vector<std::int64_t> last_face;       // contact face touched last cycle, or -1
+  // The boundary condition (deck index) whose time history scales v_bc, or -1 (constant).
+  std::array<std::vector<int>, 3> bc_curve;
+  std::vector<std::int64_t> last_face; // contact face touched last cycle, or -1
 
   std::size_t size() const { return mass.size(); }
 
@@ -55,6 +57,7 @@ struct Particles {
     fn(wave_speed);
     fn(constrained);
     for (auto& a : v_bc) fn(a);
+    for (auto& a : bc_curve) fn(a);
     fn(last_face);
   }
 };

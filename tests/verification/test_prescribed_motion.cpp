@@ -1,0 +1,204 @@
+// Prescribed motions with time histories (deck `curve`, *BOUNDARY_PRESCRIBED_MOTION with
+// *DEFINE_CURVE; docs/deck.md).
+//
+// 1. A velocity history drives a 1-D elastic wave (uniaxial strain). Reference:
+//    d'Alembert's solution for a semi-infinite column (Graff, "Wave Motion in Elastic
+//    Solids", 1975, section 1.1): the end's velocity v0(t) travels unchanged at
+//    c = sqrt((lambda + 2 mu) / rho), v(z, t) = v0(t - z / c), until the reflection from
+//    the free end comes back. v0 ramps linearly from 0 to 1 m/s over 40 element transits,
+//    then holds. Tolerances (stated before the run): away from the ramp's two corners,
+//    which the mesh's dispersion rounds off over a few elements, the mid-length velocity
+//    within 0.5% of v0's amplitude; the driven end's displacement is the midpoint-rule
+//    integral of the history, exact on each linear segment, so within the one step that
+//    straddles the corner: |error| <= |slope jump| dt^2 / 8.
+// 2. A displacement history (three segments, up, down, held) is followed by the driven
+//    nodes and particles to round-off: the velocity of each step is the difference of the
+//    history over the step, so no truncation error accumulates (a velocity integrated from
+//    a velocity history would be off by O(dt^2) per corner, ~1e-10 m here). Tolerance: the
+//    round-off of the position sums, one half-ulp of the largest coordinate (0.07 m) per
+//    step and per operation (x += dt v, u = x - x0), i.e. cycles * ulp(0.07 m); the same from
+//    an LS-DYNA keyword deck (VAD 2, SF and the curve's SFO).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "anvil/io/keyword.hpp"
+#include "anvil/parallel/comm.hpp"
+#include "anvil/solver/simulation.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using namespace anvil;
+
+TEST(PrescribedMotion, VelocityHistoryTravelsAsDAlembertSays) {
+  const double L = 0.1, rho = 7850, E = 200e9, nu = 0.3;
+  const double M = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
+  const double c = std::sqrt(M / rho);
+  const double T = 0.2 * L / c; // 40 of the 200 elements
+  const double t_end = 1.2 * L / c;
+  const std::string deck = fmt::format(R"(
+termination: {{time: {}}}
+materials:
+  steel: {{model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}}
+parts:
+  column:
+    mesh: {{generate: box, min: [0, 0, 0], max: [0.0005, 0.0005, 0.1], divisions: [1, 1, 200]}}
+    material: steel
+boundary_conditions:
+  - {{set: column.xmin, fix: [x]}}
+  - {{set: column.xmax, fix: [x]}}
+  - {{set: column.ymin, fix: [y]}}
+  - {{set: column.ymax, fix: [y]}}
+  - {{set: column.zmin, velocity: [0, 0, 1.0], components: [z], curve: [[0, 0], [{}, 1]]}}
+probes:
+  - {{name: mid, at: [0, 0, 0.05]}}
+  - {{name: end, at: [0, 0, 0]}}
+)",
+                                       t_end, T);
+  const Comm world = Comm::world();
+  Simulation sim(test::deck(deck), world);
+  auto v0 = [&](double t) { return t <= 0 ? 0.0 : (t < T ? t / T : 1.0); };
+  auto d0 = [&](double t) { return t <= 0 ? 0.0 : (t < T ? t * t / (2 * T) : t - T / 2); };
+  double worst = 0, dt_max = 0;
+  int checked = 0;
+  Sample s;
+  while (!sim.finished()) {
+    sim.step();
+    s = sim.sample();
+    dt_max = std::max(dt_max, s.dt);
+    // Away from the corners at t' = 0 and t' = T (t' = t - z / c): 0.2 T on either side.
+    const double tr = s.time - 0.05 / c;
+    if (std::abs(tr) < 0.2 * T || std::abs(tr - T) < 0.2 * T) continue;
+    worst = std::max(worst, std::abs(s.probes[5] - v0(tr)));
+    ++checked;
+  }
+  ASSERT_GT(checked, 100);
+  EXPECT_LT(worst, 0.005) << "mid-length velocity off d'Alembert's by " << worst << " m/s";
+  const double uz = s.probes[6 + 2], expected = d0(s.time);
+  const double bound = (1 / T) * dt_max * dt_max / 8;
+  EXPECT_LE(std::abs(uz - expected), bound)
+      << "end displacement " << uz << " m, integral of the history " << expected << " m";
+  if (world.rank() == 0)
+    std::printf("velocity history: worst mid-length velocity error %.2e m/s (%d samples), end "
+                "displacement error %.2e m (bound %.2e m)\n",
+                worst, checked, std::abs(uz - expected), bound);
+}
+
+// The history of test 2: up to 1 at 20 us, down to 0.25 at 50 us, then held.
+double history(double t) {
+  if (t <= 0) return 0;
+  if (t < 2e-5) return t / 2e-5;
+  if (t < 5e-5) return 1 - 0.75 * (t - 2e-5) / 3e-5;
+  return 0.25;
+}
+
+// Runs `config` to its end; per probe, the largest difference between its z displacement
+// and amplitude * history(t) over every sample.
+// Also the round-off bound of the header, cycles * ulp(0.07 m), as the last entry.
+std::vector<double> worst_displacement_errors(const Config& config, double amplitude) {
+  const Comm world = Comm::world();
+  Simulation sim(config, world);
+  std::vector<double> worst(config.probes.size() + 1, 0.0);
+  std::int64_t cycles = 0;
+  while (!sim.finished()) {
+    sim.step();
+    const Sample s = sim.sample();
+    cycles = s.cycle + 1;
+    for (std::size_t p = 0; p + 1 < worst.size(); ++p)
+      worst[p] = std::max(worst[p], std::abs(s.probes[6 * p + 2] - amplitude * history(s.time)));
+  }
+  worst.back() = static_cast<double>(cycles) * (std::nextafter(0.07, 1.0) - 0.07);
+  return worst;
+}
+
+TEST(PrescribedMotion, DisplacementHistoryIsFollowedToRoundOff) {
+  const double a = 1e-4; // m
+  const std::string deck = R"(
+termination: {time: 8.0e-5}
+materials:
+  steel: {model: elastic, density: 7800, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+parts:
+  bar:
+    mesh: {generate: box, min: [0, 0, 0], max: [0.01, 0.01, 0.05], divisions: [2, 2, 10]}
+    material: steel
+particles:
+  slab:
+    generate: {shape: box, min: [0, 0, 0.06], max: [0.01, 0.01, 0.07], spacing: 1.0e-3}
+    material: steel
+node_sets:
+  piston: {part: slab, box: {min: [-1, -1, 0.0685], max: [1, 1, 1]}}
+boundary_conditions:
+  - {set: bar.zmin, fix: all}
+  - {set: bar.zmax, displacement: [0, 0, 1.0e-4], components: [z],
+     curve: [[0, 0], [2.0e-5, 1], [5.0e-5, 0.25]]}
+  - {set: piston, displacement: [0, 0, 1.0e-4], components: [z],
+     curve: [[0, 0], [2.0e-5, 1], [5.0e-5, 0.25]]}
+probes:
+  - {name: top, at: [0.01, 0.01, 0.05]}
+  - {name: piston, at: [0.0095, 0.0095, 0.0695]}
+)";
+  const auto worst = worst_displacement_errors(test::deck(deck), a);
+  const double worst_node = worst[0], worst_particle = worst[1], bound = worst[2];
+  EXPECT_LT(worst_node, bound);
+  EXPECT_LT(worst_particle, bound);
+
+  // The same bar from a keyword deck: SF 2e-4 times a curve of values 0.5 (SFO 0.5) at the
+  // history's points.
+  const std::string k = R"(*KEYWORD
+*CONTROL_TERMINATION
+    8.0E-5
+*PART
+bar
+         1         1         1
+*SECTION_SOLID
+         1         1
+*MAT_ELASTIC
+         1    7800.0   2.0E+11       0.3
+*NODE
+       1             0.0             0.0             0.0
+       2            0.01             0.0             0.0
+       3            0.01            0.01             0.0
+       4             0.0            0.01             0.0
+       5             0.0             0.0            0.05
+       6            0.01             0.0            0.05
+       7            0.01            0.01            0.05
+       8             0.0            0.01            0.05
+*ELEMENT_SOLID
+       1       1       1       2       3       4       5       6       7       8
+*SET_NODE_LIST
+         1
+         1         2         3         4
+*SET_NODE_LIST
+         2
+         5         6         7         8
+*BOUNDARY_SPC_SET
+         1         0         1         1         1
+*BOUNDARY_PRESCRIBED_MOTION_SET
+         2         3         2         7    2.0E-4
+*DEFINE_CURVE
+         7         0       0.0       0.5
+                 0.0                 0.0
+              2.0E-5                 1.0
+              5.0E-5                0.25
+              8.0E-5                0.25
+*DATABASE_HISTORY_NODE
+         7
+*END
+)";
+  const auto keyword = worst_displacement_errors(parse_keyword_deck(k, "bar.k", "."), a);
+  const double worst_keyword = keyword[0];
+  EXPECT_LT(worst_keyword, keyword[1]);
+  if (Comm::world().rank() == 0)
+    std::printf("displacement history: worst error %.2e m (nodes), %.2e m (particles), "
+                "%.2e m (keyword deck); round-off bound %.2e m, amplitude %.0e m\n",
+                worst_node, worst_particle, worst_keyword, bound, a);
+}
+
+} // namespace
