@@ -99,6 +99,9 @@ TEST(Deck, MissingRequiredValues) {
                {"deck.yaml:5", "materials.copper.yield_stress", "missing"});
   expect_error("termination: {time: 8.0e-5}", "", {"deck.yaml", "termination", "missing"});
   expect_error("    material: copper\n", "", {"deck.yaml:8", "parts.bar.material", "missing"});
+  // Under an empty mapping, at the mapping's key (QA round 22: at line 1).
+  expect_error("output: {fields_every", "checkpoint: {}\noutput: {fields_every",
+               {"deck.yaml:21", "checkpoint.every", "missing"});
 }
 
 TEST(Deck, ImpossibleValues) {
@@ -108,6 +111,9 @@ TEST(Deck, ImpossibleValues) {
                {"deck.yaml:6", "poissons_ratio", "< 0.5"});
   expect_error("radius: 3.2e-3", "radius: 0", {"deck.yaml:9", "radius", "positive"});
   expect_error("scale: 0.9", "scale: 1.5", {"deck.yaml:3", "time_step.scale"});
+  // (QA round 22: accepted, and the run ended before its first step with status 0.)
+  expect_error("termination: {time: 8.0e-5}", "termination: {time: 8.0e-5, cycles: 0}",
+               {"deck.yaml:2", "termination.cycles", "at least 1"});
   // Each in its range, together without a wave speed (QA round 21: `check` called this
   // deck valid with a stable step of 0 s, and the run failed at t = 0).
   expect_error("density: 8930, youngs_modulus: 117.0e9", "density: 1e-300, youngs_modulus: 1e300",

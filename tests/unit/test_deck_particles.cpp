@@ -499,3 +499,16 @@ TEST(DeckParticles, WarnsOfParticleContactThatCannotAct) {
   Simulation inside(test::deck(sunk), world);
   EXPECT_TRUE(has_warning(inside, "start inside elements"));
 }
+
+// Summation density on a solid or liquid set is warned of (QA round 22: 27 water particles
+// gained energy without bound); on a gas it is what the option is for.
+TEST(DeckParticles, WarnsOfSummationDensityOnAMaterialThatIsNotAGas) {
+  const Comm world = Comm::world(); // (Simulation keeps a reference)
+  std::string solid = hybrid;
+  solid.replace(solid.rfind("material: steel}"), 16, "material: steel, summation_density: true}");
+  Simulation sim(test::deck(solid), world);
+  EXPECT_TRUE(has_warning(sim, "particle set 'ball' uses summation_density with material "
+                               "'steel', which is not a gas"));
+  Simulation plain(test::deck(hybrid), world);
+  EXPECT_FALSE(has_warning(plain, "summation_density"));
+}

@@ -199,4 +199,9 @@ void hex_forces(HexBlock& block, const NodalView& nodes, double dt_prev, CornerV
 // Element volumes at the given positions (setup and output).
 void hex_volumes(const HexBlock& block, const double* const x[3], std::span<double> out);
 
+// Element e's corner positions relative to its first corner (geometry from differences:
+// independent of where the model sits).
+void element_corners(const HexBlock& block, const double* const x[3], std::size_t e,
+                     double (&xe)[8][3]);
+
 } // namespace anvil

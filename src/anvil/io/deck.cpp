@@ -114,8 +114,17 @@ public:
   void check_keys(std::initializer_list<std::string_view> allowed) const { (void)entries(allowed); }
 
   bool has(const std::string& key) const { return n_.IsMap() && n_[key]; }
+  // The value under `key`; its fallback line (for a value without a mark, or a key
+  // missing under it, as in `checkpoint: {}`) is the key's, not this node's.
   Node child(const std::string& key) const {
-    return Node(n_[key], path_.empty() ? key : path_ + "." + key, file_, line());
+    int kline = line();
+    if (n_.IsMap())
+      for (auto it = n_.begin(); it != n_.end(); ++it)
+        if (it->first.IsScalar() && it->first.Scalar() == key) {
+          if (const auto m = it->first.Mark(); m.line >= 0) kline = m.line + 1;
+          break;
+        }
+    return Node(n_[key], path_.empty() ? key : path_ + "." + key, file_, kline);
   }
   Node required(const std::string& key) const {
     if (!n_.IsMap()) fail("expected a mapping (key: value pairs)");
@@ -713,7 +722,10 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
   if (term.has("time")) c.end_time = term.child("time").positive();
   if (term.has("cycles")) {
     c.end_cycles = term.child("cycles").integer();
-    if (c.end_cycles < 0) term.child("cycles").fail("must not be negative");
+    // (0 would end the run before its first step; LS-DYNA's ENDCYC 0 means "no limit",
+    // which here is leaving `cycles` out.)
+    if (c.end_cycles < 1)
+      term.child("cycles").fail("must be at least 1 (leave cycles out for no cycle limit)");
   }
 
   if (top.has("time_step")) {

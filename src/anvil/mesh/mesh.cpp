@@ -110,7 +110,8 @@ namespace {
 constexpr int corner_xi[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
                                  {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
 
-// det J of the trilinear map at the natural coordinates xi.
+// det J of the trilinear map at the natural coordinates xi, from the corners' positions
+// relative to the first (the same wherever the element sits).
 double det_jacobian(const std::array<Vec3, 8>& x, const double (&xi)[3]) {
   const auto& s = corner_xi;
   double J[3][3] = {};
@@ -122,7 +123,7 @@ double det_jacobian(const std::array<Vec3, 8>& x, const double (&xi)[3]) {
         if (e != d) dN[d] *= (1 + s[a][e] * xi[e]);
     }
     for (int i = 0; i < 3; ++i)
-      for (int d = 0; d < 3; ++d) J[i][d] += x[a][i] * dN[d];
+      for (int d = 0; d < 3; ++d) J[i][d] += (x[a][i] - x[0][i]) * dN[d];
   }
   return hex8::determinant(J);
 }
@@ -142,7 +143,7 @@ double hex_volume(const std::array<Vec3, 8>& x) {
 double hex_centre_jacobian(const std::array<Vec3, 8>& x) {
   double xe[8][3];
   for (int a = 0; a < 8; ++a)
-    for (int i = 0; i < 3; ++i) xe[a][i] = x[a][i];
+    for (int i = 0; i < 3; ++i) xe[a][i] = x[a][i] - x[0][i]; // (differences: see det_jacobian)
   return hex8::centre_jacobian(xe);
 }
 
