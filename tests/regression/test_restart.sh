@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Restart reproduces the uninterrupted run bit for bit, on another number of ranks:
-#  1. the can crush (contact, self-contact, prescribed block) runs uninterrupted on 1 rank;
+#  1. the can crush (contact, self-contact, prescribed block: its velocity slows along a
+#     time history through the restart, so that the curve is taken up mid-way) runs
+#     uninterrupted on 1 rank;
 #  2. on 2 ranks it is stopped at cycle 700 (the path SIGTERM takes) and restarted on 3,
 #     into another output directory (whose history and field series must continue the
 #     stopped run's: the same rows as the uninterrupted run, every series entry readable);
@@ -13,8 +15,11 @@ deck_src=$3
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cd "$work"
-sed -e 's/termination: {time: 3.2e-3}/termination: {time: 2.5e-4}/' "$deck_src" > deck.yaml
+sed -e 's/termination: {time: 3.2e-3}/termination: {time: 2.5e-4}/' \
+    -e 's/velocity: \[0, 0, -10.0\]}/velocity: [0, 0, -10.0], curve: [[0, 1], [2.5e-4, 0.5]]}/' \
+    "$deck_src" > deck.yaml
 grep -q "termination: {time: 2.5e-4}" deck.yaml || { echo "the deck edit did not apply"; exit 1; }
+grep -q "curve: \[\[0, 1\], \[2.5e-4, 0.5\]\]" deck.yaml || { echo "the curve edit did not apply"; exit 1; }
 echo "checkpoint: {every: 5.0e-5}" >> deck.yaml
 run() { mpirun --oversubscribe -np "$@"; }
 

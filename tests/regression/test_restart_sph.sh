@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Restart with SPH particles reproduces the uninterrupted run bit for bit, on another
 # number of ranks (tests/data/decks/sph_restart.yaml: particles in contact with a plate,
-# plasticity, Johnson-Cook temperature, artificial stress, a prescribed velocity):
+# plasticity, Johnson-Cook temperature, artificial stress, a prescribed velocity history):
 #  1. the deck runs uninterrupted on 1 rank;
 #  2. on 2 ranks it is stopped at cycle 150 (the path SIGTERM takes), and that checkpoint
 #     is continued on 3 ranks and, separately, on 1;
