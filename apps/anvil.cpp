@@ -26,6 +26,31 @@ void print_warnings(const anvil::Config& config, const anvil::Comm& comm) {
   for (const auto& w : config.warnings) std::fprintf(stderr, "anvil: warning: %s\n", w.c_str());
 }
 
+// One line of `check` per boundary condition, as history.csv numbers their reactions
+// (bcN.fx ...): its selection and what it holds.
+std::string describe_condition(std::size_t n, const anvil::BoundaryCondition& bc) {
+  const auto& s = bc.nodes;
+  std::string where = s.name;
+  if (where.empty()) {
+    where = s.part ? "part " + *s.part : "all";
+    if (s.box)
+      where += fmt::format(" in box [{:g}, {:g}, {:g}]-[{:g}, {:g}, {:g}]", s.box->lo.x,
+                           s.box->lo.y, s.box->lo.z, s.box->hi.x, s.box->hi.y, s.box->hi.z);
+  }
+  const auto& on = bc.prescribed ? bc.components : bc.fix;
+  std::string comps;
+  for (int i = 0; i < 3; ++i)
+    if (on[static_cast<std::size_t>(i)]) comps += "xyz"[i];
+  std::string what = "fix " + comps;
+  if (bc.prescribed) {
+    const bool moved = bc.motion == anvil::BoundaryCondition::Motion::displacement;
+    what = fmt::format("{} {} [{:g}, {:g}, {:g}]", moved ? "displacement" : "velocity", comps,
+                       bc.value.x, bc.value.y, bc.value.z);
+    if (bc.curve) what += fmt::format(" x curve of {} points", bc.curve->t.size());
+  }
+  return fmt::format("  bc{:<3} {:<24} {}", n, where, what);
+}
+
 int check(const std::string& deck, const anvil::Comm& comm) {
   const anvil::Config config = anvil::read_input(deck);
   print_warnings(config, comm);
@@ -57,6 +82,12 @@ int check(const std::string& deck, const anvil::Comm& comm) {
       std::printf("  set  %-16s material %-16s mass %.6g kg, %lld particles\n",
                   config.particles[i].name.c_str(), config.particles[i].material.c_str(),
                   set_mass[i], static_cast<long long>(off[i + 1] - off[i]));
+  }
+  if (!config.boundary_conditions.empty()) {
+    std::printf("conditions  %zu (history.csv: bcN.fx, bcN.fy, bcN.fz)\n",
+                config.boundary_conditions.size());
+    for (std::size_t b = 0; b < config.boundary_conditions.size(); ++b)
+      std::printf("%s\n", describe_condition(b, config.boundary_conditions[b]).c_str());
   }
   if (sim.global_elements() == 0) {
     // The particles' step needs their first phase (wave speeds from the materials).

@@ -3,7 +3,8 @@
 
 Columns may be given exactly (tip.uz) or as shell patterns (tip.u?, '*.vz').  Columns
 of the same kind share a panel: displacements (ux, uy, uz) in mm, velocities (vx, vy,
-vz) in m/s, forces (wall0.force) in kN; any other column gets its own panel.
+vz) in m/s, forces (wall0.force, and the reactions bc0.fx ... bc0.fz) in kN; any other
+column gets its own panel.
 """
 
 import argparse
@@ -24,7 +25,7 @@ from anvil_results import (
 KINDS = [  # (field names, panel label, factor from SI)
     (("ux", "uy", "uz"), "displacement [mm]", 1e3),
     (("vx", "vy", "vz"), "velocity [m/s]", 1.0),
-    (("force",), "force [kN]", 1e-3),
+    (("force", "fx", "fy", "fz"), "force [kN]", 1e-3),
 ]
 
 

@@ -227,11 +227,12 @@ TEST(Determinism, ErodingContactSameBitsOnAnyRankCount) {
   if (Comm::world().rank() == 0) EXPECT_GT(max_ep, 0.08); // elements eroded
 }
 
-// The rigid walls' forces (history columns, not diagnostics): a block dragged with friction
-// on one wall and SPH particles striking another, their forces every cycle compared
-// with the 1-rank run's, exactly (each wall's impulses are summed in ascending node id,
-// then particle id).
-TEST(Determinism, WallForcesSameBitsOnAnyRankCount) {
+// The rigid walls' forces and the boundary conditions' reactions (history columns, not
+// diagnostics): a block dragged with friction on one wall and SPH particles striking
+// another, the particles' top held in x, their forces every cycle compared with the 1-rank
+// run's, exactly (each wall's impulses and each condition's forces are summed in
+// ascending node id, then particle id).
+TEST(Determinism, WallForcesAndReactionsSameBitsOnAnyRankCount) {
   const char* deck = R"(
 termination: {cycles: 120}
 materials:
@@ -246,6 +247,7 @@ particles:
          material: al, smoothing_ratio: 1.3}
 boundary_conditions:
   - {set: blk.zmax, velocity: [5.0, 2.0, -0.5]}
+  - {set: {part: ball, box: {min: [-1, -1, 0.0035], max: [1, 1, 1]}}, fix: [x]}
 initial_conditions:
   - {part: blk, velocity: [5.0, 2.0, 0.0]}
   - {part: ball, velocity: [50.0, 0, -300.0]}
@@ -254,6 +256,7 @@ rigid_walls:
   - {point: [0.03, 0, 0], normal: [0, 0, 1], friction: 0.2}
 )";
   const Config config = test::deck(deck);
+  // Per cycle: the two walls' forces, then the two conditions' six reaction components.
   auto forces = [&](const Comm& comm) {
     Simulation sim(config, comm);
     std::vector<double> f;
@@ -261,6 +264,7 @@ rigid_walls:
       sim.step();
       const Sample s = sim.sample();
       f.insert(f.end(), s.wall_force.begin(), s.wall_force.end());
+      f.insert(f.end(), s.reaction.begin(), s.reaction.end());
     }
     return f;
   };
@@ -268,14 +272,16 @@ rigid_walls:
   if (Comm::world().rank() != 0) return;
   const std::vector<double> s = forces(Comm::self());
   ASSERT_EQ(p.size(), s.size());
-  std::int64_t differing = 0, acting[2] = {0, 0};
+  std::int64_t differing = 0, acting[8] = {};
   for (std::size_t k = 0; k < s.size(); ++k) {
     if (!same_bits(p[k], s[k])) ++differing;
-    if (s[k] > 0) ++acting[k % 2];
+    if (s[k] != 0) ++acting[k % 8];
   }
-  EXPECT_EQ(differing, 0) << "wall forces differing from the 1-rank run";
+  EXPECT_EQ(differing, 0) << "wall forces or reactions differing from the 1-rank run";
   EXPECT_GT(acting[0], 50); // both walls act
   EXPECT_GT(acting[1], 10);
+  EXPECT_GT(acting[4], 50); // the block's driver in z
+  EXPECT_GT(acting[5], 10); // the particles' holder in x
 }
 
 } // namespace

@@ -54,7 +54,7 @@ PY
 stop 2 deck.yaml a 20
 sed -e 's/  - {name: tip, at: \[0, 0, 0\]}/&\n  - {name: top, at: [0, 0, 0.04]}/' deck.yaml > probe2.yaml
 run 3 "$anvil" run probe2.yaml -o b -q --restart a/checkpoint.anvil 2> b.err
-grep -q "history columns (probes, rigid walls) differ" b.err || { cat b.err; exit 1; }
+grep -q "history columns (probes, rigid walls, boundary conditions) differ" b.err || { cat b.err; exit 1; }
 grep -q "history-before-s000020.csv" b.err
 [ "$(widths b/history-before-s000020.csv)" -eq 20 ]
 widths b/history.csv > /dev/null

@@ -191,7 +191,7 @@ TEST(Cli, RunWritesTheOutputs) {
   std::string header;
   std::getline(h, header);
   EXPECT_EQ(header, "time,cycle,dt,kinetic,internal,hourglass,contact,external_work,total,"
-                    "top.ux,top.uy,top.uz,top.vx,top.vy,top.vz");
+                    "top.ux,top.uy,top.uz,top.vx,top.vy,top.vz,bc0.fx,bc0.fy,bc0.fz");
   std::stringstream pvd;
   pvd << std::ifstream(dir + "/results.pvd").rdbuf();
   EXPECT_NE(pvd.str().find("step_000002.pvtu"), std::string::npos) << pvd.str();

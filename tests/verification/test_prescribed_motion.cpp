@@ -18,11 +18,22 @@
 //    round-off of the position sums, one half-ulp of the largest coordinate (0.07 m) per
 //    step and per operation (x += dt v, u = x - x0), i.e. cycles * ulp(0.07 m); the same from
 //    an LS-DYNA keyword deck (VAD 2, SF and the curve's SFO).
+// 3. The reactions (history columns bcN.fx ...): a column in uniaxial strain, fixed at its
+//    base, its top pulled by a displacement ramp over 20 wave transits. References: (a)
+//    Newton's second law, summed over the nodes: the internal forces cancel, so over each
+//    step the reactions' sum times the velocity interval is the change of momentum, to
+//    round-off (tolerance 1e-9 of the largest |sum R| dt); (b) statics (uniaxial strain):
+//    the top's force M A u / L, M = E (1 - nu) / ((1 + nu) (1 - 2 nu)), plus the dynamic
+//    part of a column driven at constant speed v, a step wave rho c v A that doubles on
+//    reflection from the fixed base: tolerance 2 rho c v A (5% of the final static force).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -199,6 +210,66 @@ bar
     std::printf("displacement history: worst error %.2e m (nodes), %.2e m (particles), "
                 "%.2e m (keyword deck); round-off bound %.2e m, amplitude %.0e m\n",
                 worst_node, worst_particle, worst_keyword, bound, a);
+}
+
+TEST(PrescribedMotion, ReactionsBalanceMomentumAndTheStaticForce) {
+  const double L = 0.1, A = 1e-4, rho = 7850, E = 200e9, nu = 0.3, u_max = 1e-5;
+  const double M = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
+  const double c = std::sqrt(M / rho);
+  const double T = 20 * L / c, v = u_max / T;
+  const std::string deck = fmt::format(R"(
+termination: {{time: {}}}
+materials:
+  steel: {{model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}}
+parts:
+  column:
+    mesh: {{generate: box, min: [0, 0, 0], max: [0.01, 0.01, 0.1], divisions: [1, 1, 20]}}
+    material: steel
+boundary_conditions:
+  - {{set: column.xmin, fix: [x]}}
+  - {{set: column.xmax, fix: [x]}}
+  - {{set: column.ymin, fix: [y]}}
+  - {{set: column.ymax, fix: [y]}}
+  - {{set: column.zmin, fix: [z]}}
+  - {{set: column.zmax, displacement: [0, 0, {}], components: [z], curve: [[0, 0], [{}, 1]]}}
+)",
+                                       1.5 * T, u_max, T);
+  const Comm world = Comm::world();
+  Simulation sim(test::deck(deck), world);
+  auto momentum = [&] {
+    double p[3] = {0, 0, 0};
+    const auto& nd = sim.nodes();
+    for (std::size_t n = 0; n < nd.size(); ++n)
+      if (sim.fe().node_owned[n])
+        for (int i = 0; i < 3; ++i) p[i] += nd.mass[n] * nd.v[i][n];
+    world.sum(std::span<double>(p, 3));
+    return std::array<double, 3>{p[0], p[1], p[2]};
+  };
+  double worst_balance = 0, largest_impulse = 0, worst_static = 0;
+  while (!sim.finished()) {
+    const auto p0 = momentum();
+    const double dt_before = sim.clock().dt;
+    sim.step();
+    const double dt_avg = 0.5 * (dt_before + sim.clock().dt);
+    const auto p1 = momentum();
+    const Sample s = sim.sample();
+    for (int i = 0; i < 3; ++i) {
+      double sum = 0;
+      for (std::size_t b = 0; b < 6; ++b) sum += s.reaction[3 * b + i];
+      worst_balance = std::max(worst_balance, std::abs(sum * dt_avg - (p1[i] - p0[i])));
+      largest_impulse = std::max(largest_impulse, std::abs(sum * dt_avg));
+    }
+    const double u = u_max * std::min(s.time / T, 1.0);
+    worst_static = std::max(worst_static, std::abs(s.reaction[3 * 5 + 2] - M * A * u / L));
+  }
+  EXPECT_LT(worst_balance, 1e-9 * largest_impulse);
+  const double bound = 2 * rho * c * v * A;
+  EXPECT_LT(worst_static, bound);
+  if (world.rank() == 0)
+    std::printf("reactions: momentum balance %.2e N s (largest impulse %.2e N s); top force off "
+                "the static M A u / L by at most %.1f N (bound 2 rho c v A = %.1f N, static "
+                "force at the end %.1f N)\n",
+                worst_balance, largest_impulse, worst_static, bound, M * A * u_max / L);
 }
 
 } // namespace

@@ -221,6 +221,8 @@ std::string Outputs::history_header() const {
     for (const char* f : {"ux", "uy", "uz", "vx", "vy", "vz"})
       h += fmt::format(",{}.{}", p.name, f);
   for (std::size_t w = 0; w < c.rigid_walls.size(); ++w) h += fmt::format(",wall{}.force", w);
+  for (std::size_t b = 0; b < c.boundary_conditions.size(); ++b)
+    for (const char* f : {"fx", "fy", "fz"}) h += fmt::format(",bc{}.{}", b, f);
   return h;
 }
 
@@ -344,7 +346,8 @@ void Outputs::resume(const OutputState& state, const std::string& from) {
     std::string text = old_header + "\n";
     for (const auto& l : keep) text += l + "\n";
     write_file_atomic(before, text);
-    warn(fmt::format("restart: the deck's history columns (probes, rigid walls) differ from "
+    warn(fmt::format("restart: the deck's history columns (probes, rigid walls, boundary "
+                     "conditions) differ from "
                      "those of the run that wrote the checkpoint: history.csv starts at the "
                      "checkpoint, its {} earlier rows are in {}",
                      keep.size(), before));
@@ -374,6 +377,7 @@ void Outputs::write_history_row(const Sample& s) {
       s.kinetic, s.internal, s.hourglass, s.contact, s.external_work, s.total());
   for (double v : s.probes) row += fmt::format(",{:.17g}", v);
   for (double v : s.wall_force) row += fmt::format(",{:.17g}", v);
+  for (double v : s.reaction) row += fmt::format(",{:.17g}", v);
   std::fprintf(history_, "%s\n", row.c_str());
   std::fflush(history_);
   ++history_rows_;

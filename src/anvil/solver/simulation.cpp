@@ -424,9 +424,10 @@ void Simulation::apply_boundary_conditions(const Mesh& mesh) {
   update_prescribed_motions(0.0, 0.0); // the factors at t = 0
   constrained_.assign(nn, 0);
   for (int i = 0; i < 3; ++i) v_bc_[i].assign(nn, 0.0);
-  // The condition that prescribes each node component last (-1: none or fixed).
-  std::array<std::vector<int>, 3> source;
+  // The condition that constrains each node component last (-1: none).
+  auto& source = bc_source_;
   for (auto& s : source) s.assign(nn, -1);
+  for (auto& r : bc_reaction_) r.assign(nn, 0.0);
   for (std::size_t b = 0; b < bcs.size(); ++b) {
     const auto& bc = bcs[b];
     const auto ids = selected_nodes(mesh, bc.nodes);
@@ -437,7 +438,7 @@ void Simulation::apply_boundary_conditions(const Mesh& mesh) {
         if (!on) continue;
         constrained_[n] |= static_cast<std::uint8_t>(1u << i);
         v_bc_[i][n] = bc.prescribed ? bc.value[i] * motion_factor_[b] : 0.0;
-        source[i][n] = bc.prescribed ? static_cast<int>(b) : -1;
+        source[i][n] = static_cast<int>(b);
       }
     }
   }
@@ -448,7 +449,8 @@ void Simulation::apply_boundary_conditions(const Mesh& mesh) {
       for (int i = 0; i < 3; ++i) {
         if (constrained_[n] & (1u << i)) nodes_.v[i][n] = v_bc_[i][n];
         const int b = source[i][n];
-        if (b >= 0 && bcs[static_cast<std::size_t>(b)].curve)
+        if (b >= 0 && bcs[static_cast<std::size_t>(b)].prescribed &&
+            bcs[static_cast<std::size_t>(b)].curve)
           curved_components_.push_back({static_cast<int>(n), i, b});
       }
     }
@@ -689,6 +691,7 @@ void Simulation::predict() {
       const double v_old = nodes_.v[i][n];
       const double v_free = v_old + dt_avg * nodes_.f[i][n] / nodes_.mass[n];
       const double v_new = v_bc_[i][n];
+      bc_reaction_[i][n] = nodes_.mass[n] * (v_new - v_free) / dt_avg;
       if (fe_.node_owned[n]) work_bc += nodes_.mass[n] * (v_new - v_free) * 0.5 * (v_old + v_new);
     }
   }
@@ -828,6 +831,7 @@ void Simulation::correct() {
             work_c += f * dt_avg_ * nodes_.v[i][n];
             reaction -= f * dt_avg_ * nodes_.v[i][n];
           }
+          bc_reaction_[i][n] -= f;
           continue;
         }
         const double before = 0.5 * (v_prev_[i][n] + nodes_.v[i][n]);
@@ -855,8 +859,8 @@ void Simulation::correct() {
       for (const int l : fn) impulse(static_cast<std::size_t>(l));
     }
     double work = work_c; // (the same sum)
+    if (sph_) correct_particles(work, ke_change, reaction);
     external_work_ += reaction;
-    if (sph_) correct_particles(work, ke_change);
     contact_energy_ -= work;
     kinetic_local_ += ke_change;
   }
@@ -956,7 +960,38 @@ Sample Simulation::sample() const {
     std::vector<WallHit> all = comm_.allgatherv(std::span<const WallHit>(wall_hits_));
     wall_forces(all, dt_avg_, s.wall_force);
   }
+  s.reaction = reactions();
   return s;
+}
+
+// Per boundary condition, the force it applies to its nodes and particles over the current
+// step (fx, fy, fz): every rank's constrained components gathered and summed in ascending
+// node id, then particle id (DESIGN.md section 3: the same bits on any number of ranks).
+// Collective.
+std::vector<double> Simulation::reactions() const {
+  const auto& bcs = config_.boundary_conditions;
+  std::vector<double> out(3 * bcs.size(), 0.0);
+  if (bcs.empty()) return out;
+  std::vector<ReactionTerm> mine;
+  for (const int n : constrained_nodes_) {
+    if (!fe_.node_owned[static_cast<std::size_t>(n)]) continue;
+    for (int i = 0; i < 3; ++i)
+      if (const int b = bc_source_[i][n]; b >= 0)
+        mine.push_back({fe_.node_gid[n], b, i, bc_reaction_[i][n]});
+  }
+  if (sph_) {
+    const auto& pt = sph_->particles();
+    for (std::size_t k = 0; k < std::min(pt.size(), p_reaction_[0].size()); ++k)
+      for (int i = 0; i < 3; ++i)
+        if (const int b = pt.bc_source[i][k]; b >= 0 && (pt.constrained[k] & (1u << i)))
+          mine.push_back({global_nodes_ + pt.gid[k], b, i, p_reaction_[i][k]});
+  }
+  std::vector<ReactionTerm> all = comm_.allgatherv(std::span<const ReactionTerm>(mine));
+  std::sort(all.begin(), all.end(), [](const ReactionTerm& a, const ReactionTerm& b) {
+    return std::tie(a.condition, a.key, a.component) < std::tie(b.condition, b.key, b.component);
+  });
+  for (const auto& r : all) out[3 * static_cast<std::size_t>(r.condition) + r.component] += r.force;
+  return out;
 }
 
 double Simulation::balance_error(const Sample& s) const {

@@ -53,6 +53,7 @@ struct Sample {
   double total() const { return kinetic + internal + hourglass + contact; }
   std::vector<double> probes;     // per probe: ux, uy, uz, vx, vy, vz
   std::vector<double> wall_force; // per rigid wall: normal force, N
+  std::vector<double> reaction;   // per boundary condition: fx, fy, fz on its nodes, N
 };
 
 class Simulation {
@@ -162,7 +163,7 @@ private:
   double particle_internal_energy() const;
   void predict_particles(double dt_avg, double& ke, double& work);
   std::vector<ContactNodeItem>& particle_contact_items(double dt);
-  void correct_particles(double& contact_work, double& kinetic);
+  void correct_particles(double& contact_work, double& kinetic, double& reaction);
   void sample_particle_probe_velocities();
   void update_particles(double dt);
   // restore() for the particles; `from` names the checkpoint in messages. Collective.
@@ -203,6 +204,17 @@ private:
   };
   std::vector<double> motion_factor_;
   std::vector<CurvedComponent> curved_components_;
+  // Per local node and component: the condition that constrains it (-1: none), and the
+  // force it applies there over the current step, N (predict, correct; summed per
+  // condition by sample()). The particles' reactions, per own particle, in p_reaction_.
+  std::array<std::vector<int>, 3> bc_source_;
+  std::array<std::vector<double>, 3> bc_reaction_;
+  struct ReactionTerm { // one constrained component's force, for the ordered sum
+    std::int64_t key;   // node gid, or global node count + particle gid
+    std::int32_t condition, component;
+    double force;
+  };
+  std::vector<double> reactions() const;
 
   // Contact (null without a contact definition): the contact decomposition and the
   // contact force per local node of the current cycle.
@@ -230,6 +242,7 @@ private:
   // contact items of this cycle.
   std::unique_ptr<sph::SphPhase> sph_;
   std::array<std::vector<double>, 3> pv_prev_;
+  std::array<std::vector<double>, 3> p_reaction_;
   std::vector<std::uint8_t> sph_contact_set_;
   std::vector<ContactNodeItem> particle_items_;
   std::vector<int> particle_item_index_;

@@ -132,7 +132,7 @@ void Simulation::apply_particle_boundary_conditions() {
         if (!on) continue;
         pt.constrained[i] |= static_cast<std::uint8_t>(1u << k);
         pt.v_bc[k][i] = bc.prescribed ? bc.value[k] : 0.0;
-        pt.bc_curve[k][i] = bc.prescribed && bc.curve ? static_cast<int>(b) : -1;
+        pt.bc_source[k][i] = static_cast<int>(b);
       }
     }
   }
@@ -143,6 +143,7 @@ void Simulation::apply_particle_boundary_conditions() {
     for (int k = config_.sph.dimensions; k < 3; ++k) {
       pt.constrained[i] |= static_cast<std::uint8_t>(1u << k);
       pt.v_bc[k][i] = 0.0;
+      pt.bc_source[k][i] = -1; // (the model's plane, not a condition of the deck)
     }
   for (std::size_t i = 0; i < pt.size(); ++i)
     for (int k = 0; k < 3; ++k)
@@ -150,10 +151,10 @@ void Simulation::apply_particle_boundary_conditions() {
 }
 
 // A constrained particle component's velocity over the current step: its value, times
-// its condition's time history factor (update_prescribed_motions).
+// its condition's time history factor (update_prescribed_motions; 1 without a curve).
 double Simulation::particle_bc_velocity(int k, std::size_t i) const {
   const auto& pt = sph_->particles();
-  const int b = pt.bc_curve[k][i];
+  const int b = pt.bc_source[k][i];
   return b < 0 ? pt.v_bc[k][i] : pt.v_bc[k][i] * motion_factor_[static_cast<std::size_t>(b)];
 }
 
@@ -165,7 +166,10 @@ void Simulation::predict_particles(double dt_avg, double& ke, double& work) {
   auto& pt = sph_->particles();
   const std::size_t n = pt.size();
   const auto rate = sph_->energy_rate();
-  for (int k = 0; k < 3; ++k) pv_prev_[k].resize(n);
+  for (int k = 0; k < 3; ++k) {
+    pv_prev_[k].resize(n);
+    p_reaction_[k].resize(n);
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const double inv_m = 1.0 / pt.mass[i];
     double avg2 = 0;
@@ -177,6 +181,7 @@ void Simulation::predict_particles(double dt_avg, double& ke, double& work) {
       if (pt.constrained[i] & (1u << k)) {
         nv = particle_bc_velocity(k, i);
         work += pt.mass[i] * (nv - free) * 0.5 * (old + nv);
+        p_reaction_[k][i] = pt.mass[i] * (nv - free) / dt_avg;
       }
       pt.v[k][i] = nv;
       const double a = 0.5 * (old + nv);
@@ -233,9 +238,10 @@ std::vector<ContactNodeItem>& Simulation::particle_contact_items(double dt) {
 }
 
 // Cycle step 5 for the particles: the penalty forces the contact phase returned change
-// v(n+1/2) by dt_avg f / m; their work is added to `contact_work` (J) and the change of
-// the kinetic energy at t(n) to `kinetic` (J), as for nodes.
-void Simulation::correct_particles(double& contact_work, double& kinetic) {
+// v(n+1/2) by dt_avg f / m; their work is added to `contact_work` (J), the change of the
+// kinetic energy at t(n) to `kinetic` (J) and the constraints' work against them to
+// `reaction` (J), as for nodes.
+void Simulation::correct_particles(double& contact_work, double& kinetic, double& reaction) {
   auto& pt = sph_->particles();
   const auto f = contact_->extra_forces();
   const auto faces = contact_->extra_faces();
@@ -244,7 +250,15 @@ void Simulation::correct_particles(double& contact_work, double& kinetic) {
     pt.last_face[i] = faces[k];
     const double inv_m = dt_avg_ / pt.mass[i];
     for (int d = 0; d < 3; ++d) {
-      if (f[k][d] == 0.0 || (pt.constrained[i] & (1u << d))) continue;
+      if (f[k][d] == 0.0) continue;
+      if (pt.constrained[i] & (1u << d)) {
+        // As for nodes: the constraint cancels the impulse, the contact force still works
+        // on the particle and the constraint's reaction (external work) takes it back.
+        contact_work += f[k][d] * dt_avg_ * pt.v[d][i];
+        reaction -= f[k][d] * dt_avg_ * pt.v[d][i];
+        p_reaction_[d][i] -= f[k][d];
+        continue;
+      }
       const double before = 0.5 * (pv_prev_[d][i] + pt.v[d][i]);
       pt.v[d][i] += inv_m * f[k][d];
       const double after = 0.5 * (pv_prev_[d][i] + pt.v[d][i]);

@@ -32,8 +32,10 @@ struct Particles {
   std::vector<double> wave_speed;            // m/s, from the last material update
   std::vector<std::uint8_t> constrained;     // bit i: velocity component i is prescribed
   std::array<std::vector<double>, 3> v_bc;   // the prescribed value, m/s
-  // The boundary condition (deck index) whose time history scales v_bc, or -1 (constant).
-  std::array<std::vector<int>, 3> bc_curve;
+  // The boundary condition (deck index) that constrains the component (its time history
+  // scales v_bc; its reaction sums the component's), or -1 (none, or the plane of a 2-D
+  // model).
+  std::array<std::vector<int>, 3> bc_source;
   std::vector<std::int64_t> last_face; // contact face touched last cycle, or -1
 
   std::size_t size() const { return mass.size(); }
@@ -57,7 +59,7 @@ struct Particles {
     fn(wave_speed);
     fn(constrained);
     for (auto& a : v_bc) fn(a);
-    for (auto& a : bc_curve) fn(a);
+    for (auto& a : bc_source) fn(a);
     fn(last_face);
   }
 };
