@@ -40,6 +40,12 @@ def parse_args(argv=None):
                    help="history column(s), e.g. tip.uz; shell patterns like 'tip.v*' allowed")
     p.add_argument("-o", "--output", help="PNG to write (default OUTDIR/probes.png)")
     p.add_argument("--title", help="plot title (default: the deck title in summary.json)")
+    p.add_argument("--x", metavar="COLUMN",
+                   help="plot against this column instead of time (a force against a "
+                        "displacement: bc1.fz --x block.uz)")
+    p.add_argument("--negate", action="store_true",
+                   help="plot the columns' negatives (a driver's reaction as a crush force)")
+    p.add_argument("--negate-x", action="store_true", help="negate the --x column")
     return p.parse_args(argv)
 
 
@@ -74,22 +80,32 @@ def group_columns(columns):
     return [(label, factor, cols) for (label, factor), cols in groups.items()]
 
 
-def plot(h, columns, title):
-    """One panel per kind of column, shared time axis; returns the Figure."""
+def plot(h, columns, title, x=None, negate=False, negate_x=False):
+    """One panel per kind of column, sharing the time axis or the column `x`; returns the
+    Figure."""
     plt = use_agg()
     groups = group_columns(columns)
-    t, tu, xlim = time_axis(h)
+    if x is None:
+        t, tu, xlim = time_axis(h)
+        xlabel = f"time [{tu}]"
+    else:
+        (xunit, xfactor, _), = group_columns([x])
+        t = h[x] * xfactor * (-1.0 if negate_x else 1.0)
+        xlabel = f"{'-' if negate_x else ''}{x}" + (f" ({xunit})" if xunit != x else "")
+        xlim = None
+    sign = -1.0 if negate else 1.0
     marker = dict(marker="o") if len(h) == 1 else {}  # a single point draws no line
     fig, axes = plt.subplots(len(groups), 1, sharex=True, squeeze=False,
                              figsize=(7.5, 2.0 + 2.3 * len(groups)))
     for ax, (label, factor, cols) in zip(axes[:, 0], groups):
         for col in cols:
-            ax.plot(t, h[col] * factor, label=col, **marker)
+            ax.plot(t, h[col] * factor * sign, label=("-" if negate else "") + col, **marker)
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
         ax.legend(loc="best", fontsize=9)
-    axes[-1, 0].set_xlabel(f"time [{tu}]")
-    axes[-1, 0].set_xlim(*xlim)  # one history row: a window around the point (time_axis)
+    axes[-1, 0].set_xlabel(xlabel)
+    if xlim is not None:
+        axes[-1, 0].set_xlim(*xlim)  # one history row: a window around the point (time_axis)
     axes[0, 0].set_title(title, fontsize=11)
     fig.align_ylabels(axes[:, 0])
     fig.tight_layout()
@@ -101,10 +117,11 @@ def main(argv=None):
     args = parse_args(argv)
     h = read_history(args.outdir)
     columns = resolve_columns(h, args.columns)
+    x = resolve_columns(h, [args.x])[0] if args.x else None
     base = args.outdir if os.path.isdir(args.outdir) else (os.path.dirname(args.outdir) or ".")
     summary = read_summary(base)
     title = args.title or title_of(summary, "anvil probe history")
-    fig = plot(h, columns, title)
+    fig = plot(h, columns, title, x, args.negate, args.negate_x)
     out = args.output or os.path.join(base, "probes.png")
     save_figure(fig, out)
     print(out)

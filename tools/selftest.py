@@ -674,6 +674,8 @@ def check_tools(outdir, tmp):
         (["plot_decomposition.py", outdir, "--field", "displacement.z", "--time", "1e-5",
           "-o", f"{tmp}/uz.png"], "uz.png"),
         (["plot_probe.py", outdir, "tip.uz", "tip.v*", "-o", f"{tmp}/probe.png"], "probe.png"),
+        (["plot_probe.py", outdir, "tip.vz", "--x", "tip.uz", "--negate", "--negate-x", "-o",
+          f"{tmp}/probe_x.png"], "probe_x.png"),
     ]
     for args, png in plots:
         run_tool(args, 0)
