@@ -327,6 +327,16 @@ TEST(Deck, PrescribedMotionCurves) {
                {"deck.yaml:18", "boundary_conditions[1]", "needs its time history"});
   expect_error(bc, "{set: bar.top, displacement: [0, 0, 1.0], curve: [[0, 1], [1, 1]]}",
                {"deck.yaml:18", "boundary_conditions[1].curve", "value at t = 0 must be 0"});
+  // 0 to round-off is 0 (QA round 23: 5.55e-17 from a sum that is 0 on paper was refused).
+  std::string round_off = good;
+  round_off.replace(round_off.find(bc), bc.size(),
+                    "{set: bar.top, displacement: [0, 0, 1.0], curve: [[0, 5.0e-17], [1, 1]]}");
+  EXPECT_NO_THROW(test::deck(round_off));
+  // Finite values whose product is not (QA round 23: an inverted element, exit 3, later).
+  expect_error(bc, "{set: bar.top, velocity: [0, 0, 1.0e300], curve: [[0, 0], [1, 1.0e10]]}",
+               {"deck.yaml:18", "boundary_conditions[1].curve", "overflows"});
+  expect_error(bc, "{set: bar.top, displacement: [0, 0, 1.0e10], curve: [[0, 0], [1.0e-300, 1]]}",
+               {"deck.yaml:18", "boundary_conditions[1].curve", "velocity", "overflows"});
   expect_error(bc, "{set: bar.top, velocity: [0, 0, 1.0], displacement: [0, 0, 1.0]}",
                {"deck.yaml:18", "exactly one of 'fix', 'velocity' or 'displacement'"});
   expect_error("{set: impact_face, fix: [z]}", "{set: impact_face, fix: [z], curve: [[0, 1]]}",

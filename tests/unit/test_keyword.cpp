@@ -601,7 +601,8 @@ TEST(Keyword, SpcIdCardComesOnceBeforeTheConstraints) {
   EXPECT_EQ(m.node_sets.at("spc_xyz"), (std::vector<std::int64_t>{9, 10, 11}));
   std::vector<std::string> sets;
   for (const auto& bc : c.boundary_conditions) sets.push_back(bc.nodes.name);
-  EXPECT_EQ(sets, (std::vector<std::string>{"nodeset_7", "nodeset_8", "nodeset_9", "spc_xyz"}));
+  // In card order: the SPC_SET of the deck, then this SPC_NODE_ID, then the two sets.
+  EXPECT_EQ(sets, (std::vector<std::string>{"nodeset_7", "spc_xyz", "nodeset_8", "nodeset_9"}));
   // Two data cards: the second is a constraint, not an ID card (it was read as NID = 0).
   EXPECT_NO_THROW(kw(with(good, "*END",
                           "*BOUNDARY_SPC_NODE_ID\n         1\n        11         0         1\n"
@@ -612,8 +613,11 @@ TEST(Keyword, SpcIdCardComesOnceBeforeTheConstraints) {
 // VAD 0 (velocity) or 2 (displacement), SF times the curve; the curve's points in fields of
 // 20 columns, t = SFA (A + OFFA), value = SFO (O + OFFO). Single nodes with the same motion
 // share one set, as constraints do.
-const std::string motion_cards = R"(*BOUNDARY_PRESCRIBED_MOTION_SET
-         7         3         2         5      0.01
+const std::string motion_cards = R"(*SET_NODE_LIST
+         8
+         9        10        11        12
+*BOUNDARY_PRESCRIBED_MOTION_SET
+         8         3         2         5      0.01
 *BOUNDARY_PRESCRIBED_MOTION_NODE
         12         1         0         6
         11         1         0         6
@@ -633,7 +637,7 @@ TEST(Keyword, PrescribedMotionsAndTheirCurves) {
   ASSERT_EQ(c.boundary_conditions.size(), 3u); // the SPC, then the two motions
   EXPECT_TRUE(c.warnings.empty());
   const BoundaryCondition& d = c.boundary_conditions[1];
-  EXPECT_EQ(d.nodes.name, "nodeset_7");
+  EXPECT_EQ(d.nodes.name, "nodeset_8");
   EXPECT_TRUE(d.prescribed);
   EXPECT_EQ(d.motion, BoundaryCondition::Motion::displacement);
   EXPECT_EQ(d.components, (std::array<bool, 3>{false, false, true}));
@@ -658,7 +662,7 @@ TEST(Keyword, PrescribedMotionErrors) {
   // Without OFFO the displacement curve starts at -1: not from the initial position.
   expect_error(with(ok, "       1.0       0.5", "       1.0       0.0"),
                {fmt::format("model.k:{}: *BOUNDARY_PRESCRIBED_MOTION_SET.LCID", set_card),
-                "curve 5 (VAD 2)", "found -1"});
+                "curve 5: a displacement history", "found -1"});
   expect_error(with(ok, "         3         2         5", "         3         1         5"),
                {"*BOUNDARY_PRESCRIBED_MOTION_SET.VAD", "VAD = 1 is not supported"});
   expect_error(with(ok, "         3         2         5", "         4         2         5"),
@@ -687,6 +691,53 @@ TEST(Keyword, PrescribedMotionErrors) {
   EXPECT_NE(c.warnings[0].find("curve 6 ends at t = 5e-05 before the end time 0.0001"),
             std::string::npos)
       << c.warnings[0];
+}
+
+// QA round 23: conditions apply in card order (a later card wins on the components two
+// hold, with a warning); a curve no motion names is not read even when a motion names
+// another; DEATH is checked on every card of a node group and without ENDTIM; a scale
+// factor that overflows the curve is an input error, not an inverted element later.
+TEST(Keyword, PrescribedMotionsInCardOrder) {
+  const std::string motion =
+      "*BOUNDARY_PRESCRIBED_MOTION_SET\n         7         3         0         6\n";
+  const std::string curve6 = "*DEFINE_CURVE\n         6\n                 0.0                 0.0\n"
+                             "              1.0E-4                 3.0\n";
+  // The SPC on set 7 (all components) comes first in the deck: the motion's z wins.
+  Config c = kw(with(good, "*END", motion + curve6 + "*END"));
+  ASSERT_EQ(c.boundary_conditions.size(), 2u);
+  EXPECT_FALSE(c.boundary_conditions[0].prescribed);
+  EXPECT_TRUE(c.boundary_conditions[1].prescribed);
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find(": 4 node components this card holds are held by the card at "
+                               "model.k:"),
+            std::string::npos)
+      << c.warnings[0];
+  // The motion before the SPC: the fix wins.
+  const std::string spc = "*BOUNDARY_SPC_SET\n         7         0         1         1         1\n";
+  c = kw(with(with(good, spc, ""), "*END", motion + spc + curve6 + "*END"));
+  ASSERT_EQ(c.boundary_conditions.size(), 2u);
+  EXPECT_TRUE(c.boundary_conditions[0].prescribed);
+  EXPECT_FALSE(c.boundary_conditions[1].prescribed);
+  // A curve for dynamic relaxation that no motion names: not read, no error.
+  const std::string sidr1 = "*DEFINE_CURVE\n         9         1\n                 0.0       0.0\n";
+  EXPECT_NO_THROW(kw(with(good, "*END", motion + curve6 + sidr1 + "*END")));
+  // DEATH on the second card of a node group, and DEATH without ENDTIM.
+  const std::string nodes =
+      "*BOUNDARY_PRESCRIBED_MOTION_NODE\n        12         1         0         6\n"
+      "        11         1         0         6" +
+      std::string(20, ' ') + "    5.0E-5\n"; // SF, VID blank; DEATH
+  expect_error(with(good, "*END", nodes + curve6 + "*END"),
+               {"*BOUNDARY_PRESCRIBED_MOTION_NODE.DEATH", "before the end time"});
+  expect_error(
+      with(with(good, "   1.0E-04\n", "       0.0       100\n"), "*END",
+           motion.substr(0, motion.size() - 1) + "                    5.0E-5\n" + curve6 + "*END"),
+      {"*BOUNDARY_PRESCRIBED_MOTION_SET.DEATH", "no ENDTIM"});
+  // SF 1e308 times a curve value of 3: not a finite velocity.
+  expect_error(with(good, "*END",
+                    "*BOUNDARY_PRESCRIBED_MOTION_SET\n         7         3         0         6"
+                    "   1.0E308\n" +
+                        curve6 + "*END"),
+               {"*BOUNDARY_PRESCRIBED_MOTION_SET.LCID", "overflows"});
 }
 
 // keyword.md: *MAT_JOHNSON_COOK with G alone takes the bulk modulus rho C^2 of the part's

@@ -6,7 +6,9 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -33,14 +35,34 @@ struct TimeCurve {
   }
 };
 
-// Why a curve cannot be a displacement history (it must start from the initial position,
-// 0 at t = 0), or "" when it can.
-inline std::string displacement_history_problem(const TimeCurve& c) {
-  const double d0 = c.at(0.0);
-  if (d0 == 0.0) return {};
-  return "a displacement history starts from the initial position: its value at t = 0 must "
-         "be 0, found " +
-         std::to_string(d0);
+// Why `amplitude` times this curve cannot be a prescribed motion, or "" when it can: a
+// displacement history starts from the initial position (0 at t = 0, to round-off of its
+// largest value); the motion's values, and a displacement's rates (the velocities it
+// prescribes), must be finite numbers.
+inline std::string motion_curve_problem(double amplitude, const TimeCurve& c, bool displacement) {
+  auto text = [](const char* format, double x) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf, format, x);
+    return std::string(buf);
+  };
+  double largest = 0;
+  for (const double v : c.value) largest = std::max(largest, std::abs(v));
+  if (displacement && std::abs(c.at(0.0)) > 1e-12 * largest)
+    return text("a displacement history starts from the initial position: its value at t = 0 "
+                "must be 0, found %g",
+                c.at(0.0));
+  for (std::size_t k = 0; k < c.t.size(); ++k) {
+    if (!std::isfinite(amplitude * c.value[k]))
+      return text("the motion's value at t = %g overflows (the scale factor times the curve "
+                  "is not a finite number)",
+                  c.t[k]);
+    if (displacement && k > 0 &&
+        !std::isfinite(amplitude * ((c.value[k] - c.value[k - 1]) / (c.t[k] - c.t[k - 1]))))
+      return text("the velocity this displacement history prescribes before t = %g overflows "
+                  "(points too close in time for their values)",
+                  c.t[k]);
+  }
+  return {};
 }
 
 } // namespace anvil

@@ -929,9 +929,13 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
         if (n.has("curve")) bc.curve = parse_curve(n.child("curve"));
         if (moved && !bc.curve)
           n.fail("a displacement needs its time history: add curve: [[t0, 0], [t1, 1], ...]");
-        if (const auto problem = moved ? displacement_history_problem(*bc.curve) : "";
-            !problem.empty())
-          n.child("curve").fail(problem);
+        if (bc.curve) {
+          const double amplitude =
+              std::max({std::abs(bc.value.x), std::abs(bc.value.y), std::abs(bc.value.z)});
+          if (const auto problem = motion_curve_problem(amplitude, *bc.curve, moved);
+              !problem.empty())
+            n.child("curve").fail(problem);
+        }
       }
       c.boundary_conditions.push_back(bc);
     }

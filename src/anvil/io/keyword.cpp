@@ -589,6 +589,7 @@ struct Spc {
   std::array<bool, 3> fix{};
   Where at;
   std::string keyword;
+  std::int64_t seq = 0; // the card's place among the constraints and motions
 };
 
 // *DEFINE_CURVE, scaled and offset: a time history for prescribed motions.
@@ -608,6 +609,7 @@ struct MotionCard {
   double sf = 1, death = 0;
   Where at;
   std::string keyword;
+  std::int64_t seq = 0; // the card's place among the constraints and motions
 };
 
 struct VelocityGen {
@@ -809,7 +811,7 @@ private:
       nodes_.push_back(x);
       node_at_.push_back(where_of(*l));
       node_ids_.push_back(nid);
-      if (tc != 0) node_tc_.emplace_back(nid, static_cast<int>(tc), where_of(*l));
+      if (tc != 0) node_tc_.push_back({nid, static_cast<int>(tc), where_of(*l), card_seq_++});
     }
   }
 
@@ -1269,6 +1271,7 @@ private:
       }
       s.at = where_of(l);
       s.keyword = b.name;
+      s.seq = card_seq_++;
       spcs_.push_back(s);
     }
   }
@@ -1307,6 +1310,7 @@ private:
         card.fail("BIRTH", "BIRTH > 0 is not supported: anvil prescribes the motion from t = 0");
       m.at = where_of(*l);
       m.keyword = b.name;
+      m.seq = card_seq_++;
       motions_.push_back(m);
     }
   }
@@ -1349,22 +1353,60 @@ private:
     return cc;
   }
 
-  // Curve `lcid`, read from the first *DEFINE_CURVE that defines it; an error at `at`
-  // when none does, at the curve when it is defined twice.
+  // The LCID a *DEFINE_CURVE block gives, or 0 when its first card gives none: a curve no
+  // motion names is never read, and need not be readable.
+  static std::int64_t curve_id(const Block& b) {
+    try {
+      Cursor c(b);
+      skip_title(b, c);
+      const Line l = c.next();
+      return Card(b, l, {10, 10, 10, 10, 10, 10, 10, 10}).integer(0, "LCID", 0);
+    } catch (const InputError&) {
+      return 0;
+    }
+  }
+
+  // Curve `lcid`, read from the *DEFINE_CURVE that defines it (an index of the curves by
+  // LCID, made at the first call); an error at `at` when none does, at the second when two
+  // do.
   const CurveCard& curve(std::int64_t lcid, const SourceLocation& at) {
     if (const auto it = curves_.find(lcid); it != curves_.end()) return it->second;
-    const CurveCard* found = nullptr;
-    for (const Block* b : curve_blocks_) {
-      CurveCard cc = read_curve(*b);
-      if (cc.lcid != lcid) continue;
-      if (found)
-        throw InputError(
-            cc.at.loc("*" + b->name + ".LCID"),
-            fmt::format("curve {} is defined twice (first at {})", lcid, found->at.str()));
-      found = &curves_.emplace(lcid, std::move(cc)).first->second;
+    if (curve_index_.empty())
+      for (const Block* b : curve_blocks_) curve_index_.emplace(curve_id(*b), b);
+    const auto [first, last] = curve_index_.equal_range(lcid);
+    if (first == last)
+      throw InputError(at, fmt::format("curve {} is not defined (*DEFINE_CURVE)", lcid));
+    CurveCard cc = read_curve(*first->second);
+    if (std::next(first) != last)
+      throw InputError(read_curve(*std::next(first)->second).at.loc("*DEFINE_CURVE.LCID"),
+                       fmt::format("curve {} is defined twice (first at {})", lcid, cc.at.str()));
+    return curves_.emplace(lcid, std::move(cc)).first->second;
+  }
+
+  // A warning for each pair of conditions that hold the same node components, not both
+  // fixing them: the later card wins there (conditions apply in card order).
+  static void warn_of_held_twice(const Config& c, const Mesh& mesh,
+                                 std::vector<std::string>& warnings) {
+    const auto& bcs = c.boundary_conditions;
+    std::vector<std::array<int, 3>> holder(mesh.nodes.size(), {-1, -1, -1});
+    std::map<std::pair<int, int>, std::int64_t> clashes; // (earlier, later) -> components
+    for (std::size_t b = 0; b < bcs.size(); ++b) {
+      const auto& on = bcs[b].prescribed ? bcs[b].components : bcs[b].fix;
+      for (const std::int64_t n : mesh.node_sets.at(bcs[b].nodes.name))
+        for (std::size_t i = 0; i < 3; ++i) {
+          if (!on[i]) continue;
+          int& h = holder[static_cast<std::size_t>(n)][i];
+          if (h >= 0 && (bcs[b].prescribed || bcs[static_cast<std::size_t>(h)].prescribed))
+            ++clashes[{h, static_cast<int>(b)}];
+          h = static_cast<int>(b);
+        }
     }
-    if (!found) throw InputError(at, fmt::format("curve {} is not defined (*DEFINE_CURVE)", lcid));
-    return *found;
+    for (const auto& [pair, count] : clashes)
+      warnings.push_back(fmt::format(
+          "{}: {} node components this card holds are held by the card at {} too; the later "
+          "card wins there (anvil applies constraints and motions in card order)",
+          bcs[static_cast<std::size_t>(pair.second)].where.str(), count,
+          bcs[static_cast<std::size_t>(pair.first)].where.str()));
   }
 
   void velocity_generation(const Block& b) {
@@ -1728,7 +1770,14 @@ private:
   std::vector<Where> node_at_;
   std::vector<std::int64_t> node_ids_;
   std::unordered_map<std::int64_t, std::int64_t> node_index_;
-  std::vector<std::tuple<std::int64_t, int, Where>> node_tc_; // *NODE TC constraints
+  struct NodeTc { // a *NODE card's TC constraint
+    std::int64_t nid;
+    int tc;
+    Where at;
+    std::int64_t seq;
+  };
+  std::vector<NodeTc> node_tc_;
+  std::int64_t card_seq_ = 0; // constraint and motion cards so far (their order)
   std::vector<RawElement> elements_;
   std::unordered_map<std::int64_t, std::size_t> element_index_;
   std::vector<PartCard> parts_;
@@ -1739,8 +1788,9 @@ private:
   std::map<std::int64_t, IdSet> node_sets_, part_sets_;
   std::vector<Spc> spcs_;
   std::vector<MotionCard> motions_;
-  std::vector<const Block*> curve_blocks_;   // *DEFINE_CURVE, read by curve()
-  std::map<std::int64_t, CurveCard> curves_; // those read
+  std::vector<const Block*> curve_blocks_;                // *DEFINE_CURVE, read by curve()
+  std::multimap<std::int64_t, const Block*> curve_index_; // by LCID (0: none readable)
+  std::map<std::int64_t, CurveCard> curves_;              // those read
   std::vector<VelocityGen> velocities_;
   std::vector<ContactCard> contacts_;
   std::vector<WallCard> walls_;
@@ -2017,65 +2067,85 @@ Config KeywordReader::config(const std::string& deck_file) {
     }
   }
 
-  // Constraints: *BOUNDARY_SPC_SET by set; single nodes (*BOUNDARY_SPC_NODE, *NODE TC)
-  // grouped by the components they fix, one set each, so that a deck with thousands of
-  // them makes seven conditions, not thousands.
-  std::map<int, std::pair<std::vector<std::int64_t>, Where>> single; // mask -> nodes
-  for (const auto& s : spcs_) {
-    if (!s.fix[0] && !s.fix[1] && !s.fix[2]) continue; // rotations only
-    if (s.set != 0) {
-      BoundaryCondition bc;
-      bc.nodes.name = node_set_name(s.set, s.at, "*" + s.keyword + ".NSID");
-      bc.nodes.where = s.at.loc("*" + s.keyword);
-      bc.fix = s.fix;
-      bc.where = bc.nodes.where;
-      c.boundary_conditions.push_back(bc);
+  // Constraints and prescribed motions become conditions in card order, so that a later
+  // card wins on the node components two hold, as in the YAML deck: one condition per card
+  // by set; single nodes (*BOUNDARY_SPC_NODE, *NODE TC, *BOUNDARY_PRESCRIBED_MOTION_NODE)
+  // grouped by what they hold, one set each at their first card's place, so that a deck
+  // with thousands of them makes a few conditions, not thousands.
+  std::vector<std::pair<std::int64_t, BoundaryCondition>> ordered; // (card seq, condition)
+  auto fix_condition = [&](std::int64_t seq, const std::string& set_name,
+                           const SourceLocation& where, std::array<bool, 3> fix) {
+    BoundaryCondition bc;
+    bc.nodes.name = set_name;
+    bc.nodes.where = where;
+    bc.fix = fix;
+    bc.where = where;
+    ordered.emplace_back(seq, std::move(bc));
+  };
+  struct SingleFix {
+    std::vector<std::int64_t> ids;
+    Where at;
+    std::int64_t seq = 0;
+  };
+  std::map<int, SingleFix> single; // fixed-component mask -> nodes
+  auto add_single = [&](int mask, std::int64_t pos, const Where& at, std::int64_t seq) {
+    SingleFix& g = single[mask];
+    if (g.ids.empty() || seq < g.seq) {
+      g.at = at;
+      g.seq = seq;
+    }
+    g.ids.push_back(pos);
+  };
+  for (const auto& sp : spcs_) {
+    if (!sp.fix[0] && !sp.fix[1] && !sp.fix[2]) continue; // rotations only
+    if (sp.set != 0) {
+      fix_condition(sp.seq, node_set_name(sp.set, sp.at, "*" + sp.keyword + ".NSID"),
+                    sp.at.loc("*" + sp.keyword), sp.fix);
     } else {
-      const auto pos = node_position(s.node, s.at, "*" + s.keyword + ".NID", "the constraint");
-      const int mask = (s.fix[0] ? 1 : 0) | (s.fix[1] ? 2 : 0) | (s.fix[2] ? 4 : 0);
-      auto& [ids, at] = single[mask];
-      if (ids.empty()) at = s.at;
-      ids.push_back(pos);
+      const auto pos = node_position(sp.node, sp.at, "*" + sp.keyword + ".NID", "the constraint");
+      add_single((sp.fix[0] ? 1 : 0) | (sp.fix[1] ? 2 : 0) | (sp.fix[2] ? 4 : 0), pos, sp.at,
+                 sp.seq);
     }
   }
-  for (const auto& [nid, tc, at] : node_tc_) {
+  for (const auto& t : node_tc_) {
     // TC: 1 x, 2 y, 3 z, 4 x and y, 5 y and z, 6 z and x, 7 all.
     static constexpr int masks[8] = {0, 1, 2, 4, 3, 6, 5, 7};
-    auto& [ids, first] = single[masks[tc]];
-    if (ids.empty()) first = at;
-    ids.push_back(node_index_.at(nid));
+    add_single(masks[t.tc], node_index_.at(t.nid), t.at, t.seq);
   }
-  for (auto& [mask, entry] : single) {
-    auto& [ids, at] = entry;
-    std::sort(ids.begin(), ids.end());
-    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  for (auto& [mask, g] : single) {
+    std::sort(g.ids.begin(), g.ids.end());
+    g.ids.erase(std::unique(g.ids.begin(), g.ids.end()), g.ids.end());
     const std::string name =
         fmt::format("spc_{}{}{}", mask & 1 ? "x" : "", mask & 2 ? "y" : "", mask & 4 ? "z" : "");
-    mesh.node_sets[name] = ids;
-    BoundaryCondition bc;
-    bc.nodes.name = name;
-    bc.nodes.where = at.loc("*BOUNDARY_SPC_NODE");
-    bc.fix = {(mask & 1) != 0, (mask & 2) != 0, (mask & 4) != 0};
-    bc.where = bc.nodes.where;
-    c.boundary_conditions.push_back(bc);
+    mesh.node_sets[name] = g.ids;
+    fix_condition(g.seq, name, g.at.loc("*BOUNDARY_SPC_NODE"),
+                  {(mask & 1) != 0, (mask & 2) != 0, (mask & 4) != 0});
   }
 
-  // Prescribed motions: one condition per card by set; single nodes grouped by what they
-  // prescribe, one set each, as the constraints are.
+  // A motion card's own checks (each card of a group of single nodes too).
+  auto check_motion = [&](const MotionCard& m) {
+    const std::string key = "*" + m.keyword + ".DEATH";
+    // LS-DYNA's "never" is 1e28; anything below 1e20 is a time.
+    if (m.death == 0 || m.death >= 1e20) return;
+    if (endtim_ == 0)
+      throw InputError(m.at.loc(key),
+                       fmt::format("DEATH = {} with no ENDTIM (*CONTROL_TERMINATION) is not "
+                                   "supported: anvil prescribes the motion to the end of the "
+                                   "run, so give an ENDTIM no later than DEATH",
+                                   m.death));
+    if (m.death < endtim_)
+      throw InputError(m.at.loc(key),
+                       fmt::format("DEATH = {} before the end time {} is not supported: anvil "
+                                   "prescribes the motion to the end of the run",
+                                   m.death, endtim_));
+  };
   std::set<std::int64_t> curves_warned;
   auto motion_condition = [&](const MotionCard& m, const std::string& set_name) {
     const std::string key = "*" + m.keyword;
     const CurveCard& cc = curve(m.lcid, m.at.loc(key + ".LCID"));
     const TimeCurve& tc = cc.curve;
-    if (m.displacement)
-      if (const auto problem = displacement_history_problem(tc); !problem.empty())
-        throw InputError(m.at.loc(key + ".LCID"),
-                         fmt::format("curve {} (VAD 2): {}", m.lcid, problem));
-    if (m.death != 0 && endtim_ > 0 && m.death < endtim_)
-      throw InputError(m.at.loc(key + ".DEATH"),
-                       fmt::format("DEATH = {} before the end time {} is not supported: anvil "
-                                   "prescribes the motion to the end of the run",
-                                   m.death, endtim_));
+    if (const auto problem = motion_curve_problem(m.sf, tc, m.displacement); !problem.empty())
+      throw InputError(m.at.loc(key + ".LCID"), fmt::format("curve {}: {}", m.lcid, problem));
     const std::size_t last = tc.t.size() - 1;
     if (endtim_ > tc.t[last] && last > 0 && tc.value[last] != tc.value[last - 1] &&
         curves_warned.insert(m.lcid).second)
@@ -2094,12 +2164,13 @@ Config KeywordReader::config(const std::string& deck_file) {
     bc.value[m.dof] = m.sf;
     bc.curve = tc;
     bc.where = bc.nodes.where;
-    c.boundary_conditions.push_back(bc);
+    ordered.emplace_back(m.seq, std::move(bc));
   };
   std::map<std::tuple<int, bool, std::int64_t, double>,
            std::pair<std::vector<std::int64_t>, MotionCard>>
       moved; // single nodes by (DOF, VAD, LCID, SF): their nodes and first card
   for (const auto& m : motions_) {
+    check_motion(m);
     if (m.set != 0) {
       motion_condition(m, node_set_name(m.set, m.at, "*" + m.keyword + ".NSID"));
     } else {
@@ -2118,6 +2189,10 @@ Config KeywordReader::config(const std::string& deck_file) {
     mesh.node_sets[name] = ids;
     motion_condition(first, name);
   }
+  std::stable_sort(ordered.begin(), ordered.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (auto& [seq, bc] : ordered) c.boundary_conditions.push_back(std::move(bc));
+  warn_of_held_twice(c, mesh, warnings);
 
   const auto shared = std::make_shared<const Mesh>(std::move(mesh));
   for (auto& pc : c.parts) pc.mesh.embedded = shared;

@@ -954,6 +954,10 @@ Sample Simulation::sample() const {
   s.external_work = local[3];
   s.probes = probe_local_;
   comm_.sum(std::span<double>(s.probes));
+  // A probe's value is its rank's; the other ranks add +0. On one rank a -0 (a curve that
+  // scaled a negative value to 0) stayed -0, on several it became +0 (QA round 23): the
+  // same value, other bits. Adding +0 makes every zero +0.
+  for (double& v : s.probes) v += 0.0;
   // The walls' forces: every rank's hits, summed in ascending key (DESIGN.md section 3).
   s.wall_force.assign(config_.rigid_walls.size(), 0.0);
   if (!s.wall_force.empty()) {
