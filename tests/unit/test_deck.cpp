@@ -343,6 +343,34 @@ TEST(Deck, PrescribedMotionCurves) {
                {"deck.yaml:17", "boundary_conditions[0].curve", "goes with velocity"});
 }
 
+// gravity: [gx, gy, gz], or {acceleration: [..], curve: [[t, s], ...]} (deck.md).
+TEST(Deck, Gravity) {
+  std::string text = good;
+  text += "gravity: [0, 0, -9.81]\n";
+  Config c = test::deck(text);
+  ASSERT_EQ(c.body_loads.size(), 1u);
+  EXPECT_EQ(c.body_loads[0].acceleration, (Vec3{0, 0, -9.81}));
+  EXPECT_FALSE(c.body_loads[0].curve);
+  text =
+      std::string(good) + "gravity: {acceleration: [0, -9.81, 0], curve: [[0, 0], [1.0e-3, 1]]}\n";
+  c = test::deck(text);
+  ASSERT_TRUE(c.body_loads.at(0).curve);
+  EXPECT_EQ(c.body_loads[0].curve->at(0.5e-3), 0.5);
+  auto error = [](const std::string& line) {
+    try {
+      test::deck(std::string(good) + line, "deck.yaml");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error("gravity: [0, -9.81]\n").find("deck.yaml:22: gravity: expected a list of three"),
+            std::string::npos);
+  EXPECT_NE(error("gravity: {curve: [[0, 1]]}\n").find("gravity.acceleration"), std::string::npos);
+  EXPECT_NE(error("gravity: {acceleration: [0, 0, -9.81], ramp: 1}\n").find("unknown key 'ramp'"),
+            std::string::npos);
+}
+
 // QA D9: a deck set named like a generated one (bar.top) replaced it without a word.
 TEST(Deck, NodeSetNamesHaveNoDots) {
   expect_error("  impact_face: {part", "  bar.top: {part",

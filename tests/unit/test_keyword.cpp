@@ -718,6 +718,19 @@ TEST(Keyword, PrescribedMotionsInCardOrder) {
   ASSERT_EQ(c.boundary_conditions.size(), 2u);
   EXPECT_TRUE(c.boundary_conditions[0].prescribed);
   EXPECT_FALSE(c.boundary_conditions[1].prescribed);
+  // Single-node cards of one kind around a card on the same node component: not one group
+  // placed before it (QA round 23b: the later SPC lost to the motion between).
+  c = kw(with(good, "*END",
+              "*BOUNDARY_SPC_NODE\n         5         0         0         1\n"
+              "*BOUNDARY_PRESCRIBED_MOTION_NODE\n         9         2         0         6\n"
+              "*BOUNDARY_SPC_NODE\n         9         0         0         1\n" +
+                  curve6 + "*END"));
+  std::vector<std::string> names;
+  for (const auto& bc : c.boundary_conditions) names.push_back(bc.nodes.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"nodeset_7", "spc_y", "motion_nodes_1", "spc_y_2"}));
+  const Mesh m = build_mesh(c);
+  EXPECT_EQ(m.node_sets.at("spc_y"), (std::vector<std::int64_t>{4}));
+  EXPECT_EQ(m.node_sets.at("spc_y_2"), (std::vector<std::int64_t>{8}));
   // A curve for dynamic relaxation that no motion names: not read, no error.
   const std::string sidr1 = "*DEFINE_CURVE\n         9         1\n                 0.0       0.0\n";
   EXPECT_NO_THROW(kw(with(good, "*END", motion + curve6 + sidr1 + "*END")));
@@ -738,6 +751,31 @@ TEST(Keyword, PrescribedMotionsInCardOrder) {
                     "   1.0E308\n" +
                         curve6 + "*END"),
                {"*BOUNDARY_PRESCRIBED_MOTION_SET.LCID", "overflows"});
+}
+
+// *LOAD_BODY_Z is a base acceleration (LS-DYNA): SF 9.81 is gravity along -z; LCIDDR is
+// left out with a warning, CID and *LOAD_BODY_PARTS are errors.
+TEST(Keyword, BodyLoads) {
+  const std::string curve1 = "*DEFINE_CURVE\n         1\n                 0.0                 1.0\n"
+                             "                 1.0                 1.0\n";
+  Config c = kw(with(good, "*END", "*LOAD_BODY_Z\n         1      9.81\n" + curve1 + "*END"));
+  ASSERT_EQ(c.body_loads.size(), 1u);
+  EXPECT_EQ(c.body_loads[0].acceleration, (Vec3{0, 0, -9.81}));
+  EXPECT_EQ(c.body_loads[0].curve->at(0.5), 1.0);
+  EXPECT_TRUE(c.warnings.empty());
+  c = kw(with(good, "*END", "*LOAD_BODY_X\n         1      -2.0         1\n" + curve1 + "*END"));
+  EXPECT_EQ(c.body_loads.at(0).acceleration, (Vec3{2.0, 0, 0}));
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("LCIDDR"), std::string::npos);
+  expect_error(with(good, "*END",
+                    "*LOAD_BODY_Z\n         1      9.81         0       0.0       0.0       0.0"
+                    "         3\n" +
+                        curve1 + "*END"),
+               {"*LOAD_BODY_Z.CID"});
+  expect_error(with(good, "*END", "*LOAD_BODY_Z\n         2      9.81\n" + curve1 + "*END"),
+               {"*LOAD_BODY_Z.LCID", "curve 2 is not defined"});
+  expect_error(with(good, "*END", "*LOAD_BODY_PARTS\n         1\n*END"),
+               {"*LOAD_BODY_PARTS", "not supported"});
 }
 
 // keyword.md: *MAT_JOHNSON_COOK with G alone takes the bulk modulus rho C^2 of the part's

@@ -128,6 +128,14 @@ struct BoundaryCondition {
   SourceLocation where;
 };
 
+// A body force per unit mass on every node and particle (deck `gravity`, LS-DYNA
+// *LOAD_BODY_X/Y/Z): `acceleration` times its curve's value at the time (1 without one).
+struct BodyLoad {
+  Vec3 acceleration; // m/s^2
+  std::optional<TimeCurve> curve;
+  SourceLocation where;
+};
+
 // General contact (DESIGN.md section 4): node-to-face penalty contact among the exterior
 // faces of the listed parts, self-contact included.
 struct ContactConfig {
@@ -190,6 +198,7 @@ struct Config {
   std::vector<ProbeConfig> probes;
   std::vector<ContactConfig> contact; // at most one
   std::vector<RigidWallConfig> rigid_walls;
+  std::vector<BodyLoad> body_loads; // summed
   DecompositionConfig decomposition;
   // What the reader accepted but could not take over exactly (an LS-DYNA keyword that
   // anvil ignores, a material option it approximates); the command line prints them.

@@ -710,7 +710,7 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
   const auto entries =
       top.entries({"title", "termination", "time_step", "materials", "parts", "particles", "sph",
                    "node_sets", "initial_conditions", "boundary_conditions", "contact",
-                   "rigid_walls", "probes", "output", "checkpoint", "decomposition"});
+                   "rigid_walls", "gravity", "probes", "output", "checkpoint", "decomposition"});
   (void)entries;
 
   if (top.has("title")) c.title = top.child("title").str();
@@ -1007,6 +1007,28 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
       }
       c.contact.push_back(cc);
     }
+  }
+
+  // gravity: [gx, gy, gz], or {acceleration: [..], curve: [[t, s], ...]}.
+  if (top.has("gravity")) {
+    const Node g = top.child("gravity");
+    BodyLoad load;
+    load.where = g.where();
+    if (g.is_map()) {
+      g.check_keys({"acceleration", "curve"});
+      load.acceleration = g.required("acceleration").vec3();
+      if (g.has("curve")) {
+        load.curve = parse_curve(g.child("curve"));
+        const Vec3& a = load.acceleration;
+        const double amplitude = std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z)});
+        if (const auto problem = motion_curve_problem(amplitude, *load.curve, false);
+            !problem.empty())
+          g.child("curve").fail(problem);
+      }
+    } else {
+      load.acceleration = g.vec3();
+    }
+    c.body_loads.push_back(load);
   }
 
   if (top.has("rigid_walls")) {

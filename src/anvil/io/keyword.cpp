@@ -612,6 +612,15 @@ struct MotionCard {
   std::int64_t seq = 0; // the card's place among the constraints and motions
 };
 
+// *LOAD_BODY_X/Y/Z: a base acceleration SF times curve LCID along one axis.
+struct BodyCard {
+  int axis = 0;
+  std::int64_t lcid = 0;
+  double sf = 1;
+  Where at;
+  std::string keyword;
+};
+
 struct VelocityGen {
   int styp; // 1 part set, 2 part, 3 node set, 0: all parts (*INITIAL_VELOCITY with NSID 0)
   std::int64_t id;
@@ -720,6 +729,12 @@ private:
       return prescribed_motion(b, true);
     if (n == "BOUNDARY_PRESCRIBED_MOTION_NODE" || n == "BOUNDARY_PRESCRIBED_MOTION_NODE_ID")
       return prescribed_motion(b, false);
+    if (n == "LOAD_BODY_X" || n == "LOAD_BODY_Y" || n == "LOAD_BODY_Z") return body_load(b);
+    if (n == "LOAD_BODY_PARTS")
+      throw InputError(b.head.where("*LOAD_BODY_PARTS"),
+                       "*LOAD_BODY_PARTS is not supported: anvil's body loads act on every "
+                       "part and particle set, so the run would load parts this deck leaves "
+                       "unloaded");
     if (n == "DEFINE_CURVE" || n == "DEFINE_CURVE_TITLE") {
       Cursor(b).skip_rest(); // read when a motion names it
       curve_blocks_.push_back(&b);
@@ -1276,6 +1291,29 @@ private:
     }
   }
 
+  // LCID, SF, LCIDDR, XC, YC, ZC, CID (LS-DYNA manual, *LOAD_BODY). LCIDDR (the curve of
+  // a dynamic relaxation) is left out with a warning: anvil has no such phase.
+  void body_load(const Block& b) {
+    Cursor c(b);
+    const Line l = c.next();
+    const Card card(b, l, {10, 10, 10, 10, 10, 10, 10});
+    BodyCard bc;
+    bc.axis = b.name.back() - 'X';
+    bc.lcid = card.integer(0, "LCID", 0);
+    if (bc.lcid <= 0) card.fail("LCID", "LCID must be the id of a *DEFINE_CURVE");
+    bc.sf = card.real(1, "SF", 1.0);
+    if (card.integer(6, "CID", 0) != 0)
+      card.fail("CID", "body loads in a local coordinate system (CID) are not supported");
+    if (card.integer(2, "LCIDDR", 0) != 0)
+      warnings_.push_back(fmt::format("{}: *{}: LCIDDR (a dynamic relaxation curve) is "
+                                      "ignored: anvil has no dynamic relaxation phase, the run "
+                                      "starts unloaded and LCID loads it",
+                                      where_of(l).str(), b.name));
+    bc.at = where_of(l);
+    bc.keyword = b.name;
+    bodies_.push_back(bc);
+  }
+
   // Any number of cards NSID (NID), DOF, VAD, LCID, SF, VID, DEATH, BIRTH (LS-DYNA
   // manual, *BOUNDARY_PRESCRIBED_MOTION), after the ID card of the _ID option. anvil
   // prescribes translations (DOF 1-3) by velocity (VAD 0) or displacement (VAD 2) from
@@ -1788,6 +1826,7 @@ private:
   std::map<std::int64_t, IdSet> node_sets_, part_sets_;
   std::vector<Spc> spcs_;
   std::vector<MotionCard> motions_;
+  std::vector<BodyCard> bodies_;
   std::vector<const Block*> curve_blocks_;                // *DEFINE_CURVE, read by curve()
   std::multimap<std::int64_t, const Block*> curve_index_; // by LCID (0: none readable)
   std::map<std::int64_t, CurveCard> curves_;              // those read
@@ -2070,57 +2109,11 @@ Config KeywordReader::config(const std::string& deck_file) {
   // Constraints and prescribed motions become conditions in card order, so that a later
   // card wins on the node components two hold, as in the YAML deck: one condition per card
   // by set; single nodes (*BOUNDARY_SPC_NODE, *NODE TC, *BOUNDARY_PRESCRIBED_MOTION_NODE)
-  // grouped by what they hold, one set each at their first card's place, so that a deck
-  // with thousands of them makes a few conditions, not thousands.
-  std::vector<std::pair<std::int64_t, BoundaryCondition>> ordered; // (card seq, condition)
-  auto fix_condition = [&](std::int64_t seq, const std::string& set_name,
-                           const SourceLocation& where, std::array<bool, 3> fix) {
-    BoundaryCondition bc;
-    bc.nodes.name = set_name;
-    bc.nodes.where = where;
-    bc.fix = fix;
-    bc.where = where;
-    ordered.emplace_back(seq, std::move(bc));
-  };
-  struct SingleFix {
-    std::vector<std::int64_t> ids;
-    Where at;
-    std::int64_t seq = 0;
-  };
-  std::map<int, SingleFix> single; // fixed-component mask -> nodes
-  auto add_single = [&](int mask, std::int64_t pos, const Where& at, std::int64_t seq) {
-    SingleFix& g = single[mask];
-    if (g.ids.empty() || seq < g.seq) {
-      g.at = at;
-      g.seq = seq;
-    }
-    g.ids.push_back(pos);
-  };
-  for (const auto& sp : spcs_) {
-    if (!sp.fix[0] && !sp.fix[1] && !sp.fix[2]) continue; // rotations only
-    if (sp.set != 0) {
-      fix_condition(sp.seq, node_set_name(sp.set, sp.at, "*" + sp.keyword + ".NSID"),
-                    sp.at.loc("*" + sp.keyword), sp.fix);
-    } else {
-      const auto pos = node_position(sp.node, sp.at, "*" + sp.keyword + ".NID", "the constraint");
-      add_single((sp.fix[0] ? 1 : 0) | (sp.fix[1] ? 2 : 0) | (sp.fix[2] ? 4 : 0), pos, sp.at,
-                 sp.seq);
-    }
-  }
-  for (const auto& t : node_tc_) {
-    // TC: 1 x, 2 y, 3 z, 4 x and y, 5 y and z, 6 z and x, 7 all.
-    static constexpr int masks[8] = {0, 1, 2, 4, 3, 6, 5, 7};
-    add_single(masks[t.tc], node_index_.at(t.nid), t.at, t.seq);
-  }
-  for (auto& [mask, g] : single) {
-    std::sort(g.ids.begin(), g.ids.end());
-    g.ids.erase(std::unique(g.ids.begin(), g.ids.end()), g.ids.end());
-    const std::string name =
-        fmt::format("spc_{}{}{}", mask & 1 ? "x" : "", mask & 2 ? "y" : "", mask & 4 ? "z" : "");
-    mesh.node_sets[name] = g.ids;
-    fix_condition(g.seq, name, g.at.loc("*BOUNDARY_SPC_NODE"),
-                  {(mask & 1) != 0, (mask & 2) != 0, (mask & 4) != 0});
-  }
+  // grouped by what they hold, one set each at its first card's place, so that a deck with
+  // thousands of them makes a few conditions, not thousands. A card joins its group only
+  // if no card since the group's first holds the same node component; else it starts a
+  // new group at its own place (QA round 23: a *NODE TC joined a group before a motion
+  // card on its node, and the motion won).
 
   // A motion card's own checks (each card of a group of single nodes too).
   auto check_motion = [&](const MotionCard& m) {
@@ -2139,21 +2132,36 @@ Config KeywordReader::config(const std::string& deck_file) {
                                    "prescribes the motion to the end of the run",
                                    m.death, endtim_));
   };
+  // A curve that ends before ENDTIM while still changing: said once per curve.
   std::set<std::int64_t> curves_warned;
-  auto motion_condition = [&](const MotionCard& m, const std::string& set_name) {
+  auto warn_if_curve_ends = [&](std::int64_t lcid, const CurveCard& cc) {
+    const TimeCurve& tc = cc.curve;
+    const std::size_t last = tc.t.size() - 1;
+    if (endtim_ > tc.t[last] && last > 0 && tc.value[last] != tc.value[last - 1] &&
+        curves_warned.insert(lcid).second)
+      warnings.push_back(fmt::format(
+          "{}: curve {} ends at t = {} before the end time {}: anvil holds its last value "
+          "there, where LS-DYNA would extrapolate its last slope (extend the curve to the end "
+          "time to have the same run in both)",
+          cc.at.str(), lcid, tc.t[last], endtim_));
+  };
+  std::vector<std::pair<std::int64_t, BoundaryCondition>> ordered; // (card seq, condition)
+  auto fix_condition = [&](std::int64_t seq, const std::string& set_name,
+                           const SourceLocation& where, std::array<bool, 3> fix) {
+    BoundaryCondition bc;
+    bc.nodes.name = set_name;
+    bc.nodes.where = where;
+    bc.fix = fix;
+    bc.where = where;
+    ordered.emplace_back(seq, std::move(bc));
+  };
+  auto motion_condition = [&](const MotionCard& m, std::int64_t seq, const std::string& set_name) {
     const std::string key = "*" + m.keyword;
     const CurveCard& cc = curve(m.lcid, m.at.loc(key + ".LCID"));
     const TimeCurve& tc = cc.curve;
     if (const auto problem = motion_curve_problem(m.sf, tc, m.displacement); !problem.empty())
       throw InputError(m.at.loc(key + ".LCID"), fmt::format("curve {}: {}", m.lcid, problem));
-    const std::size_t last = tc.t.size() - 1;
-    if (endtim_ > tc.t[last] && last > 0 && tc.value[last] != tc.value[last - 1] &&
-        curves_warned.insert(m.lcid).second)
-      warnings.push_back(fmt::format(
-          "{}: curve {} ends at t = {} before the end time {}: anvil holds its last value "
-          "there, where LS-DYNA would extrapolate its last slope (extend the curve to the end "
-          "time to have the same run in both)",
-          cc.at.str(), m.lcid, tc.t[last], endtim_));
+    warn_if_curve_ends(m.lcid, cc);
     BoundaryCondition bc;
     bc.nodes.name = set_name;
     bc.nodes.where = m.at.loc(key);
@@ -2164,35 +2172,124 @@ Config KeywordReader::config(const std::string& deck_file) {
     bc.value[m.dof] = m.sf;
     bc.curve = tc;
     bc.where = bc.nodes.where;
-    ordered.emplace_back(m.seq, std::move(bc));
+    ordered.emplace_back(seq, std::move(bc));
   };
-  std::map<std::tuple<int, bool, std::int64_t, double>,
-           std::pair<std::vector<std::int64_t>, MotionCard>>
-      moved; // single nodes by (DOF, VAD, LCID, SF): their nodes and first card
-  for (const auto& m : motions_) {
-    check_motion(m);
-    if (m.set != 0) {
-      motion_condition(m, node_set_name(m.set, m.at, "*" + m.keyword + ".NSID"));
+
+  // Every card in deck order: (seq, kind, index) with kind 0 an SPC, 1 a *NODE TC, 2 a
+  // motion.
+  std::vector<std::tuple<std::int64_t, int, std::size_t>> cards;
+  for (std::size_t k = 0; k < spcs_.size(); ++k) cards.emplace_back(spcs_[k].seq, 0, k);
+  for (std::size_t k = 0; k < node_tc_.size(); ++k) cards.emplace_back(node_tc_[k].seq, 1, k);
+  for (std::size_t k = 0; k < motions_.size(); ++k) cards.emplace_back(motions_[k].seq, 2, k);
+  std::sort(cards.begin(), cards.end());
+  // The place (seq) of the condition that last held each node component, and the groups
+  // of single nodes: key (fix mask, or motion DOF, VAD, LCID, SF) -> its latest group.
+  std::vector<std::array<std::int64_t, 3>> held(mesh.nodes.size(), {-1, -1, -1});
+  auto hold = [&](std::int64_t pos, std::array<bool, 3> on, std::int64_t seq) {
+    for (std::size_t i = 0; i < 3; ++i)
+      if (on[i]) held[static_cast<std::size_t>(pos)][i] = seq;
+  };
+  struct Group {
+    std::int64_t seq;
+    std::vector<std::int64_t> ids;
+    std::array<bool, 3> on;
+    Where at;
+    std::string keyword;      // of its first card
+    const MotionCard* motion; // its first card, for a motion group
+  };
+  std::vector<Group> groups;
+  using GroupKey = std::tuple<int, int, bool, std::int64_t, double>;
+  std::map<GroupKey, std::size_t> latest;
+  auto add_single = [&](const GroupKey& key, std::int64_t pos, std::array<bool, 3> on,
+                        std::int64_t seq, const Where& at, const std::string& keyword,
+                        const MotionCard* motion) {
+    const auto it = latest.find(key);
+    bool join = it != latest.end();
+    if (join)
+      for (std::size_t i = 0; i < 3; ++i)
+        if (on[i] && held[static_cast<std::size_t>(pos)][i] > groups[it->second].seq) join = false;
+    if (!join) {
+      latest[key] = groups.size();
+      groups.push_back({seq, {}, on, at, keyword, motion});
+    }
+    Group& g = groups[latest[key]];
+    g.ids.push_back(pos);
+    hold(pos, on, g.seq);
+  };
+  for (const auto& [seq, kind, k] : cards) {
+    if (kind == 0) {
+      const Spc& sp = spcs_[k];
+      if (!sp.fix[0] && !sp.fix[1] && !sp.fix[2]) continue; // rotations only
+      const int mask = (sp.fix[0] ? 1 : 0) | (sp.fix[1] ? 2 : 0) | (sp.fix[2] ? 4 : 0);
+      if (sp.set != 0) {
+        const std::string name = node_set_name(sp.set, sp.at, "*" + sp.keyword + ".NSID");
+        fix_condition(seq, name, sp.at.loc("*" + sp.keyword), sp.fix);
+        for (const auto pos : mesh.node_sets.at(name)) hold(pos, sp.fix, seq);
+      } else {
+        const auto pos = node_position(sp.node, sp.at, "*" + sp.keyword + ".NID", "the constraint");
+        add_single({0, mask, false, 0, 0.0}, pos, sp.fix, seq, sp.at, sp.keyword, nullptr);
+      }
+    } else if (kind == 1) {
+      // TC: 1 x, 2 y, 3 z, 4 x and y, 5 y and z, 6 z and x, 7 all.
+      static constexpr int masks[8] = {0, 1, 2, 4, 3, 6, 5, 7};
+      const NodeTc& t = node_tc_[k];
+      const int mask = masks[t.tc];
+      add_single({0, mask, false, 0, 0.0}, node_index_.at(t.nid),
+                 {(mask & 1) != 0, (mask & 2) != 0, (mask & 4) != 0}, seq, t.at, "NODE", nullptr);
     } else {
-      const auto pos = node_position(m.node, m.at, "*" + m.keyword + ".NID", "the motion");
-      auto& [ids, first] = moved[{m.dof, m.displacement, m.lcid, m.sf}];
-      if (ids.empty()) first = m;
-      ids.push_back(pos);
+      const MotionCard& m = motions_[k];
+      check_motion(m);
+      std::array<bool, 3> on{false, false, false};
+      on[static_cast<std::size_t>(m.dof)] = true;
+      if (m.set != 0) {
+        const std::string name = node_set_name(m.set, m.at, "*" + m.keyword + ".NSID");
+        motion_condition(m, seq, name);
+        for (const auto pos : mesh.node_sets.at(name)) hold(pos, on, seq);
+      } else {
+        const auto pos = node_position(m.node, m.at, "*" + m.keyword + ".NID", "the motion");
+        add_single({1, m.dof, m.displacement, m.lcid, m.sf}, pos, on, seq, m.at, m.keyword, &m);
+      }
     }
   }
-  int group = 0;
-  for (auto& [what, entry] : moved) {
-    auto& [ids, first] = entry;
-    std::sort(ids.begin(), ids.end());
-    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-    const std::string name = fmt::format("motion_nodes_{}", ++group);
-    mesh.node_sets[name] = ids;
-    motion_condition(first, name);
+  // The groups' sets, named in deck order: spc_x, spc_x_2, ...; motion_nodes_1, ...
+  std::map<std::string, int> named;
+  int motion_groups = 0;
+  for (Group& g : groups) {
+    std::sort(g.ids.begin(), g.ids.end());
+    g.ids.erase(std::unique(g.ids.begin(), g.ids.end()), g.ids.end());
+    std::string name;
+    if (g.motion) {
+      name = fmt::format("motion_nodes_{}", ++motion_groups);
+    } else {
+      name = fmt::format("spc_{}{}{}", g.on[0] ? "x" : "", g.on[1] ? "y" : "", g.on[2] ? "z" : "");
+      if (const int n = ++named[name]; n > 1) name += fmt::format("_{}", n);
+    }
+    mesh.node_sets[name] = g.ids;
+    if (g.motion)
+      motion_condition(*g.motion, g.seq, name);
+    else
+      fix_condition(g.seq, name, g.at.loc(g.keyword == "NODE" ? "*NODE.TC" : "*" + g.keyword),
+                    g.on);
   }
   std::stable_sort(ordered.begin(), ordered.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   for (auto& [seq, bc] : ordered) c.boundary_conditions.push_back(std::move(bc));
   warn_of_held_twice(c, mesh, warnings);
+
+  // Body loads: LS-DYNA's are base accelerations, so the body is pushed the other way: a
+  // positive *LOAD_BODY_Z of 9.81 is gravity along -z.
+  for (const auto& bl : bodies_) {
+    const std::string key = "*" + bl.keyword;
+    const CurveCard& cc = curve(bl.lcid, bl.at.loc(key + ".LCID"));
+    if (const auto problem = motion_curve_problem(bl.sf, cc.curve, false); !problem.empty())
+      throw InputError(bl.at.loc(key + ".LCID"), fmt::format("curve {}: {}", bl.lcid, problem));
+    warn_if_curve_ends(bl.lcid, cc);
+    BodyLoad load;
+    load.acceleration[bl.axis] = -bl.sf;
+    load.curve = cc.curve;
+    load.where = bl.at.loc(key);
+    c.body_loads.push_back(load);
+  }
 
   const auto shared = std::make_shared<const Mesh>(std::move(mesh));
   for (auto& pc : c.parts) pc.mesh.embedded = shared;

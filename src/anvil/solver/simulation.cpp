@@ -457,6 +457,16 @@ void Simulation::apply_boundary_conditions(const Mesh& mesh) {
   apply_particle_boundary_conditions();
 }
 
+// The body acceleration at time t: the deck's loads, each times its curve's value then.
+std::array<double, 3> Simulation::body_acceleration(double t) const {
+  std::array<double, 3> g{0, 0, 0};
+  for (const auto& load : config_.body_loads) {
+    const double s = load.curve ? load.curve->at(t) : 1.0;
+    for (int i = 0; i < 3; ++i) g[i] += load.acceleration[i] * s;
+  }
+  return g;
+}
+
 // The prescribed motions' factors for the step from t to t + dt: a velocity history at
 // the mid-step, where central difference places v(n+1/2); a displacement history as the
 // velocity that carries the node from d(t) to d(t + dt) exactly, so that the displacement
@@ -632,16 +642,18 @@ void Simulation::fe_forces() {
 namespace {
 
 // Central difference for the velocity of one node, or of a vector of nodes: v(n+1/2) from
-// old = v(n-1/2) and the force f, or the prescribed velocity bc in the directions where
-// `fixed` holds; returns 1/2 m |v(n)|^2 with v(n) the mean of the two half-step
-// velocities. One template for the vector body and the scalar rest: the same operations.
+// old = v(n-1/2), the force f and the body acceleration g, or the prescribed velocity bc
+// in the directions where `fixed` holds; returns 1/2 m |v(n)|^2 with v(n) the mean of the
+// two half-step velocities. One template for the vector body and the scalar rest: the
+// same operations.
 template <class V, class Mask>
 V advance_velocity(const V (&old)[3], const V (&f)[3], const V (&bc)[3], const Mask (&fixed)[3],
-                   const V& m, double dt_avg, V (&nv)[3]) {
+                   const V& m, double dt_avg, const double (&g)[3], V (&nv)[3]) {
   const V inv_m = 1.0 / m;
   V avg2 = 0.0;
   for (int i = 0; i < 3; ++i) {
-    nv[i] = simd::select(fixed[i], bc[i], old[i] + dt_avg * f[i] * inv_m);
+    // (dt f / m first, as without g: with g = 0 the same bits as before it existed.)
+    nv[i] = simd::select(fixed[i], bc[i], old[i] + (dt_avg * f[i] * inv_m + dt_avg * g[i]));
     const V a = 0.5 * (old[i] + nv[i]);
     avg2 += a * a;
   }
@@ -685,14 +697,24 @@ void Simulation::predict() {
   // memory at every term, a quarter of this function's time on the can crush).
   double work_bc = 0;
   update_prescribed_motions(clock_.time, dt);
+  // The body acceleration of this step, at t(n) where its forces are; and the one of the
+  // step before, at its middle, for the body force's work (below).
+  const auto g_now = body_acceleration(clock_.time);
+  const double g[3] = {g_now[0], g_now[1], g_now[2]};
+  for (int i = 0; i < 3; ++i) gravity_[i] = g[i];
+  const auto g_before = body_acceleration(clock_.time - 0.5 * clock_.dt_prev);
   for (int n : constrained_nodes_) {
     for (int i = 0; i < 3; ++i) {
       if (!(constrained_[n] & (1u << i))) continue;
       const double v_old = nodes_.v[i][n];
-      const double v_free = v_old + dt_avg * nodes_.f[i][n] / nodes_.mass[n];
+      // The reaction holds the body force too; its work is the constrained component's
+      // whole change of kinetic energy but the forces' (the body force works on free
+      // components only, below).
+      const double v_forces = v_old + dt_avg * nodes_.f[i][n] / nodes_.mass[n];
+      const double v_free = v_old + (dt_avg * nodes_.f[i][n] / nodes_.mass[n] + dt_avg * g[i]);
       const double v_new = v_bc_[i][n];
       bc_reaction_[i][n] = nodes_.mass[n] * (v_new - v_free) / dt_avg;
-      if (fe_.node_owned[n]) work_bc += nodes_.mass[n] * (v_new - v_free) * 0.5 * (v_old + v_new);
+      if (fe_.node_owned[n]) work_bc += nodes_.mass[n] * (v_new - v_forces) * 0.5 * (v_old + v_new);
     }
   }
   double work = work_bc; // (the same sum)
@@ -728,7 +750,7 @@ void Simulation::predict() {
       if (any != 0)
         fx[i] = simd::vdouble([&](auto l) { return double((fixed[n + l] >> i) & 1u); }) != 0.0;
     }
-    const simd::vdouble e = advance_velocity(old, force, bc, fx, simd::load(m + n), dt_avg, nv);
+    const simd::vdouble e = advance_velocity(old, force, bc, fx, simd::load(m + n), dt_avg, g, nv);
     for (int i = 0; i < 3; ++i) {
       simd::store(old[i], v_prev[i] + n);
       simd::store(nv[i], v[i] + n);
@@ -745,7 +767,7 @@ void Simulation::predict() {
       bc[i] = v_bc_[i][n];
       fx[i] = ((fixed[n] >> i) & 1u) != 0;
     }
-    const double e = advance_velocity(old, force, bc, fx, m[n], dt_avg, nv);
+    const double e = advance_velocity(old, force, bc, fx, m[n], dt_avg, g, nv);
     for (int i = 0; i < 3; ++i) {
       v_prev[i][n] = old[i];
       v[i][n] = nv[i];
@@ -753,6 +775,16 @@ void Simulation::predict() {
     if (owned[n]) ke_nodes += e;
   }
   ke = ke_nodes; // (ke is 0 before the nodes: the same sum)
+  // The body force's work on the free components: m g . (x(n) - x(n-1)), the step before's
+  // displacement dt(n-1/2) v(n-1/2), so that the work to t(n) is m g . (x(n) - x(0)) for a
+  // constant g, which is exactly the kinetic energy a free fall from rest reports at t(n)
+  // (a midpoint rule on v(n) lagged half a step: 1/N of it after N steps).
+  if (g_before[0] != 0.0 || g_before[1] != 0.0 || g_before[2] != 0.0)
+    for (std::size_t k = 0; k < nn; ++k)
+      if (owned[k])
+        for (int i = 0; i < 3; ++i)
+          if (!((fixed[k] >> i) & 1u)) work += clock_.dt_prev * m[k] * g_before[i] * v_prev[i][k];
+  gravity_work_before_ = g_before;
   if (sph_) predict_particles(dt_avg, ke, work);
   external_work_ += work;
   kinetic_local_ = ke; // correct() adds what contact and walls change

@@ -148,6 +148,7 @@ private:
   void apply_initial_conditions(const Mesh& mesh);
   void apply_boundary_conditions(const Mesh& mesh);
   void update_prescribed_motions(double t, double dt);
+  std::array<double, 3> body_acceleration(double t) const;
   void locate_probes(const Mesh& mesh);
   double owned_kinetic_energy() const;
   // Particles: selection (mask over own particles), conditions, their part of predict,
@@ -203,6 +204,8 @@ private:
     int condition;
   };
   std::vector<double> motion_factor_;
+  double gravity_[3] = {0, 0, 0}; // body acceleration of the current step, m/s^2
+  std::array<double, 3> gravity_work_before_{0, 0, 0}; // of the step before (its work)
   std::vector<CurvedComponent> curved_components_;
   // Per local node and component: the condition that constrains it (-1: none), and the
   // force it applies there over the current step, N (predict, correct; summed per

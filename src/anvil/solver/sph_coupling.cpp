@@ -176,12 +176,16 @@ void Simulation::predict_particles(double dt_avg, double& ke, double& work) {
     for (int k = 0; k < 3; ++k) {
       const double old = pt.v[k][i];
       pv_prev_[k][i] = old;
-      const double free = old + dt_avg * pt.f[k][i] * inv_m;
+      const double free = old + (dt_avg * pt.f[k][i] * inv_m + dt_avg * gravity_[k]);
       double nv = free;
       if (pt.constrained[i] & (1u << k)) {
         nv = particle_bc_velocity(k, i);
-        work += pt.mass[i] * (nv - free) * 0.5 * (old + nv);
+        // (As for nodes: the reaction holds the body force, its work is all but the
+        // forces'.)
+        work += pt.mass[i] * (nv - (old + dt_avg * pt.f[k][i] * inv_m)) * 0.5 * (old + nv);
         p_reaction_[k][i] = pt.mass[i] * (nv - free) / dt_avg;
+      } else if (gravity_work_before_[k] != 0.0) {
+        work += clock_.dt_prev * pt.mass[i] * gravity_work_before_[k] * old; // (predict())
       }
       pt.v[k][i] = nv;
       const double a = 0.5 * (old + nv);
