@@ -1262,6 +1262,208 @@ private:
 
   // ---- loads, constraints, contact ------------------------------------------------------
 
+  // The deck's name of node set `sid` (an error at `at`, naming `key`, when undefined).
+  std::string node_set_name(std::int64_t sid, const Where& at, const std::string& key) const {
+    if (!node_sets_.count(sid))
+      throw InputError(at.loc(key),
+                       fmt::format("node set {} is not defined (*SET_NODE_LIST)", sid));
+    return fmt::format("nodeset_{}", sid);
+  }
+
+  // The constraints, prescribed motions and body loads of the deck into `c` (part of
+  // config()): `mesh` gains the sets of the single-node groups; `warnings` what anvil does
+  // otherwise than LS-DYNA might.
+  void conditions(Config& c, Mesh& mesh, std::vector<std::string>& warnings) {
+    // Constraints and prescribed motions become conditions in card order, so that a later
+    // card wins on the node components two hold, as in the YAML deck: one condition per card
+    // by set; single nodes (*BOUNDARY_SPC_NODE, *NODE TC, *BOUNDARY_PRESCRIBED_MOTION_NODE)
+    // grouped by what they hold, one set each at its first card's place, so that a deck with
+    // thousands of them makes a few conditions, not thousands. A card joins its group only
+    // if no card since the group's first holds the same node component; else it starts a
+    // new group at its own place (QA round 23: a *NODE TC joined a group before a motion
+    // card on its node, and the motion won).
+
+    // A motion card's own checks (each card of a group of single nodes too).
+    auto check_motion = [&](const MotionCard& m) {
+      const std::string key = "*" + m.keyword + ".DEATH";
+      // LS-DYNA's "never" is 1e28; anything below 1e20 is a time.
+      if (m.death == 0 || m.death >= 1e20) return;
+      if (endtim_ == 0)
+        throw InputError(m.at.loc(key),
+                         fmt::format("DEATH = {} with no ENDTIM (*CONTROL_TERMINATION) is not "
+                                     "supported: anvil prescribes the motion to the end of the "
+                                     "run, so give an ENDTIM no later than DEATH",
+                                     m.death));
+      if (m.death < endtim_)
+        throw InputError(m.at.loc(key),
+                         fmt::format("DEATH = {} before the end time {} is not supported: anvil "
+                                     "prescribes the motion to the end of the run",
+                                     m.death, endtim_));
+    };
+    // A curve that ends before ENDTIM while still changing: said once per curve.
+    std::set<std::int64_t> curves_warned;
+    auto warn_if_curve_ends = [&](std::int64_t lcid, const CurveCard& cc) {
+      const TimeCurve& tc = cc.curve;
+      const std::size_t last = tc.t.size() - 1;
+      if (endtim_ > tc.t[last] && last > 0 && tc.value[last] != tc.value[last - 1] &&
+          curves_warned.insert(lcid).second)
+        warnings.push_back(fmt::format(
+            "{}: curve {} ends at t = {} before the end time {}: anvil holds its last value "
+            "there, where LS-DYNA would extrapolate its last slope (extend the curve to the end "
+            "time to have the same run in both)",
+            cc.at.str(), lcid, tc.t[last], endtim_));
+    };
+    std::vector<std::pair<std::int64_t, BoundaryCondition>> ordered; // (card seq, condition)
+    auto fix_condition = [&](std::int64_t seq, const std::string& set_name,
+                             const SourceLocation& where, std::array<bool, 3> fix) {
+      BoundaryCondition bc;
+      bc.nodes.name = set_name;
+      bc.nodes.where = where;
+      bc.fix = fix;
+      bc.where = where;
+      ordered.emplace_back(seq, std::move(bc));
+    };
+    auto motion_condition = [&](const MotionCard& m, std::int64_t seq,
+                                const std::string& set_name) {
+      const std::string key = "*" + m.keyword;
+      const CurveCard& cc = curve(m.lcid, m.at.loc(key + ".LCID"));
+      const TimeCurve& tc = cc.curve;
+      if (const auto problem = motion_curve_problem(m.sf, tc, m.displacement); !problem.empty())
+        throw InputError(m.at.loc(key + ".LCID"), fmt::format("curve {}: {}", m.lcid, problem));
+      warn_if_curve_ends(m.lcid, cc);
+      BoundaryCondition bc;
+      bc.nodes.name = set_name;
+      bc.nodes.where = m.at.loc(key);
+      bc.prescribed = true;
+      bc.motion = m.displacement ? BoundaryCondition::Motion::displacement
+                                 : BoundaryCondition::Motion::velocity;
+      bc.components[static_cast<std::size_t>(m.dof)] = true;
+      bc.value[m.dof] = m.sf;
+      bc.curve = tc;
+      bc.where = bc.nodes.where;
+      ordered.emplace_back(seq, std::move(bc));
+    };
+
+    // Every card in deck order: (seq, kind, index) with kind 0 an SPC, 1 a *NODE TC, 2 a
+    // motion.
+    std::vector<std::tuple<std::int64_t, int, std::size_t>> cards;
+    for (std::size_t k = 0; k < spcs_.size(); ++k) cards.emplace_back(spcs_[k].seq, 0, k);
+    for (std::size_t k = 0; k < node_tc_.size(); ++k) cards.emplace_back(node_tc_[k].seq, 1, k);
+    for (std::size_t k = 0; k < motions_.size(); ++k) cards.emplace_back(motions_[k].seq, 2, k);
+    std::sort(cards.begin(), cards.end());
+    // The place (seq) of the condition that last held each node component, and the groups
+    // of single nodes: key (fix mask, or motion DOF, VAD, LCID, SF) -> its latest group.
+    std::vector<std::array<std::int64_t, 3>> held(mesh.nodes.size(), {-1, -1, -1});
+    auto hold = [&](std::int64_t pos, std::array<bool, 3> on, std::int64_t seq) {
+      for (std::size_t i = 0; i < 3; ++i)
+        if (on[i]) held[static_cast<std::size_t>(pos)][i] = seq;
+    };
+    struct Group {
+      std::int64_t seq;
+      std::vector<std::int64_t> ids;
+      std::array<bool, 3> on;
+      Where at;
+      std::string keyword;      // of its first card
+      const MotionCard* motion; // its first card, for a motion group
+    };
+    std::vector<Group> groups;
+    using GroupKey = std::tuple<int, int, bool, std::int64_t, double>;
+    std::map<GroupKey, std::size_t> latest;
+    auto add_single = [&](const GroupKey& key, std::int64_t pos, std::array<bool, 3> on,
+                          std::int64_t seq, const Where& at, const std::string& keyword,
+                          const MotionCard* motion) {
+      const auto it = latest.find(key);
+      bool join = it != latest.end();
+      if (join)
+        for (std::size_t i = 0; i < 3; ++i)
+          if (on[i] && held[static_cast<std::size_t>(pos)][i] > groups[it->second].seq)
+            join = false;
+      if (!join) {
+        latest[key] = groups.size();
+        groups.push_back({seq, {}, on, at, keyword, motion});
+      }
+      Group& g = groups[latest[key]];
+      g.ids.push_back(pos);
+      hold(pos, on, g.seq);
+    };
+    for (const auto& [seq, kind, k] : cards) {
+      if (kind == 0) {
+        const Spc& sp = spcs_[k];
+        if (!sp.fix[0] && !sp.fix[1] && !sp.fix[2]) continue; // rotations only
+        const int mask = (sp.fix[0] ? 1 : 0) | (sp.fix[1] ? 2 : 0) | (sp.fix[2] ? 4 : 0);
+        if (sp.set != 0) {
+          const std::string name = node_set_name(sp.set, sp.at, "*" + sp.keyword + ".NSID");
+          fix_condition(seq, name, sp.at.loc("*" + sp.keyword), sp.fix);
+          for (const auto pos : mesh.node_sets.at(name)) hold(pos, sp.fix, seq);
+        } else {
+          const auto pos =
+              node_position(sp.node, sp.at, "*" + sp.keyword + ".NID", "the constraint");
+          add_single({0, mask, false, 0, 0.0}, pos, sp.fix, seq, sp.at, sp.keyword, nullptr);
+        }
+      } else if (kind == 1) {
+        // TC: 1 x, 2 y, 3 z, 4 x and y, 5 y and z, 6 z and x, 7 all.
+        static constexpr int masks[8] = {0, 1, 2, 4, 3, 6, 5, 7};
+        const NodeTc& t = node_tc_[k];
+        const int mask = masks[t.tc];
+        add_single({0, mask, false, 0, 0.0}, node_index_.at(t.nid),
+                   {(mask & 1) != 0, (mask & 2) != 0, (mask & 4) != 0}, seq, t.at, "NODE", nullptr);
+      } else {
+        const MotionCard& m = motions_[k];
+        check_motion(m);
+        std::array<bool, 3> on{false, false, false};
+        on[static_cast<std::size_t>(m.dof)] = true;
+        if (m.set != 0) {
+          const std::string name = node_set_name(m.set, m.at, "*" + m.keyword + ".NSID");
+          motion_condition(m, seq, name);
+          for (const auto pos : mesh.node_sets.at(name)) hold(pos, on, seq);
+        } else {
+          const auto pos = node_position(m.node, m.at, "*" + m.keyword + ".NID", "the motion");
+          add_single({1, m.dof, m.displacement, m.lcid, m.sf}, pos, on, seq, m.at, m.keyword, &m);
+        }
+      }
+    }
+    // The groups' sets, named in deck order: spc_x, spc_x_2, ...; motion_nodes_1, ...
+    std::map<std::string, int> named;
+    int motion_groups = 0;
+    for (Group& g : groups) {
+      std::sort(g.ids.begin(), g.ids.end());
+      g.ids.erase(std::unique(g.ids.begin(), g.ids.end()), g.ids.end());
+      std::string name;
+      if (g.motion) {
+        name = fmt::format("motion_nodes_{}", ++motion_groups);
+      } else {
+        name =
+            fmt::format("spc_{}{}{}", g.on[0] ? "x" : "", g.on[1] ? "y" : "", g.on[2] ? "z" : "");
+        if (const int n = ++named[name]; n > 1) name += fmt::format("_{}", n);
+      }
+      mesh.node_sets[name] = g.ids;
+      if (g.motion)
+        motion_condition(*g.motion, g.seq, name);
+      else
+        fix_condition(g.seq, name, g.at.loc(g.keyword == "NODE" ? "*NODE.TC" : "*" + g.keyword),
+                      g.on);
+    }
+    std::stable_sort(ordered.begin(), ordered.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (auto& [seq, bc] : ordered) c.boundary_conditions.push_back(std::move(bc));
+    warn_of_held_twice(c, mesh, warnings);
+
+    // Body loads: LS-DYNA's are base accelerations, so the body is pushed the other way: a
+    // positive *LOAD_BODY_Z of 9.81 is gravity along -z.
+    for (const auto& bl : bodies_) {
+      const std::string key = "*" + bl.keyword;
+      const CurveCard& cc = curve(bl.lcid, bl.at.loc(key + ".LCID"));
+      if (const auto problem = motion_curve_problem(bl.sf, cc.curve, false); !problem.empty())
+        throw InputError(bl.at.loc(key + ".LCID"), fmt::format("curve {}: {}", bl.lcid, problem));
+      warn_if_curve_ends(bl.lcid, cc);
+      BodyLoad load;
+      load.acceleration[bl.axis] = -bl.sf;
+      load.curve = cc.curve;
+      load.where = bl.at.loc(key);
+      c.body_loads.push_back(load);
+    }
+  }
+
   void spc(const Block& b, bool set) {
     Cursor c(b);
     // The _ID option adds one card (ID, HEADING) to the keyword, not one per constraint:
@@ -2057,12 +2259,6 @@ Config KeywordReader::config(const std::string& deck_file) {
     c.parts.push_back(std::move(pc));
   }
 
-  auto node_set_name = [&](std::int64_t sid, const Where& at, const std::string& key) {
-    if (!node_sets_.count(sid))
-      throw InputError(at.loc(key),
-                       fmt::format("node set {} is not defined (*SET_NODE_LIST)", sid));
-    return fmt::format("nodeset_{}", sid);
-  };
   auto part_ref = [&](std::int64_t pid, const Where& at, const std::string& key) {
     if (std::none_of(parts_.begin(), parts_.end(), [&](const PartCard& p) { return p.pid == pid; }))
       throw InputError(at.loc(key), fmt::format("part {} is not defined (*PART)", pid));
@@ -2106,190 +2302,7 @@ Config KeywordReader::config(const std::string& deck_file) {
     }
   }
 
-  // Constraints and prescribed motions become conditions in card order, so that a later
-  // card wins on the node components two hold, as in the YAML deck: one condition per card
-  // by set; single nodes (*BOUNDARY_SPC_NODE, *NODE TC, *BOUNDARY_PRESCRIBED_MOTION_NODE)
-  // grouped by what they hold, one set each at its first card's place, so that a deck with
-  // thousands of them makes a few conditions, not thousands. A card joins its group only
-  // if no card since the group's first holds the same node component; else it starts a
-  // new group at its own place (QA round 23: a *NODE TC joined a group before a motion
-  // card on its node, and the motion won).
-
-  // A motion card's own checks (each card of a group of single nodes too).
-  auto check_motion = [&](const MotionCard& m) {
-    const std::string key = "*" + m.keyword + ".DEATH";
-    // LS-DYNA's "never" is 1e28; anything below 1e20 is a time.
-    if (m.death == 0 || m.death >= 1e20) return;
-    if (endtim_ == 0)
-      throw InputError(m.at.loc(key),
-                       fmt::format("DEATH = {} with no ENDTIM (*CONTROL_TERMINATION) is not "
-                                   "supported: anvil prescribes the motion to the end of the "
-                                   "run, so give an ENDTIM no later than DEATH",
-                                   m.death));
-    if (m.death < endtim_)
-      throw InputError(m.at.loc(key),
-                       fmt::format("DEATH = {} before the end time {} is not supported: anvil "
-                                   "prescribes the motion to the end of the run",
-                                   m.death, endtim_));
-  };
-  // A curve that ends before ENDTIM while still changing: said once per curve.
-  std::set<std::int64_t> curves_warned;
-  auto warn_if_curve_ends = [&](std::int64_t lcid, const CurveCard& cc) {
-    const TimeCurve& tc = cc.curve;
-    const std::size_t last = tc.t.size() - 1;
-    if (endtim_ > tc.t[last] && last > 0 && tc.value[last] != tc.value[last - 1] &&
-        curves_warned.insert(lcid).second)
-      warnings.push_back(fmt::format(
-          "{}: curve {} ends at t = {} before the end time {}: anvil holds its last value "
-          "there, where LS-DYNA would extrapolate its last slope (extend the curve to the end "
-          "time to have the same run in both)",
-          cc.at.str(), lcid, tc.t[last], endtim_));
-  };
-  std::vector<std::pair<std::int64_t, BoundaryCondition>> ordered; // (card seq, condition)
-  auto fix_condition = [&](std::int64_t seq, const std::string& set_name,
-                           const SourceLocation& where, std::array<bool, 3> fix) {
-    BoundaryCondition bc;
-    bc.nodes.name = set_name;
-    bc.nodes.where = where;
-    bc.fix = fix;
-    bc.where = where;
-    ordered.emplace_back(seq, std::move(bc));
-  };
-  auto motion_condition = [&](const MotionCard& m, std::int64_t seq, const std::string& set_name) {
-    const std::string key = "*" + m.keyword;
-    const CurveCard& cc = curve(m.lcid, m.at.loc(key + ".LCID"));
-    const TimeCurve& tc = cc.curve;
-    if (const auto problem = motion_curve_problem(m.sf, tc, m.displacement); !problem.empty())
-      throw InputError(m.at.loc(key + ".LCID"), fmt::format("curve {}: {}", m.lcid, problem));
-    warn_if_curve_ends(m.lcid, cc);
-    BoundaryCondition bc;
-    bc.nodes.name = set_name;
-    bc.nodes.where = m.at.loc(key);
-    bc.prescribed = true;
-    bc.motion = m.displacement ? BoundaryCondition::Motion::displacement
-                               : BoundaryCondition::Motion::velocity;
-    bc.components[static_cast<std::size_t>(m.dof)] = true;
-    bc.value[m.dof] = m.sf;
-    bc.curve = tc;
-    bc.where = bc.nodes.where;
-    ordered.emplace_back(seq, std::move(bc));
-  };
-
-  // Every card in deck order: (seq, kind, index) with kind 0 an SPC, 1 a *NODE TC, 2 a
-  // motion.
-  std::vector<std::tuple<std::int64_t, int, std::size_t>> cards;
-  for (std::size_t k = 0; k < spcs_.size(); ++k) cards.emplace_back(spcs_[k].seq, 0, k);
-  for (std::size_t k = 0; k < node_tc_.size(); ++k) cards.emplace_back(node_tc_[k].seq, 1, k);
-  for (std::size_t k = 0; k < motions_.size(); ++k) cards.emplace_back(motions_[k].seq, 2, k);
-  std::sort(cards.begin(), cards.end());
-  // The place (seq) of the condition that last held each node component, and the groups
-  // of single nodes: key (fix mask, or motion DOF, VAD, LCID, SF) -> its latest group.
-  std::vector<std::array<std::int64_t, 3>> held(mesh.nodes.size(), {-1, -1, -1});
-  auto hold = [&](std::int64_t pos, std::array<bool, 3> on, std::int64_t seq) {
-    for (std::size_t i = 0; i < 3; ++i)
-      if (on[i]) held[static_cast<std::size_t>(pos)][i] = seq;
-  };
-  struct Group {
-    std::int64_t seq;
-    std::vector<std::int64_t> ids;
-    std::array<bool, 3> on;
-    Where at;
-    std::string keyword;      // of its first card
-    const MotionCard* motion; // its first card, for a motion group
-  };
-  std::vector<Group> groups;
-  using GroupKey = std::tuple<int, int, bool, std::int64_t, double>;
-  std::map<GroupKey, std::size_t> latest;
-  auto add_single = [&](const GroupKey& key, std::int64_t pos, std::array<bool, 3> on,
-                        std::int64_t seq, const Where& at, const std::string& keyword,
-                        const MotionCard* motion) {
-    const auto it = latest.find(key);
-    bool join = it != latest.end();
-    if (join)
-      for (std::size_t i = 0; i < 3; ++i)
-        if (on[i] && held[static_cast<std::size_t>(pos)][i] > groups[it->second].seq) join = false;
-    if (!join) {
-      latest[key] = groups.size();
-      groups.push_back({seq, {}, on, at, keyword, motion});
-    }
-    Group& g = groups[latest[key]];
-    g.ids.push_back(pos);
-    hold(pos, on, g.seq);
-  };
-  for (const auto& [seq, kind, k] : cards) {
-    if (kind == 0) {
-      const Spc& sp = spcs_[k];
-      if (!sp.fix[0] && !sp.fix[1] && !sp.fix[2]) continue; // rotations only
-      const int mask = (sp.fix[0] ? 1 : 0) | (sp.fix[1] ? 2 : 0) | (sp.fix[2] ? 4 : 0);
-      if (sp.set != 0) {
-        const std::string name = node_set_name(sp.set, sp.at, "*" + sp.keyword + ".NSID");
-        fix_condition(seq, name, sp.at.loc("*" + sp.keyword), sp.fix);
-        for (const auto pos : mesh.node_sets.at(name)) hold(pos, sp.fix, seq);
-      } else {
-        const auto pos = node_position(sp.node, sp.at, "*" + sp.keyword + ".NID", "the constraint");
-        add_single({0, mask, false, 0, 0.0}, pos, sp.fix, seq, sp.at, sp.keyword, nullptr);
-      }
-    } else if (kind == 1) {
-      // TC: 1 x, 2 y, 3 z, 4 x and y, 5 y and z, 6 z and x, 7 all.
-      static constexpr int masks[8] = {0, 1, 2, 4, 3, 6, 5, 7};
-      const NodeTc& t = node_tc_[k];
-      const int mask = masks[t.tc];
-      add_single({0, mask, false, 0, 0.0}, node_index_.at(t.nid),
-                 {(mask & 1) != 0, (mask & 2) != 0, (mask & 4) != 0}, seq, t.at, "NODE", nullptr);
-    } else {
-      const MotionCard& m = motions_[k];
-      check_motion(m);
-      std::array<bool, 3> on{false, false, false};
-      on[static_cast<std::size_t>(m.dof)] = true;
-      if (m.set != 0) {
-        const std::string name = node_set_name(m.set, m.at, "*" + m.keyword + ".NSID");
-        motion_condition(m, seq, name);
-        for (const auto pos : mesh.node_sets.at(name)) hold(pos, on, seq);
-      } else {
-        const auto pos = node_position(m.node, m.at, "*" + m.keyword + ".NID", "the motion");
-        add_single({1, m.dof, m.displacement, m.lcid, m.sf}, pos, on, seq, m.at, m.keyword, &m);
-      }
-    }
-  }
-  // The groups' sets, named in deck order: spc_x, spc_x_2, ...; motion_nodes_1, ...
-  std::map<std::string, int> named;
-  int motion_groups = 0;
-  for (Group& g : groups) {
-    std::sort(g.ids.begin(), g.ids.end());
-    g.ids.erase(std::unique(g.ids.begin(), g.ids.end()), g.ids.end());
-    std::string name;
-    if (g.motion) {
-      name = fmt::format("motion_nodes_{}", ++motion_groups);
-    } else {
-      name = fmt::format("spc_{}{}{}", g.on[0] ? "x" : "", g.on[1] ? "y" : "", g.on[2] ? "z" : "");
-      if (const int n = ++named[name]; n > 1) name += fmt::format("_{}", n);
-    }
-    mesh.node_sets[name] = g.ids;
-    if (g.motion)
-      motion_condition(*g.motion, g.seq, name);
-    else
-      fix_condition(g.seq, name, g.at.loc(g.keyword == "NODE" ? "*NODE.TC" : "*" + g.keyword),
-                    g.on);
-  }
-  std::stable_sort(ordered.begin(), ordered.end(),
-                   [](const auto& a, const auto& b) { return a.first < b.first; });
-  for (auto& [seq, bc] : ordered) c.boundary_conditions.push_back(std::move(bc));
-  warn_of_held_twice(c, mesh, warnings);
-
-  // Body loads: LS-DYNA's are base accelerations, so the body is pushed the other way: a
-  // positive *LOAD_BODY_Z of 9.81 is gravity along -z.
-  for (const auto& bl : bodies_) {
-    const std::string key = "*" + bl.keyword;
-    const CurveCard& cc = curve(bl.lcid, bl.at.loc(key + ".LCID"));
-    if (const auto problem = motion_curve_problem(bl.sf, cc.curve, false); !problem.empty())
-      throw InputError(bl.at.loc(key + ".LCID"), fmt::format("curve {}: {}", bl.lcid, problem));
-    warn_if_curve_ends(bl.lcid, cc);
-    BodyLoad load;
-    load.acceleration[bl.axis] = -bl.sf;
-    load.curve = cc.curve;
-    load.where = bl.at.loc(key);
-    c.body_loads.push_back(load);
-  }
+  conditions(c, mesh, warnings);
 
   const auto shared = std::make_shared<const Mesh>(std::move(mesh));
   for (auto& pc : c.parts) pc.mesh.embedded = shared;
