@@ -367,6 +367,9 @@ TEST(Deck, Gravity) {
   EXPECT_NE(error("gravity: [0, -9.81]\n").find("deck.yaml:22: gravity: expected a list of three"),
             std::string::npos);
   EXPECT_NE(error("gravity: {curve: [[0, 1]]}\n").find("gravity.acceleration"), std::string::npos);
+  // A null value at its key's line (QA round 23c: at the next line's).
+  EXPECT_NE(error("gravity:\n\n# end\n").find("deck.yaml:22: gravity: expected a list"),
+            std::string::npos);
   EXPECT_NE(error("gravity: {acceleration: [0, 0, -9.81], ramp: 1}\n").find("unknown key 'ramp'"),
             std::string::npos);
 }

@@ -512,3 +512,22 @@ TEST(DeckParticles, WarnsOfSummationDensityOnAMaterialThatIsNotAGas) {
   Simulation plain(test::deck(hybrid), world);
   EXPECT_FALSE(has_warning(plain, "summation_density"));
 }
+
+// A body load across a 2-D model's plane moves nothing: warned of (QA round 23c: a z
+// gravity in a plane model, silently held by the plane's constraint).
+TEST(DeckParticles, WarnsOfABodyLoadAcrossThePlane) {
+  const Comm world = Comm::world(); // (Simulation keeps a reference)
+  const std::string deck = R"(termination: {cycles: 5}
+sph: {dimensions: 2}
+materials:
+  rubber: {model: elastic, density: 1200, youngs_modulus: 1.0e7, poissons_ratio: 0.4}
+particles:
+  a: {generate: {shape: box, min: [0, 0, 0], max: [0.004, 0.004, 0.001], spacing: 5.0e-4},
+      material: rubber}
+)";
+  Simulation across(test::deck(deck + "gravity: [0, -9.81, -9.81]\n"), world);
+  EXPECT_TRUE(has_warning(across, "the body load's z component acts across this 2-D model's "
+                                  "plane and moves nothing"));
+  Simulation in_plane(test::deck(deck + "gravity: [0, -9.81, 0]\n"), world);
+  EXPECT_FALSE(has_warning(in_plane, "body load"));
+}

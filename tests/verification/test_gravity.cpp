@@ -22,6 +22,7 @@
 #include <span>
 #include <string>
 
+#include "anvil/core/error.hpp"
 #include "anvil/parallel/comm.hpp"
 #include "anvil/solver/simulation.hpp"
 #include "test_support.hpp"
@@ -118,6 +119,30 @@ gravity: {acceleration: [0, 0, -9.81], curve: [[0, 0], [5.0e-5, 1]]}
     std::printf("gravity on a column: momentum balance %.2e N s (weight's impulse per step "
                 "%.2e N s); base reaction at the end %.4g N, weight %.4g N\n",
                 worst, largest, last_reaction, weight);
+}
+
+// A step that no longer advances the time stops the run with exit status 3 (QA round 23c:
+// particles under a gravity of 1e308 looped for ever at a step of 0 s; minimum_fraction,
+// 0 by default, was the only guard).
+TEST(Gravity, AStepThatNoLongerAdvancesTheTimeStopsTheRun) {
+  const Comm world = Comm::world();
+  Simulation sim(test::deck(R"(
+termination: {time: 1.0e-3}
+materials:
+  steel: {model: elastic, density: 7800, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+particles:
+  cube: {generate: {shape: box, min: [0, 0, 0], max: [0.002, 0.002, 0.002], spacing: 1.0e-3},
+         material: steel}
+gravity: [0, 0, 1.0e308]
+)"),
+                 world);
+  std::string message;
+  try {
+    for (int k = 0; k < 100000 && !sim.finished(); ++k) sim.step();
+  } catch (const PhysicsError& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("too small to advance the time"), std::string::npos) << message;
 }
 
 } // namespace

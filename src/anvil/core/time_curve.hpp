@@ -35,11 +35,11 @@ struct TimeCurve {
   }
 };
 
-// Why `amplitude` times this curve cannot be a prescribed motion, or "" when it can: a
-// displacement history starts from the initial position (0 at t = 0, to round-off of its
-// largest value); the motion's values, and a displacement's rates (the velocities it
-// prescribes), must be finite numbers.
-inline std::string motion_curve_problem(double amplitude, const TimeCurve& c, bool displacement) {
+// Why `amplitude` times this curve cannot be a time history (of a prescribed motion or a
+// body load), or "" when it can: a displacement history starts from the initial position
+// (0 at t = 0, to round-off of its largest value); the values, and a displacement's rates
+// (the velocities it prescribes), must be finite numbers.
+inline std::string time_history_problem(double amplitude, const TimeCurve& c, bool displacement) {
   auto text = [](const char* format, double x) {
     char buf[256];
     std::snprintf(buf, sizeof buf, format, x);
@@ -53,8 +53,8 @@ inline std::string motion_curve_problem(double amplitude, const TimeCurve& c, bo
                 c.at(0.0));
   for (std::size_t k = 0; k < c.t.size(); ++k) {
     if (!std::isfinite(amplitude * c.value[k]))
-      return text("the motion's value at t = %g overflows (the scale factor times the curve "
-                  "is not a finite number)",
+      return text("the value at t = %g overflows (the scale factor times the curve is not a "
+                  "finite number)",
                   c.t[k]);
     if (displacement && k > 0 &&
         !std::isfinite(amplitude * ((c.value[k] - c.value[k - 1]) / (c.t[k] - c.t[k - 1]))))

@@ -73,6 +73,9 @@ public:
 
   const std::string& path() const { return path_; }
   int line() const {
+    // A null value (`gravity:` with nothing after it) is marked at the next token, often on
+    // a later line: it is reported at its key's line (QA round 23c).
+    if ((!n_ || n_.IsNull()) && fallback_line_ > 0) return fallback_line_;
     const auto m = n_.Mark();
     return m.line >= 0 ? m.line + 1 : fallback_line_;
   }
@@ -932,7 +935,7 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
         if (bc.curve) {
           const double amplitude =
               std::max({std::abs(bc.value.x), std::abs(bc.value.y), std::abs(bc.value.z)});
-          if (const auto problem = motion_curve_problem(amplitude, *bc.curve, moved);
+          if (const auto problem = time_history_problem(amplitude, *bc.curve, moved);
               !problem.empty())
             n.child("curve").fail(problem);
         }
@@ -1021,7 +1024,7 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
         load.curve = parse_curve(g.child("curve"));
         const Vec3& a = load.acceleration;
         const double amplitude = std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z)});
-        if (const auto problem = motion_curve_problem(amplitude, *load.curve, false);
+        if (const auto problem = time_history_problem(amplitude, *load.curve, false);
             !problem.empty())
           g.child("curve").fail(problem);
       }

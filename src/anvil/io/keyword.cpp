@@ -1328,7 +1328,7 @@ private:
       const std::string key = "*" + m.keyword;
       const CurveCard& cc = curve(m.lcid, m.at.loc(key + ".LCID"));
       const TimeCurve& tc = cc.curve;
-      if (const auto problem = motion_curve_problem(m.sf, tc, m.displacement); !problem.empty())
+      if (const auto problem = time_history_problem(m.sf, tc, m.displacement); !problem.empty())
         throw InputError(m.at.loc(key + ".LCID"), fmt::format("curve {}: {}", m.lcid, problem));
       warn_if_curve_ends(m.lcid, cc);
       BoundaryCondition bc;
@@ -1453,7 +1453,7 @@ private:
     for (const auto& bl : bodies_) {
       const std::string key = "*" + bl.keyword;
       const CurveCard& cc = curve(bl.lcid, bl.at.loc(key + ".LCID"));
-      if (const auto problem = motion_curve_problem(bl.sf, cc.curve, false); !problem.empty())
+      if (const auto problem = time_history_problem(bl.sf, cc.curve, false); !problem.empty())
         throw InputError(bl.at.loc(key + ".LCID"), fmt::format("curve {}: {}", bl.lcid, problem));
       warn_if_curve_ends(bl.lcid, cc);
       BodyLoad load;

@@ -330,6 +330,19 @@ void Simulation::warn_of_setup(const Mesh& mesh) {
         "continuity density (the default) for liquids and solids (docs/sph.md)",
         ps.where.str(), ps.name, ps.material));
   }
+  // A body load across the plane (line) of a 2-D (1-D) particle model: held by the plane's
+  // constraint, it does nothing (QA round 23c: a z gravity in a plane model, almost always
+  // meant along y).
+  if (pt && config_.sph.dimensions < 3)
+    for (const auto& load : config_.body_loads)
+      for (int i = config_.sph.dimensions; i < 3; ++i)
+        if (load.acceleration[i] != 0.0)
+          warnings_.push_back(fmt::format(
+              "{}: the body load's {} component acts across this {}-D model's {} and moves "
+              "nothing (the model's constraint holds it); a {}-D model's loads lie along {}",
+              load.where.str(), "xyz"[i], config_.sph.dimensions,
+              config_.sph.dimensions == 2 ? "plane" : "line", config_.sph.dimensions,
+              config_.sph.dimensions == 2 ? "x and y" : "x"));
 }
 
 std::vector<std::size_t> Simulation::contact_blocks(const Mesh& mesh) const {
@@ -665,7 +678,16 @@ V advance_velocity(const V (&old)[3], const V (&f)[3], const V (&bc)[3], const M
 void Simulation::predict() {
   ScopedPhase t(timers_, Phase::predict);
   double dt = config_.time_step_scale * dt_stable_;
-  if (clock_.cycle > 0 && dt < config_.time_step_minimum_fraction * clock_.dt_initial) {
+  const bool below =
+      clock_.cycle > 0 && dt < config_.time_step_minimum_fraction * clock_.dt_initial;
+  // Steps that no longer advance the time (0, not a number, or below the time's last
+  // digit) would repeat for ever, whatever minimum_fraction says (QA round 23c: particles
+  // under a gravity of 1e308 looped at a step of 0 s). Many are let pass: an element
+  // crushed flat controls such steps, shrinking, until erosion takes it (3,010 of them in
+  // Cli.ErosionAndTimeStepCollapse).
+  stalled_steps_ = clock_.time + dt > clock_.time ? 0 : stalled_steps_ + 1;
+  const bool stalled = stalled_steps_ > 10000;
+  if (below || stalled) {
     // Every rank takes this branch (dt is global). The controlling element: the smallest
     // gid among the ranks that hold the global minimum (an element's step, unless a
     // particle's was smaller).
@@ -677,9 +699,12 @@ void Simulation::predict() {
         clock_.dt_particle >= 0 ? fmt::format("particle {}", clock_.dt_particle + 1)
                                 : describe_element(element),
         clock_.time,
-        fmt::format("the time step collapsed to {:.3e} s, below {} of the initial {:.3e} s "
-                    "(it controls the step)",
-                    dt, config_.time_step_minimum_fraction, clock_.dt_initial));
+        stalled ? fmt::format("the time step collapsed to {:.3e} s, too small to advance the "
+                              "time for 10,000 steps (it controls the step)",
+                              dt)
+                : fmt::format("the time step collapsed to {:.3e} s, below {} of the initial "
+                              "{:.3e} s (it controls the step)",
+                              dt, config_.time_step_minimum_fraction, clock_.dt_initial));
   }
   dt_full_ = dt;
   if (std::isfinite(config_.end_time) && clock_.time + dt > config_.end_time)

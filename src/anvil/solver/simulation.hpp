@@ -206,6 +206,7 @@ private:
   std::vector<double> motion_factor_;
   double gravity_[3] = {0, 0, 0}; // body acceleration of the current step, m/s^2
   std::array<double, 3> gravity_work_before_{0, 0, 0}; // of the step before (its work)
+  std::int64_t stalled_steps_ = 0; // steps in a row that did not advance the time
   std::vector<CurvedComponent> curved_components_;
   // Per local node and component: the condition that constrains it (-1: none), and the
   // force it applies there over the current step, N (predict, correct; summed per
