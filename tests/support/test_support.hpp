@@ -2,10 +2,12 @@
 // and running a deck given as text.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <string>
 
 #include "anvil/io/config.hpp"
+#include "anvil/solver/simulation.hpp"
 
 namespace anvil::test {
 
@@ -14,6 +16,10 @@ double relative_error(double a, double b, double floor = 1e-300);
 
 // Parses deck text (as if from file `name`) into configuration.
 Config deck(const std::string& yaml, const std::string& name = "test.yaml");
+
+// The nodes' total momentum (x, y, z) and, last, the sum of their |m v| (a scale for
+// tolerances), over every rank's owned nodes. Collective.
+std::array<double, 4> node_momentum(const Simulation& sim);
 
 // Source and binary locations (set by CMake).
 inline const char* source_dir() {

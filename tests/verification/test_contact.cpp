@@ -26,18 +26,7 @@ namespace {
 
 using namespace anvil;
 
-// The total momentum and, last, the sum of the nodes' |m v| (for the tolerance).
-std::array<double, 4> momentum(const Simulation& sim) {
-  std::array<double, 4> p{0, 0, 0, 0};
-  const auto& nd = sim.nodes();
-  for (std::size_t n = 0; n < nd.size(); ++n)
-    if (sim.fe().node_owned[n]) {
-      for (int i = 0; i < 3; ++i) p[i] += nd.mass[n] * nd.v[i][n];
-      p[3] += nd.mass[n] * std::hypot(nd.v[0][n], nd.v[1][n], nd.v[2][n]);
-    }
-  sim.comm().sum(std::span<double>(p));
-  return p;
-}
+using test::node_momentum;
 
 TEST(Contact, TwoBlocksConserveMomentumAndEnergy) {
   const Config c = test::deck(R"(
@@ -60,9 +49,9 @@ contact:
 )");
   const Comm world = Comm::world();
   Simulation sim(c, world);
-  const auto p0 = momentum(sim);
+  const auto p0 = node_momentum(sim);
   while (!sim.finished()) sim.step();
-  const auto p1 = momentum(sim);
+  const auto p1 = node_momentum(sim);
   const double scale = p0[3]; // |p_a| + |p_b|: each block moves as a whole at t = 0
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(p1[i], p0[i], 1e-12 * scale) << "component " << i;
   const Sample s = sim.sample();

@@ -48,31 +48,43 @@ namespace {
 
 using namespace anvil;
 
-TEST(PrescribedMotion, VelocityHistoryTravelsAsDAlembertSays) {
-  const double L = 0.1, rho = 7850, E = 200e9, nu = 0.3;
-  const double M = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
-  const double c = std::sqrt(M / rho);
-  const double T = 0.2 * L / c; // 40 of the 200 elements
-  const double t_end = 1.2 * L / c;
-  const std::string deck = fmt::format(R"(
+// The steel columns of tests 1 and 3: L = 0.1 m along z, in uniaxial strain (sides held
+// laterally), with the P-wave modulus M and wave speed c.
+constexpr double L = 0.1, rho = 7850, E = 200e9, nu = 0.3;
+const double M = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
+const double c = std::sqrt(M / rho);
+
+// The column's deck: `width` square, `cells` elements along z, run to `end`; `more` adds
+// conditions (its ends' loading) and sections.
+std::string column_deck(double width, int cells, double end, const std::string& more) {
+  return fmt::format(R"(
 termination: {{time: {}}}
 materials:
   steel: {{model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}}
 parts:
   column:
-    mesh: {{generate: box, min: [0, 0, 0], max: [0.0005, 0.0005, 0.1], divisions: [1, 1, 200]}}
+    mesh: {{generate: box, min: [0, 0, 0], max: [{}, {}, 0.1], divisions: [1, 1, {}]}}
     material: steel
 boundary_conditions:
   - {{set: column.xmin, fix: [x]}}
   - {{set: column.xmax, fix: [x]}}
   - {{set: column.ymin, fix: [y]}}
   - {{set: column.ymax, fix: [y]}}
-  - {{set: column.zmin, velocity: [0, 0, 1.0], components: [z], curve: [[0, 0], [{}, 1]]}}
-probes:
-  - {{name: mid, at: [0, 0, 0.05]}}
-  - {{name: end, at: [0, 0, 0]}}
 )",
-                                       t_end, T);
+                     end, width, width, cells) +
+         more;
+}
+
+TEST(PrescribedMotion, VelocityHistoryTravelsAsDAlembertSays) {
+  const double T = 0.2 * L / c; // 40 of the 200 elements
+  const double t_end = 1.2 * L / c;
+  const std::string deck =
+      column_deck(0.0005, 200, t_end,
+                  fmt::format("  - {{set: column.zmin, velocity: [0, 0, 1.0], components: [z], "
+                              "curve: [[0, 0], [{}, 1]]}}\n"
+                              "probes:\n  - {{name: mid, at: [0, 0, 0.05]}}\n"
+                              "  - {{name: end, at: [0, 0, 0]}}\n",
+                              T));
   const Comm world = Comm::world();
   Simulation sim(test::deck(deck), world);
   auto v0 = [&](double t) { return t <= 0 ? 0.0 : (t < T ? t / T : 1.0); };
@@ -213,45 +225,23 @@ bar
 }
 
 TEST(PrescribedMotion, ReactionsBalanceMomentumAndTheStaticForce) {
-  const double L = 0.1, A = 1e-4, rho = 7850, E = 200e9, nu = 0.3, u_max = 1e-5;
-  const double M = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
-  const double c = std::sqrt(M / rho);
+  const double A = 1e-4, u_max = 1e-5;
   const double T = 20 * L / c, v = u_max / T;
-  const std::string deck = fmt::format(R"(
-termination: {{time: {}}}
-materials:
-  steel: {{model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}}
-parts:
-  column:
-    mesh: {{generate: box, min: [0, 0, 0], max: [0.01, 0.01, 0.1], divisions: [1, 1, 20]}}
-    material: steel
-boundary_conditions:
-  - {{set: column.xmin, fix: [x]}}
-  - {{set: column.xmax, fix: [x]}}
-  - {{set: column.ymin, fix: [y]}}
-  - {{set: column.ymax, fix: [y]}}
-  - {{set: column.zmin, fix: [z]}}
-  - {{set: column.zmax, displacement: [0, 0, {}], components: [z], curve: [[0, 0], [{}, 1]]}}
-)",
-                                       1.5 * T, u_max, T);
+  const std::string deck =
+      column_deck(0.01, 20, 1.5 * T,
+                  fmt::format("  - {{set: column.zmin, fix: [z]}}\n"
+                              "  - {{set: column.zmax, displacement: [0, 0, {}], components: [z], "
+                              "curve: [[0, 0], [{}, 1]]}}\n",
+                              u_max, T));
   const Comm world = Comm::world();
   Simulation sim(test::deck(deck), world);
-  auto momentum = [&] {
-    double p[3] = {0, 0, 0};
-    const auto& nd = sim.nodes();
-    for (std::size_t n = 0; n < nd.size(); ++n)
-      if (sim.fe().node_owned[n])
-        for (int i = 0; i < 3; ++i) p[i] += nd.mass[n] * nd.v[i][n];
-    world.sum(std::span<double>(p, 3));
-    return std::array<double, 3>{p[0], p[1], p[2]};
-  };
   double worst_balance = 0, largest_impulse = 0, worst_static = 0;
   while (!sim.finished()) {
-    const auto p0 = momentum();
+    const auto p0 = test::node_momentum(sim);
     const double dt_before = sim.clock().dt;
     sim.step();
     const double dt_avg = 0.5 * (dt_before + sim.clock().dt);
-    const auto p1 = momentum();
+    const auto p1 = test::node_momentum(sim);
     const Sample s = sim.sample();
     for (int i = 0; i < 3; ++i) {
       double sum = 0;
