@@ -28,8 +28,13 @@ void print_warnings(const anvil::Config& config, const anvil::Comm& comm) {
 
 // One line of `check` per boundary condition, as history.csv numbers their reactions
 // (bcN.fx ...): its selection and what it holds.
-std::string describe_condition(std::size_t n, const anvil::BoundaryCondition& bc) {
-  const auto& s = bc.nodes;
+// "1 node", "2 nodes".
+std::string count_of(std::int64_t n, const char* thing) {
+  return fmt::format("{} {}{}", n, thing, n == 1 ? "" : "s");
+}
+
+// A selection as `check` shows it: its name, or its part and box.
+std::string describe_selection(const anvil::Selection& s) {
   std::string where = s.name;
   if (where.empty()) {
     where = s.part ? "part " + *s.part : "all";
@@ -37,6 +42,11 @@ std::string describe_condition(std::size_t n, const anvil::BoundaryCondition& bc
       where += fmt::format(" in box [{:g}, {:g}, {:g}]-[{:g}, {:g}, {:g}]", s.box->lo.x,
                            s.box->lo.y, s.box->lo.z, s.box->hi.x, s.box->hi.y, s.box->hi.z);
   }
+  return where;
+}
+
+std::string describe_condition(std::size_t n, const anvil::BoundaryCondition& bc) {
+  const std::string where = describe_selection(bc.nodes);
   const auto& on = bc.prescribed ? bc.components : bc.fix;
   std::string comps;
   for (int i = 0; i < 3; ++i)
@@ -46,9 +56,24 @@ std::string describe_condition(std::size_t n, const anvil::BoundaryCondition& bc
     const bool moved = bc.motion == anvil::BoundaryCondition::Motion::displacement;
     what = fmt::format("{} {} [{:g}, {:g}, {:g}]", moved ? "displacement" : "velocity", comps,
                        bc.value.x, bc.value.y, bc.value.z);
-    if (bc.curve) what += fmt::format(" x curve of {} points", bc.curve->t.size());
+    if (bc.curve)
+      what += fmt::format(" x curve of {}",
+                          count_of(static_cast<std::int64_t>(bc.curve->t.size()), "point"));
   }
   return fmt::format("  bc{:<3} {:<24} {}", n, where, what);
+}
+
+// One line of `check` per external load: what it applies, and where.
+std::string describe_load(std::size_t n, const anvil::Load& load, std::int64_t targets) {
+  std::string what =
+      load.kind == anvil::Load::Kind::force
+          ? fmt::format("force [{:g}, {:g}, {:g}] N on each of {}", load.force.x, load.force.y,
+                        load.force.z, count_of(targets, "node"))
+          : fmt::format("pressure {:g} Pa on {}", load.pressure, count_of(targets, "face"));
+  if (load.curve)
+    what += fmt::format(" x curve of {}",
+                        count_of(static_cast<std::int64_t>(load.curve->t.size()), "point"));
+  return fmt::format("  load{:<2} {:<24} {}", n, describe_selection(load.target), what);
 }
 
 int check(const std::string& deck, const anvil::Comm& comm) {
@@ -66,6 +91,7 @@ int check(const std::string& deck, const anvil::Comm& comm) {
       set_mass[static_cast<std::size_t>(pt.set[i])] += pt.mass[i];
     comm.sum(std::span<double>(set_mass));
   }
+  const std::vector<std::int64_t> load_targets = sim.load_targets();
   if (comm.rank() != 0) return 0;
   std::printf("deck        %s%s\n", deck.c_str(),
               config.title.empty() ? "" : fmt::format("  ({})", config.title).c_str());
@@ -88,6 +114,11 @@ int check(const std::string& deck, const anvil::Comm& comm) {
                 config.boundary_conditions.size());
     for (std::size_t b = 0; b < config.boundary_conditions.size(); ++b)
       std::printf("%s\n", describe_condition(b, config.boundary_conditions[b]).c_str());
+  }
+  if (!config.loads.empty()) {
+    std::printf("loads       %zu\n", config.loads.size());
+    for (std::size_t l = 0; l < config.loads.size(); ++l)
+      std::printf("%s\n", describe_load(l, config.loads[l], load_targets[l]).c_str());
   }
   if (sim.global_elements() == 0) {
     // The particles' step needs their first phase (wave speeds from the materials).

@@ -1,8 +1,8 @@
 // The whole cycle allocates nothing in steady state (the rule for the hot cycle): after
 // warm-up cycles, during which buffers grow to their working size, further steps of an
-// FE model in contact (element forces, corner exchange, the contact decomposition's
-// transfers, search and penalty forces, forces back to the owners, rigid wall, update)
-// make no C++ allocation. Tolerance: zero.
+// FE model in contact (element forces, external loads (a pressure and nodal forces), corner
+// exchange, the contact decomposition's transfers, search and penalty forces, forces back
+// to the owners, rigid wall, update) make no C++ allocation. Tolerance: zero.
 //
 // The model must be steady for that to mean anything: a buffer that follows the model
 // (pairs, ghosted faces, a rank's share of the contact items) grows each
@@ -50,6 +50,9 @@ initial_conditions:
   - {part: b, velocity: [0, 0, -20.0]}
 boundary_conditions:
   - {set: b.zmax, velocity: [0, 0, 0]}
+loads:
+  - {surface: a.xmax, pressure: 1.0e5, curve: [[0, 0], [1.0e-5, 1]]}
+  - {set: a.ymin, force: [0, 1.0e-3, 0]}
 rigid_walls:
   - {point: [0, 0, 0], normal: [0, 0, 1]}
 contact:

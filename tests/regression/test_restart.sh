@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Restart reproduces the uninterrupted run bit for bit, on another number of ranks:
 #  1. the can crush (contact, self-contact, prescribed block: its velocity slows along a
-#     time history through the restart, so that the curve is taken up mid-way) runs
-#     uninterrupted on 1 rank;
+#     time history through the restart, so that the curve is taken up mid-way; a ramped
+#     pressure and nodal forces) runs uninterrupted on 1 rank;
 #  2. on 2 ranks it is stopped at cycle 700 (the path SIGTERM takes) and restarted on 3,
 #     into another output directory (whose history and field series must continue the
 #     stopped run's: the same rows as the uninterrupted run, every series entry readable);
@@ -21,6 +21,9 @@ sed -e 's/termination: {time: 3.2e-3}/termination: {time: 2.5e-4}/' \
 grep -q "termination: {time: 2.5e-4}" deck.yaml || { echo "the deck edit did not apply"; exit 1; }
 grep -q "curve: \[\[0, 1\], \[2.5e-4, 0.5\]\]" deck.yaml || { echo "the curve edit did not apply"; exit 1; }
 echo "checkpoint: {every: 5.0e-5}" >> deck.yaml
+# External loads ramped through the restart (a pressure on the can's outside, forces on its
+# rim): nothing of them is in the checkpoint, all of it follows from the time and state.
+printf 'loads:\n  - {surface: can.outer, pressure: 2.0e5, curve: [[0, 0], [2.5e-4, 1]]}\n  - {set: can.top, force: [0, 0, -0.5]}\n' >> deck.yaml
 run() { mpirun --oversubscribe -np "$@"; }
 
 run 1 "$anvil" run deck.yaml -o full -q

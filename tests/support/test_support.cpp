@@ -4,6 +4,8 @@
 #include <cmath>
 #include <span>
 
+#include <fmt/format.h>
+
 #include "anvil/io/deck.hpp"
 
 namespace anvil::test {
@@ -28,6 +30,25 @@ std::array<double, 4> node_momentum(const Simulation& sim) {
     }
   sim.comm().sum(std::span<double>(p));
   return p;
+}
+
+std::string column_deck(double width, int cells, double end, const std::string& more) {
+  return fmt::format(R"(
+termination: {{time: {}}}
+materials:
+  steel: {{model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}}
+parts:
+  column:
+    mesh: {{generate: box, min: [0, 0, 0], max: [{}, {}, {}], divisions: [1, 1, {}]}}
+    material: steel
+boundary_conditions:
+  - {{set: column.xmin, fix: [x]}}
+  - {{set: column.xmax, fix: [x]}}
+  - {{set: column.ymin, fix: [y]}}
+  - {{set: column.ymax, fix: [y]}}
+)",
+                     end, width, width, column_length, cells) +
+         more;
 }
 
 } // namespace anvil::test

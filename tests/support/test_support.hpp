@@ -21,6 +21,13 @@ Config deck(const std::string& yaml, const std::string& name = "test.yaml");
 // tolerances), over every rank's owned nodes. Collective.
 std::array<double, 4> node_momentum(const Simulation& sim);
 
+// The steel column of the 1-D wave tests (prescribed motions, loads): column_length = 0.1 m
+// along z, `width` square, `cells` elements along z, its sides held laterally (uniaxial
+// strain), run to `end`; `more` adds conditions (its ends' loading) and sections.
+// Steel: density 7850 kg/m^3, E 200 GPa, nu 0.3.
+inline constexpr double column_length = 0.1;
+std::string column_deck(double width, int cells, double end, const std::string& more);
+
 // Source and binary locations (set by CMake).
 inline const char* source_dir() {
   return ANVIL_SOURCE_DIR;

@@ -471,12 +471,12 @@ TEST(Keyword, ConstraintsVelocitiesContactWalls) {
 }
 
 TEST(Keyword, UnsupportedKeywordsMakeOneWarning) {
-  const Config c = kw(with(good, "*END", R"(*LOAD_NODE_SET
+  const Config c = kw(with(good, "*END", R"(*LOAD_SHELL_SET
          7         3         1
 *DEFINE_CURVE
          1
        0.0       0.0
-*LOAD_NODE_SET
+*LOAD_SHELL_SET
          7         1         1
 *PART
 shell part
@@ -492,7 +492,7 @@ shell part
       about_keywords.push_back(w);
   ASSERT_EQ(about_keywords.size(), 1u);
   const std::string& w = about_keywords[0];
-  EXPECT_NE(w.find("*LOAD_NODE_SET (2x, first at model.k:"), std::string::npos) << w;
+  EXPECT_NE(w.find("*LOAD_SHELL_SET (2x, first at model.k:"), std::string::npos) << w;
   // A curve no prescribed motion names is not read (its card here is not even in LS-DYNA's
   // columns) and changes nothing: not listed.
   EXPECT_EQ(w.find("*DEFINE_CURVE"), std::string::npos) << w;
@@ -1055,12 +1055,12 @@ CliRun anvil(const std::string& args) {
 TEST(KeywordCli, CheckAndRun) {
   const auto dir = fs::temp_directory_path() / fmt::format("anvil_keyword_cli_{}", ::getpid());
   fs::create_directories(dir);
-  std::ofstream(dir / "good.k") << with(good, "*END", "*LOAD_NODE_SET\n7\n*END");
+  std::ofstream(dir / "good.k") << with(good, "*END", "*LOAD_SHELL_SET\n7\n*END");
   CliRun r = anvil(fmt::format("check '{}'", (dir / "good.k").string()));
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("elements    2\n"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("anvil: warning:"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("*LOAD_NODE_SET (1x"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("*LOAD_SHELL_SET (1x"), std::string::npos) << r.output;
   r = anvil(fmt::format("run '{}' -q -o '{}'", (dir / "good.k").string(), (dir / "out").string()));
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(fs::exists(dir / "out" / "summary.json"));

@@ -48,32 +48,12 @@ namespace {
 
 using namespace anvil;
 
-// The steel columns of tests 1 and 3: L = 0.1 m along z, in uniaxial strain (sides held
-// laterally), with the P-wave modulus M and wave speed c.
-constexpr double L = 0.1, rho = 7850, E = 200e9, nu = 0.3;
+// The steel columns of tests 1 and 3 (test::column_deck): L = 0.1 m along z, in uniaxial
+// strain (sides held laterally), with the P-wave modulus M and wave speed c.
+constexpr double L = test::column_length, rho = 7850, E = 200e9, nu = 0.3;
 const double M = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
 const double c = std::sqrt(M / rho);
-
-// The column's deck: `width` square, `cells` elements along z, run to `end`; `more` adds
-// conditions (its ends' loading) and sections.
-std::string column_deck(double width, int cells, double end, const std::string& more) {
-  return fmt::format(R"(
-termination: {{time: {}}}
-materials:
-  steel: {{model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}}
-parts:
-  column:
-    mesh: {{generate: box, min: [0, 0, 0], max: [{}, {}, 0.1], divisions: [1, 1, {}]}}
-    material: steel
-boundary_conditions:
-  - {{set: column.xmin, fix: [x]}}
-  - {{set: column.xmax, fix: [x]}}
-  - {{set: column.ymin, fix: [y]}}
-  - {{set: column.ymax, fix: [y]}}
-)",
-                     end, width, width, cells) +
-         more;
-}
+using test::column_deck;
 
 TEST(PrescribedMotion, VelocityHistoryTravelsAsDAlembertSays) {
   const double T = 0.2 * L / c; // 40 of the 200 elements

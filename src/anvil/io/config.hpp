@@ -136,6 +136,20 @@ struct BodyLoad {
   SourceLocation where;
 };
 
+// An external load on the mesh (deck `loads`; LS-DYNA *LOAD_NODE, *LOAD_SEGMENT): a force
+// on each node of a set, or a pressure on faces, times its curve's value at the time (1
+// without a curve).
+struct Load {
+  enum class Kind { force, pressure } kind = Kind::force;
+  // force: the nodes. pressure: the faces, a side set of the mesh by name (PART.SET), or the
+  // exterior faces whose four nodes a node selection holds.
+  Selection target;
+  Vec3 force;          // N on each node
+  double pressure = 0; // Pa; positive pushes into the body, against the outward normal
+  std::optional<TimeCurve> curve;
+  SourceLocation where;
+};
+
 // General contact (DESIGN.md section 4): node-to-face penalty contact among the exterior
 // faces of the listed parts, self-contact included.
 struct ContactConfig {
@@ -199,6 +213,7 @@ struct Config {
   std::vector<ContactConfig> contact; // at most one
   std::vector<RigidWallConfig> rigid_walls;
   std::vector<BodyLoad> body_loads; // summed
+  std::vector<Load> loads;
   DecompositionConfig decomposition;
   // What the reader accepted but could not take over exactly (an LS-DYNA keyword that
   // anvil ignores, a material option it approximates); the command line prints them.

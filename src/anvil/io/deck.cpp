@@ -710,10 +710,10 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
   }
   const Node top(root, "", &c.deck_file, 1);
   if (top.is_null()) throw InputError({name, 1, ""}, "the deck is empty");
-  const auto entries =
-      top.entries({"title", "termination", "time_step", "materials", "parts", "particles", "sph",
-                   "node_sets", "initial_conditions", "boundary_conditions", "contact",
-                   "rigid_walls", "gravity", "probes", "output", "checkpoint", "decomposition"});
+  const auto entries = top.entries({"title", "termination", "time_step", "materials", "parts",
+                                    "particles", "sph", "node_sets", "initial_conditions",
+                                    "boundary_conditions", "contact", "rigid_walls", "gravity",
+                                    "loads", "probes", "output", "checkpoint", "decomposition"});
   (void)entries;
 
   if (top.has("title")) c.title = top.child("title").str();
@@ -1032,6 +1032,40 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
       load.acceleration = g.vec3();
     }
     c.body_loads.push_back(load);
+  }
+
+  // loads: forces on nodes, pressures on faces, each optionally times a time history.
+  if (top.has("loads")) {
+    for (const auto& n : top.child("loads").items()) {
+      n.check_keys({"set", "force", "surface", "pressure", "curve"});
+      Load load;
+      load.where = n.where();
+      if (n.has("force") == n.has("pressure")) n.fail("give exactly one of 'force' or 'pressure'");
+      double amplitude = 0;
+      if (n.has("force")) {
+        load.kind = Load::Kind::force;
+        if (n.has("surface"))
+          n.child("surface").fail("a force acts on the nodes of a set: write set, not surface");
+        load.target = parse_set_ref(n.required("set"));
+        load.force = n.child("force").vec3();
+        amplitude =
+            std::max({std::abs(load.force.x), std::abs(load.force.y), std::abs(load.force.z)});
+      } else {
+        load.kind = Load::Kind::pressure;
+        if (n.has("set")) n.child("set").fail("a pressure acts on faces: write surface, not set");
+        load.target = parse_set_ref(n.required("surface"));
+        load.pressure = n.child("pressure").number();
+        amplitude = std::abs(load.pressure);
+      }
+      check_name(load.target);
+      if (n.has("curve")) {
+        load.curve = parse_curve(n.child("curve"));
+        if (const auto problem = time_history_problem(amplitude, *load.curve, false);
+            !problem.empty())
+          n.child("curve").fail(problem);
+      }
+      c.loads.push_back(load);
+    }
   }
 
   if (top.has("rigid_walls")) {

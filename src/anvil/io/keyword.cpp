@@ -621,6 +621,35 @@ struct BodyCard {
   std::string keyword;
 };
 
+// *LOAD_NODE_POINT/_SET: a force SF times curve LCID along one axis on a node (each node
+// of a set).
+struct NodeLoadCard {
+  std::int64_t set = 0, node = 0; // one of them
+  int dof = 0;                    // 0, 1, 2: x, y, z
+  std::int64_t lcid = 0;
+  double sf = 1;
+  Where at;
+  std::string keyword;
+};
+
+// *LOAD_SEGMENT (one segment by its nodes) or *LOAD_SEGMENT_SET (a *SET_SEGMENT): a
+// pressure SF times curve LCID.
+struct SegmentLoadCard {
+  std::int64_t set = 0;                // *LOAD_SEGMENT_SET
+  std::array<std::int64_t, 4> nodes{}; // *LOAD_SEGMENT: N1-N4 (node ids)
+  std::int64_t lcid = 0;
+  double sf = 1;
+  Where at;
+  std::string keyword;
+};
+
+// *SET_SEGMENT: quadrilaterals by their four node ids, each with its card.
+struct SegmentSet {
+  std::vector<std::array<std::int64_t, 4>> segments;
+  std::vector<Where> at;
+  Where head;
+};
+
 struct VelocityGen {
   int styp; // 1 part set, 2 part, 3 node set, 0: all parts (*INITIAL_VELOCITY with NSID 0)
   std::int64_t id;
@@ -730,6 +759,10 @@ private:
     if (n == "BOUNDARY_PRESCRIBED_MOTION_NODE" || n == "BOUNDARY_PRESCRIBED_MOTION_NODE_ID")
       return prescribed_motion(b, false);
     if (n == "LOAD_BODY_X" || n == "LOAD_BODY_Y" || n == "LOAD_BODY_Z") return body_load(b);
+    if (n == "LOAD_NODE_POINT" || n == "LOAD_NODE_SET") return node_load(b, n == "LOAD_NODE_SET");
+    if (n == "LOAD_SEGMENT" || n == "LOAD_SEGMENT_ID") return segment_load(b, false);
+    if (n == "LOAD_SEGMENT_SET" || n == "LOAD_SEGMENT_SET_ID") return segment_load(b, true);
+    if (n == "SET_SEGMENT" || n == "SET_SEGMENT_TITLE") return segment_set(b);
     if (n == "LOAD_BODY_PARTS")
       throw InputError(b.head.where("*LOAD_BODY_PARTS"),
                        "*LOAD_BODY_PARTS is not supported: anvil's body loads act on every "
@@ -1300,18 +1333,8 @@ private:
                                      "prescribes the motion to the end of the run",
                                      m.death, endtim_));
     };
-    // A curve that ends before ENDTIM while still changing: said once per curve.
-    std::set<std::int64_t> curves_warned;
     auto warn_if_curve_ends = [&](std::int64_t lcid, const CurveCard& cc) {
-      const TimeCurve& tc = cc.curve;
-      const std::size_t last = tc.t.size() - 1;
-      if (endtim_ > tc.t[last] && last > 0 && tc.value[last] != tc.value[last - 1] &&
-          curves_warned.insert(lcid).second)
-        warnings.push_back(fmt::format(
-            "{}: curve {} ends at t = {} before the end time {}: anvil holds its last value "
-            "there, where LS-DYNA would extrapolate its last slope (extend the curve to the end "
-            "time to have the same run in both)",
-            cc.at.str(), lcid, tc.t[last], endtim_));
+      curve_ends_early(lcid, cc, warnings);
     };
     std::vector<std::pair<std::int64_t, BoundaryCondition>> ordered; // (card seq, condition)
     auto fix_condition = [&](std::int64_t seq, const std::string& set_name,
@@ -1464,6 +1487,185 @@ private:
     }
   }
 
+  // A curve that ends before ENDTIM while still changing: said once per curve.
+  void curve_ends_early(std::int64_t lcid, const CurveCard& cc,
+                        std::vector<std::string>& warnings) {
+    const TimeCurve& tc = cc.curve;
+    const std::size_t last = tc.t.size() - 1;
+    if (endtim_ > tc.t[last] && last > 0 && tc.value[last] != tc.value[last - 1] &&
+        curves_warned_.insert(lcid).second)
+      warnings.push_back(fmt::format(
+          "{}: curve {} ends at t = {} before the end time {}: anvil holds its last value "
+          "there, where LS-DYNA would extrapolate its last slope (extend the curve to the end "
+          "time to have the same run in both)",
+          cc.at.str(), lcid, tc.t[last], endtim_));
+  }
+
+  // Curve `lcid` of a load card, as the time history of SF times it (an error where it
+  // cannot be one, a warning where it ends early).
+  const TimeCurve& load_curve(std::int64_t lcid, double sf, const Where& at, const std::string& key,
+                              std::vector<std::string>& warnings) {
+    const CurveCard& cc = curve(lcid, at.loc(key + ".LCID"));
+    if (const auto problem = time_history_problem(sf, cc.curve, false); !problem.empty())
+      throw InputError(at.loc(key + ".LCID"), fmt::format("curve {}: {}", lcid, problem));
+    curve_ends_early(lcid, cc, warnings);
+    return cc.curve;
+  }
+
+  // The external loads of the deck into `c` (part of config()): forces on nodes (sets)
+  // and pressures on segments. `mesh` gains the sets they need: the nodes of the single-node
+  // cards, grouped by what they apply (load_nodes_N), and the faces of the segments, as side
+  // sets of the elements' faces: SEGSET (segset_SID, or load_segments_N for single-segment
+  // cards grouped by curve and scale) for the segments ordered as the face is seen from
+  // outside its element, SEGSET_reversed for the others. LS-DYNA's positive pressure acts
+  // against the segment's right-hand normal (N1-N2-N3-N4), anvil's against the face's
+  // outward one: the reversed faces take -SF.
+  void loads(Config& c, Mesh& mesh, std::vector<std::string>& warnings) {
+    // Forces: a set's card is a load; single nodes are grouped by (DOF, LCID, SF).
+    std::map<std::tuple<int, std::int64_t, double>, std::size_t> node_groups;
+    for (const auto& nl : node_loads_) {
+      const std::string key = "*" + nl.keyword;
+      Load load;
+      load.kind = Load::Kind::force;
+      load.force[nl.dof] = nl.sf;
+      load.curve = load_curve(nl.lcid, nl.sf, nl.at, key, warnings);
+      load.where = nl.at.loc(key);
+      load.target.where = load.where;
+      if (nl.set != 0) {
+        load.target.name = node_set_name(nl.set, nl.at, key + ".NSID");
+        c.loads.push_back(load);
+        continue;
+      }
+      const auto pos = node_position(nl.node, nl.at, key + ".NID", "the load");
+      const auto [it, fresh] =
+          node_groups.emplace(std::tuple{nl.dof, nl.lcid, nl.sf}, c.loads.size());
+      if (fresh) {
+        load.target.name = fmt::format("load_nodes_{}", node_groups.size());
+        c.loads.push_back(load);
+      }
+      auto& ids = mesh.node_sets[c.loads[it->second].target.name];
+      ids.insert(std::lower_bound(ids.begin(), ids.end(), pos), pos);
+    }
+    if (segment_loads_.empty()) return;
+
+    // Every face of every element, by its sorted node positions, for the segments' lookup.
+    struct FaceKey {
+      std::array<std::int64_t, 4> sorted;
+      std::int64_t element;
+      int face;
+    };
+    std::vector<FaceKey> faces;
+    std::int64_t gid = 0;
+    for (const auto& blk : mesh.blocks)
+      for (const auto& h : blk.elements) {
+        for (int f = 0; f < 6; ++f) {
+          FaceKey k{{}, gid, f};
+          for (int a = 0; a < 4; ++a) k.sorted[a] = h[hex_faces[f][a]];
+          std::sort(k.sorted.begin(), k.sorted.end());
+          faces.push_back(k);
+        }
+        ++gid;
+      }
+    std::sort(faces.begin(), faces.end(), [](const FaceKey& a, const FaceKey& b) {
+      return std::tie(a.sorted, a.element, a.face) < std::tie(b.sorted, b.element, b.face);
+    });
+    const auto offsets = mesh.block_offsets();
+    // The face a segment is (of the lowest element that has it), and whether the segment
+    // runs the other way round.
+    auto face_of = [&](const std::array<std::int64_t, 4>& ids, const Where& at,
+                       const std::string& key) -> std::pair<SideEntry, bool> {
+      std::array<std::int64_t, 4> pos{};
+      for (int a = 0; a < 4; ++a)
+        pos[a] = node_position(ids[a], at, fmt::format("{}.N{}", key, a + 1), "the segment");
+      std::array<std::int64_t, 4> sorted = pos;
+      std::sort(sorted.begin(), sorted.end());
+      if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
+        throw InputError(at.loc(key + ".N4"),
+                         fmt::format("segment ({}, {}, {}, {}) repeats a node: triangular "
+                                     "segments are not supported (anvil's faces are the "
+                                     "quadrilaterals of hexahedra)",
+                                     ids[0], ids[1], ids[2], ids[3]));
+      const auto it = std::lower_bound(
+          faces.begin(), faces.end(), sorted,
+          [](const FaceKey& f, const std::array<std::int64_t, 4>& k) { return f.sorted < k; });
+      if (it == faces.end() || it->sorted != sorted)
+        throw InputError(at.loc(key + ".N1"),
+                         fmt::format("segment ({}, {}, {}, {}) is not a face of a solid "
+                                     "element of the model",
+                                     ids[0], ids[1], ids[2], ids[3]));
+      const auto b = static_cast<std::size_t>(
+          std::upper_bound(offsets.begin(), offsets.end(), it->element) - offsets.begin() - 1);
+      const Hex& h = mesh.blocks[b].elements[static_cast<std::size_t>(it->element - offsets[b])];
+      std::array<std::int64_t, 4> face{};
+      for (int a = 0; a < 4; ++a) face[a] = h[hex_faces[it->face][a]];
+      const auto k = std::find(face.begin(), face.end(), pos[0]) - face.begin();
+      const bool same = face[(k + 1) % 4] == pos[1] && face[(k + 2) % 4] == pos[2];
+      const bool reversed = face[(k + 3) % 4] == pos[1] && face[(k + 2) % 4] == pos[2];
+      if (!same && !reversed)
+        throw InputError(at.loc(key + ".N1"),
+                         fmt::format("segment ({}, {}, {}, {}) does not go round its face in "
+                                     "order (its nodes cross over)",
+                                     ids[0], ids[1], ids[2], ids[3]));
+      return {SideEntry{it->element, it->face}, reversed};
+    };
+    // A pressure on the faces of `segments` (with their cards), as up to two loads on side
+    // sets `name` and `name`_reversed.
+    auto add_pressure = [&](const std::string& name,
+                            const std::vector<std::array<std::int64_t, 4>>& segments,
+                            const std::vector<Where>& at, const std::string& key,
+                            const SegmentLoadCard& card, const TimeCurve& curve) {
+      std::vector<SideEntry> side[2];
+      for (std::size_t k = 0; k < segments.size(); ++k) {
+        const auto [entry, reversed] = face_of(segments[k], at[k], key);
+        side[reversed ? 1 : 0].push_back(entry);
+      }
+      for (int r = 0; r < 2; ++r) {
+        if (side[r].empty()) continue;
+        const std::string set = r ? name + "_reversed" : name;
+        auto& dst = mesh.side_sets[set];
+        dst.insert(dst.end(), side[r].begin(), side[r].end());
+        Load load;
+        load.kind = Load::Kind::pressure;
+        load.pressure = r ? -card.sf : card.sf;
+        load.curve = curve;
+        load.where = card.at.loc("*" + card.keyword);
+        load.target.name = set;
+        load.target.where = load.where;
+        c.loads.push_back(load);
+      }
+    };
+    // Single segments grouped by (LCID, SF), each group at its first card's place.
+    std::map<std::pair<std::int64_t, double>, std::size_t> groups;
+    struct Group {
+      const SegmentLoadCard* first;
+      std::vector<std::array<std::int64_t, 4>> segments;
+      std::vector<Where> at;
+    };
+    std::vector<Group> group;
+    for (const auto& sl : segment_loads_) {
+      const std::string key = "*" + sl.keyword;
+      const TimeCurve& curve = load_curve(sl.lcid, sl.sf, sl.at, key, warnings);
+      if (sl.set != 0) {
+        const auto it = segment_sets_.find(sl.set);
+        if (it == segment_sets_.end())
+          throw InputError(sl.at.loc(key + ".SSID"),
+                           fmt::format("segment set {} is not defined (*SET_SEGMENT)", sl.set));
+        add_pressure(fmt::format("segset_{}", sl.set), it->second.segments, it->second.at,
+                     "*SET_SEGMENT", sl, curve);
+        continue;
+      }
+      const auto [it, fresh] = groups.emplace(std::pair{sl.lcid, sl.sf}, group.size());
+      if (fresh) group.push_back({&sl, {}, {}});
+      group[it->second].segments.push_back(sl.nodes);
+      group[it->second].at.push_back(sl.at);
+    }
+    for (std::size_t g = 0; g < group.size(); ++g) {
+      const SegmentLoadCard& first = *group[g].first;
+      add_pressure(fmt::format("load_segments_{}", g + 1), group[g].segments, group[g].at,
+                   "*" + first.keyword, first, curves_.at(first.lcid).curve);
+    }
+  }
+
   void spc(const Block& b, bool set) {
     Cursor c(b);
     // The _ID option adds one card (ID, HEADING) to the keyword, not one per constraint:
@@ -1514,6 +1716,101 @@ private:
     bc.at = where_of(l);
     bc.keyword = b.name;
     bodies_.push_back(bc);
+  }
+
+  // Any number of cards NID (NSID), DOF, LCID, SF, CID, M1, M2, M3 (LS-DYNA manual,
+  // *LOAD_NODE). anvil applies forces along x, y, z (DOF 1-3) in the global system; a
+  // follower force, a moment or a local system would be another load, so it is an error.
+  void node_load(const Block& b, bool set) {
+    Cursor c(b);
+    while (auto l = c.next_record()) {
+      const Card card(b, *l, {10, 10, 10, 10, 10, 10, 10, 10});
+      const char* what = set ? "NSID" : "NID";
+      NodeLoadCard nl;
+      (set ? nl.set : nl.node) = card.integer(0, what, 0);
+      if ((set ? nl.set : nl.node) <= 0)
+        card.fail(what, fmt::format("{} must be a positive id", what));
+      const auto dof = card.integer(1, "DOF", 0);
+      if (dof < 1 || dof > 3)
+        card.fail("DOF", fmt::format("DOF = {} is not supported: anvil applies forces along x, "
+                                     "y, z (DOF 1, 2, 3); solid nodes take no moments",
+                                     dof));
+      nl.dof = static_cast<int>(dof - 1);
+      nl.lcid = card.integer(2, "LCID", 0);
+      if (nl.lcid <= 0) card.fail("LCID", "LCID must be the id of a *DEFINE_CURVE");
+      nl.sf = card.real(3, "SF", 1.0);
+      if (card.integer(4, "CID", 0) != 0)
+        card.fail("CID", "forces in a local coordinate system (CID) are not supported");
+      nl.at = where_of(*l);
+      nl.keyword = b.name;
+      node_loads_.push_back(nl);
+    }
+  }
+
+  // *LOAD_SEGMENT: any number of cards LCID, SF, AT, N1, N2, N3, N4 (N5: a higher-order
+  // segment's, not supported); *LOAD_SEGMENT_SET: any number of cards SSID, LCID, SF, AT.
+  // The _ID option adds one card (ID, HEADING) first. A pressure that arrives later (AT > 0)
+  // is not supported: anvil applies it from t = 0 (a curve that is 0 until then does it).
+  void segment_load(const Block& b, bool set) {
+    Cursor c(b);
+    if (ends_with(b.name, "_ID")) c.next();
+    while (auto l = c.next_record()) {
+      const Card card(b, *l, {10, 10, 10, 10, 10, 10, 10, 10});
+      SegmentLoadCard sl;
+      const int base = set ? 1 : 0; // LCID's field
+      if (set) {
+        sl.set = card.integer(0, "SSID", 0);
+        if (sl.set <= 0) card.fail("SSID", "SSID must be a positive id");
+      }
+      sl.lcid = card.integer(base, "LCID", 0);
+      if (sl.lcid <= 0) card.fail("LCID", "LCID must be the id of a *DEFINE_CURVE");
+      sl.sf = card.real(base + 1, "SF", 1.0);
+      if (card.real(base + 2, "AT", 0) > 0)
+        card.fail("AT", "AT > 0 (a pressure that arrives later) is not supported: anvil applies "
+                        "the pressure from t = 0; give a curve that is 0 until then");
+      if (!set) {
+        for (int a = 0; a < 4; ++a) {
+          const std::string name = fmt::format("N{}", a + 1);
+          sl.nodes[a] = card.integer(3 + a, name, 0);
+          if (sl.nodes[a] <= 0) card.fail(name, fmt::format("{} must be a positive node id", name));
+        }
+        if (card.integer(7, "N5", 0) != 0)
+          card.fail("N5", "higher-order segments (N5-N8) are not supported: anvil's faces are "
+                          "the quadrilaterals of 8-node hexahedra");
+      }
+      sl.at = where_of(*l);
+      sl.keyword = b.name;
+      segment_loads_.push_back(sl);
+    }
+  }
+
+  // *SET_SEGMENT(_TITLE): SID, DA1-DA4, SOLVER; then any number of cards N1, N2, N3, N4,
+  // A1-A4 (the attributes are not used).
+  void segment_set(const Block& b) {
+    Cursor c(b);
+    skip_title(b, c);
+    const Line l = c.next();
+    const Card head(b, l, {10, 10, 10, 10, 10, 10});
+    const std::int64_t sid = head.integer(0, "SID", 0);
+    if (sid <= 0) head.fail("SID", fmt::format("SID must be a positive set id, found {}", sid));
+    SegmentSet s;
+    s.head = where_of(l);
+    while (auto r = c.next_record()) {
+      const Card card(b, *r, {10, 10, 10, 10, 10, 10, 10, 10});
+      std::array<std::int64_t, 4> n{};
+      for (int a = 0; a < 4; ++a) {
+        const std::string name = fmt::format("N{}", a + 1);
+        n[a] = card.integer(a, name, 0);
+        if (n[a] <= 0) card.fail(name, fmt::format("{} must be a positive node id", name));
+      }
+      s.segments.push_back(n);
+      s.at.push_back(where_of(*r));
+    }
+    if (s.segments.empty()) head.fail("SID", fmt::format("segment set {} has no segments", sid));
+    const auto [it, fresh] = segment_sets_.emplace(sid, std::move(s));
+    if (!fresh)
+      head.fail("SID", fmt::format("segment set {} is defined twice (first at {})", sid,
+                                   it->second.head.str()));
   }
 
   // Any number of cards NSID (NID), DOF, VAD, LCID, SF, VID, DEATH, BIRTH (LS-DYNA
@@ -2029,6 +2326,10 @@ private:
   std::vector<Spc> spcs_;
   std::vector<MotionCard> motions_;
   std::vector<BodyCard> bodies_;
+  std::vector<NodeLoadCard> node_loads_;
+  std::vector<SegmentLoadCard> segment_loads_;
+  std::map<std::int64_t, SegmentSet> segment_sets_;
+  std::set<std::int64_t> curves_warned_;                  // curves said to end before ENDTIM
   std::vector<const Block*> curve_blocks_;                // *DEFINE_CURVE, read by curve()
   std::multimap<std::int64_t, const Block*> curve_index_; // by LCID (0: none readable)
   std::map<std::int64_t, CurveCard> curves_;              // those read
@@ -2303,6 +2604,7 @@ Config KeywordReader::config(const std::string& deck_file) {
   }
 
   conditions(c, mesh, warnings);
+  loads(c, mesh, warnings);
 
   const auto shared = std::make_shared<const Mesh>(std::move(mesh));
   for (auto& pc : c.parts) pc.mesh.embedded = shared;

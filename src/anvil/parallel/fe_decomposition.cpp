@@ -178,11 +178,12 @@ FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, in
   return d;
 }
 
-CornerExchange::CornerExchange(const FeDecomposition& d, const Comm& comm) : d_(d), comm_(comm) {
+CornerExchange::CornerExchange(const FeDecomposition& d, const Comm& comm, int components)
+    : d_(d), comm_(comm), components_(static_cast<std::size_t>(components)) {
   std::size_t ns = 0;
   for (const auto& nb : d.neighbors) ns += nb.send_slots.size();
-  send_.resize(ns * 3);
-  recv_.resize(d.remote_slots * 3);
+  send_.resize(ns * components_);
+  recv_.resize(d.remote_slots * components_);
 }
 
 void CornerExchange::exchange(std::initializer_list<double*> list) {
@@ -193,6 +194,7 @@ void CornerExchange::exchange(std::initializer_list<double*> list) {
 void CornerExchange::start(std::initializer_list<double*> list) {
   if (d_.neighbors.empty()) return;
   const std::size_t k = list.size();
+  if (k > components_) throw std::logic_error("CornerExchange: more arrays than it was built for");
   double* const* arrays = list.begin();
   Requests& req = requests_;
   for (const auto& nb : d_.neighbors) {

@@ -74,7 +74,9 @@ FeDecomposition decompose_fe(const Mesh& mesh, const std::vector<int>& owner, in
 // The per-cycle exchange of corner values between ranks that share nodes.
 class CornerExchange {
 public:
-  CornerExchange(const FeDecomposition& d, const Comm& comm);
+  // `components`: the most arrays one exchange carries (3 forces; 6 with the pressure
+  // loads' corner forces).
+  CornerExchange(const FeDecomposition& d, const Comm& comm, int components = 3);
   // Fills the remote slots of `components` arrays of total_slots() values each. The
   // arrays come as a braced list (an initializer_list lives on the stack: the cycle
   // allocates nothing for it).
@@ -91,6 +93,7 @@ private:
   const Comm& comm_;
   std::vector<double> send_, recv_;
   Requests requests_; // reused: the exchange allocates nothing
+  std::size_t components_;
 };
 
 // Sums the corner slots of every local node (the gather): out[i][n] = sum over the

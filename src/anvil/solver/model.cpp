@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "anvil/contact/surface.hpp"
 #include "anvil/fe/hex_block.hpp"
 #include "anvil/io/keyword.hpp"
 #include "anvil/mesh/generators.hpp"
@@ -122,6 +123,25 @@ Mesh build_mesh(const Config& config) {
     if (m.blocks[0].elements.empty())
       throw InputError(p.mesh.where, "the part's mesh has no elements");
     mesh.append(m, p.name);
+  }
+  // The embedded meshes' side sets (a keyword deck's loaded segments), renumbered from
+  // their blocks to the parts that took them.
+  const auto offsets = mesh.block_offsets();
+  for (const auto& embedded : embedded_offset) {
+    const Mesh* src = embedded.first;
+    const auto src_offsets = src->block_offsets();
+    for (const auto& [name, sides] : src->side_sets) {
+      auto& dst = mesh.side_sets[name];
+      for (const SideEntry& s : sides) {
+        const auto sb = static_cast<std::size_t>(
+            std::upper_bound(src_offsets.begin(), src_offsets.end(), s.element) -
+            src_offsets.begin() - 1);
+        for (std::size_t b = 0; b < config.parts.size(); ++b)
+          if (config.parts[b].mesh.embedded.get() == src &&
+              config.parts[b].mesh.embedded_block == sb)
+            dst.push_back({offsets[b] + (s.element - src_offsets[sb]), s.face});
+      }
+    }
   }
   for (std::size_t b = 0; b < config.parts.size(); ++b)
     if (config.parts[b].thick_shell.enabled()) orient_thickness_zeta(mesh, b);
@@ -263,6 +283,53 @@ std::vector<std::int64_t> resolve_selection(const Mesh& mesh, const Config& conf
   }
   if (ids.empty()) throw InputError(sel.where, "the selection contains no nodes");
   return ids;
+}
+
+std::vector<SideEntry> resolve_surface(const Mesh& mesh, const Config& config,
+                                       const Selection& sel) {
+  if (!sel.name.empty()) {
+    if (const auto it = mesh.side_sets.find(sel.name); it != mesh.side_sets.end()) {
+      std::vector<SideEntry> faces = it->second;
+      std::sort(faces.begin(), faces.end(), [](const SideEntry& a, const SideEntry& b) {
+        return a.element != b.element ? a.element < b.element : a.face < b.face;
+      });
+      faces.erase(std::unique(faces.begin(), faces.end(),
+                              [](const SideEntry& a, const SideEntry& b) {
+                                return a.element == b.element && a.face == b.face;
+                              }),
+                  faces.end());
+      if (faces.empty())
+        throw InputError(sel.where, fmt::format("side set '{}' is empty", sel.name));
+      return faces;
+    }
+    // A deck set: its own selection (its part restricts the faces too), found here.
+    if (const auto it = config.node_sets.find(sel.name); it != config.node_sets.end()) {
+      Selection named = it->second;
+      named.where = sel.where;
+      return resolve_surface(mesh, config, named);
+    }
+  }
+  if (sel.part && part_index(config, *sel.part) == config.parts.size() &&
+      config.particle_set(*sel.part) >= 0)
+    throw InputError(sel.where, fmt::format("'{}' is a particle set: a pressure acts on the "
+                                            "faces of the mesh",
+                                            *sel.part));
+  const std::vector<std::int64_t> nodes = resolve_selection(mesh, config, sel);
+  std::vector<bool> blocks(mesh.blocks.size(), !sel.part);
+  if (sel.part) blocks[part_index(config, *sel.part)] = true;
+  const ExteriorFaces ext = exterior_faces(mesh, blocks);
+  std::vector<SideEntry> faces;
+  for (std::size_t f = 0; f < ext.size(); ++f)
+    if (std::all_of(ext.nodes[f].begin(), ext.nodes[f].end(), [&](std::int64_t n) {
+          return std::binary_search(nodes.begin(), nodes.end(), n);
+        }))
+      faces.push_back({ext.element[f], ext.side[f]});
+  if (faces.empty())
+    throw InputError(sel.where, fmt::format("the selection holds no face of the model's surface "
+                                            "(of its {} nodes, no four are the corners of an "
+                                            "exterior face)",
+                                            nodes.size()));
+  return faces;
 }
 
 std::vector<int> partition_model(const Mesh& mesh, const Config& config, const Comm& comm) {

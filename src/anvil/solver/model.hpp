@@ -22,6 +22,13 @@ Mesh build_mesh(const Config& config);
 std::vector<std::int64_t> resolve_selection(const Mesh& mesh, const Config& config,
                                             const Selection& sel);
 
+// The faces of a pressure load's surface, ascending (element, face): the side set of that
+// name if the mesh has one, else the faces of the model's surface (exterior faces, those of
+// the selection's part only if it names one) whose four nodes the node selection holds. An
+// InputError (at the selection's deck location) if there is none.
+std::vector<SideEntry> resolve_surface(const Mesh& mesh, const Config& config,
+                                       const Selection& sel);
+
 // For each point, the smallest global id of an element of `blocks` that holds it inside
 // the body (behind the plane of each of its six faces, through the face's centre with the
 // normal of its diagonals, by more than 1e-6 of the element's size where the face bounds

@@ -26,7 +26,10 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
   block_offsets_ = mesh.block_offsets();
   const std::vector<int> owner = partition_model(mesh, config_, comm_);
   fe_ = decompose_fe(mesh, owner, comm_.rank(), comm_.size());
-  corner_exchange_ = std::make_unique<CornerExchange>(fe_, comm_);
+  // With pressure loads the exchange carries their corner forces too (loads.cpp).
+  const bool pressures = std::any_of(config_.loads.begin(), config_.loads.end(),
+                                     [](const Load& l) { return l.kind == Load::Kind::pressure; });
+  corner_exchange_ = std::make_unique<CornerExchange>(fe_, comm_, pressures ? 6 : 3);
   // Nodes that no element uses (mid-side nodes of imported quadratic elements, stray
   // points) take no part in the run and are not counted.
   global_nodes_ = comm_.sum(fe_.num_owned_nodes());
@@ -184,6 +187,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
   // the constraint, so that the energy balance starts from the energy the deck gave.
   const double ke_given = comm_.sum(owned_kinetic_energy() + particle_kinetic_energy());
   apply_boundary_conditions(mesh);
+  setup_loads(mesh);
   locate_probes(mesh);
 
   // The initial sample (t = 0): kinetic energy of the initial velocities, probes at rest
@@ -613,6 +617,7 @@ void Simulation::fe_forces() {
     double* const f[3] = {nodes_.f[0].data(), nodes_.f[1].data(), nodes_.f[2].data()};
     workspace_.end_nodal_forces(f);
     eroded_ += r.eroded;
+    press_faces(); // the pressure loads' corner forces, exchanged with the elements'
   }
   {
     // The reductions are timed with the exchange, not with the element work: a rank that
@@ -622,14 +627,18 @@ void Simulation::fe_forces() {
     // anything below can stop the run, so no message is left outstanding).
     const std::initializer_list<double*> corners = {
         corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()};
-    corner_exchange_->start(corners);
+    const std::initializer_list<double*> with_loads = {
+        corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data(),
+        load_corner_[0].data(),  load_corner_[1].data(),  load_corner_[2].data()};
+    const bool pressures = !load_corner_[0].empty();
+    corner_exchange_->start(pressures ? with_loads : corners);
     // One reduction per cycle carries the stable step and the failure and erosion flags.
     const double none = std::numeric_limits<double>::infinity();
     double red[5] = {r.dt_stable, r.inverted_gid >= 0 ? static_cast<double>(r.inverted_gid) : none,
                      r.nonfinite_gid >= 0 ? static_cast<double>(r.nonfinite_gid) : none,
                      stop_local_ ? 0.0 : 1.0, r.eroded > 0 ? 0.0 : 1.0};
     comm_.min(std::span<double>(red, 5));
-    corner_exchange_->finish(corners);
+    corner_exchange_->finish(pressures ? with_loads : corners);
     stop_ = red[3] == 0.0;             // a stop asked on any rank stops every rank after this cycle
     if (red[4] == 0.0) share_eroded(); // some element eroded somewhere
     if (red[1] != none)
@@ -649,6 +658,7 @@ void Simulation::fe_forces() {
     gather_corners(fe_, {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()},
                    {nodes_.f[0].data(), nodes_.f[1].data(), nodes_.f[2].data()},
                    fe_.exchanged_nodes);
+    add_loads(); // the external loads of t(n)
   }
 }
 
@@ -810,6 +820,7 @@ void Simulation::predict() {
         for (int i = 0; i < 3; ++i)
           if (!((fixed[k] >> i) & 1u)) work += clock_.dt_prev * m[k] * g_before[i] * v_prev[i][k];
   gravity_work_before_ = g_before;
+  work += load_work();
   if (sph_) predict_particles(dt_avg, ke, work);
   external_work_ += work;
   kinetic_local_ = ke; // correct() adds what contact and walls change

@@ -130,6 +130,9 @@ public:
   const std::vector<double>& part_masses() const { return part_mass_; }
   // Global element id -> part name (for messages).
   std::string describe_element(std::int64_t gid) const;
+  // Per external load, the faces it presses or the nodes it pushes, over all ranks
+  // (collective).
+  std::vector<std::int64_t> load_targets() const;
   // What the setup found questionable (the same on every rank), for the user.
   const std::vector<std::string>& warnings() const { return warnings_; }
 
@@ -148,6 +151,13 @@ private:
   void apply_initial_conditions(const Mesh& mesh);
   void apply_boundary_conditions(const Mesh& mesh);
   void update_prescribed_motions(double t, double dt);
+  // External loads (loads.cpp): resolved at setup; the pressed faces' corner forces at t(n)
+  // before the corner exchange, the loads' nodal forces added after it; their work over the
+  // step before (predict).
+  void setup_loads(const Mesh& mesh);
+  void press_faces();
+  void add_loads();
+  double load_work() const;
   std::array<double, 3> body_acceleration(double t) const;
   void locate_probes(const Mesh& mesh);
   double owned_kinetic_energy() const;
@@ -208,6 +218,27 @@ private:
   std::array<double, 3> gravity_work_before_{0, 0, 0}; // of the step before (its work)
   std::int64_t stalled_steps_ = 0; // steps in a row that did not advance the time
   std::vector<CurvedComponent> curved_components_;
+  // External loads (deck `loads`). The faces pressed on this rank's elements, ascending
+  // (element gid, face, load), with their corners' forces under a unit pressure at t(n)
+  // (12 values per face, for the work); the pressure corner forces of the step, per slot
+  // (empty without pressures), exchanged with the element forces; the nodes whose sums they
+  // enter (on any rank), ascending; the forces on nodes, ascending (node, load); all the
+  // loaded nodes, ascending, and their load force of the step.
+  struct PressedFace {
+    std::int64_t gid;
+    int block, element, face, load;
+  };
+  struct NodalForce {
+    int node, load;
+  };
+  std::vector<PressedFace> pressed_;
+  std::vector<double> pressed_unit_;
+  std::array<std::vector<double>, 3> load_corner_;
+  std::vector<int> pressure_nodes_;
+  std::vector<NodalForce> nodal_forces_;
+  std::vector<int> loaded_nodes_;
+  std::array<std::vector<double>, 3> f_load_;
+  std::vector<double> load_factor_; // per load, its curve's value at t(n) (1 without one)
   // Per local node and component: the condition that constrains it (-1: none), and the
   // force it applies there over the current step, N (predict, correct; summed per
   // condition by sample()). The particles' reactions, per own particle, in p_reaction_.
