@@ -115,6 +115,14 @@ int check(const std::string& deck, const anvil::Comm& comm) {
     for (std::size_t b = 0; b < config.boundary_conditions.size(); ++b)
       std::printf("%s\n", describe_condition(b, config.boundary_conditions[b]).c_str());
   }
+  for (const auto& g : config.body_loads) {
+    std::string line = fmt::format("gravity     [{:g}, {:g}, {:g}] m/s^2", g.acceleration.x,
+                                   g.acceleration.y, g.acceleration.z);
+    if (g.curve)
+      line += fmt::format(" x curve of {}",
+                          count_of(static_cast<std::int64_t>(g.curve->t.size()), "point"));
+    std::printf("%s\n", line.c_str());
+  }
   if (!config.loads.empty()) {
     std::printf("loads       %zu\n", config.loads.size());
     for (std::size_t l = 0; l < config.loads.size(); ++l)

@@ -374,6 +374,20 @@ TEST(Deck, Gravity) {
             std::string::npos);
 }
 
+// QA round 24: a prescribed value on a component `components` leaves out was dropped (a
+// driver along x held only in z stood still in x); a component listed twice, or a word
+// for the list, is refused.
+TEST(Deck, PrescribedValuesOnlyOnTheirComponents) {
+  expect_error(
+      "velocity: [0, 0, 1.0], components: [z]", "velocity: [5.0, 0, 1.0], components: [z]",
+      {"deck.yaml:18", "boundary_conditions[1].velocity", "5 on x, which `components` leaves out"});
+  expect_error("components: [z]", "components: [z, z]",
+               {"boundary_conditions[1].components[1]", "z is listed twice"});
+  expect_error(
+      "components: [z]", "components: ALL",
+      {"boundary_conditions[1].components", "expected a list of x, y, z, or all, got 'ALL'"});
+}
+
 // QA D9: a deck set named like a generated one (bar.top) replaced it without a word.
 TEST(Deck, NodeSetNamesHaveNoDots) {
   expect_error("  impact_face: {part", "  bar.top: {part",

@@ -530,4 +530,12 @@ particles:
                                   "plane and moves nothing"));
   Simulation in_plane(test::deck(deck + "gravity: [0, -9.81, 0]\n"), world);
   EXPECT_FALSE(has_warning(in_plane, "body load"));
+  // So does a prescribed motion across it (QA round 24); a fixed component says nothing.
+  Simulation driven(
+      test::deck(deck + "boundary_conditions:\n  - {set: {part: a}, velocity: [1.0, 0, 5.0]}\n"
+                        "  - {set: {part: a}, fix: [z]}\n"),
+      world);
+  EXPECT_TRUE(has_warning(driven, "the prescribed z component acts across this 2-D model's "
+                                  "plane and moves nothing"));
+  EXPECT_FALSE(has_warning(driven, "prescribed x"));
 }

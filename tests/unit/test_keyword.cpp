@@ -693,6 +693,31 @@ TEST(Keyword, PrescribedMotionErrors) {
       << c.warnings[0];
 }
 
+// QA round 24: an explicit SF = 0 (a zero motion or load; LS-DYNA may read it as its
+// default 1) is warned of; a motion on a node no element uses acts on nothing, said by the
+// model's setup.
+TEST(Keyword, ZeroScaleAndNodesOutsideTheModelAreWarnedOf) {
+  const std::string ok = with(good, "*END", motion_cards);
+  const std::string node_card = "        12         1         0         6";
+  const Config zero = kw(with(ok, node_card, node_card + "       0.0"));
+  ASSERT_EQ(zero.warnings.size(), 1u);
+  EXPECT_NE(zero.warnings[0].find("*BOUNDARY_PRESCRIBED_MOTION_NODE.SF is 0"), std::string::npos)
+      << zero.warnings[0];
+  const std::string stray =
+      with(with(ok, "      12             0.0             1.0             2.0\n",
+                "      12             0.0             1.0             2.0\n"
+                "      13             5.0             5.0             5.0\n"),
+           node_card, node_card + "\n        13         1         0         6       2.0");
+  const Config c = kw(stray);
+  const Comm self = Comm::self();
+  Simulation sim(c, self);
+  const auto& w = sim.warnings();
+  EXPECT_TRUE(std::any_of(w.begin(), w.end(), [](const std::string& m) {
+    return m.find("*BOUNDARY_PRESCRIBED_MOTION_NODE: the selection's 1 node belongs to no "
+                  "element") != std::string::npos;
+  })) << (w.empty() ? std::string("no warnings") : w[0]);
+}
+
 // QA round 23: conditions apply in card order (a later card wins on the components two
 // hold, with a warning); a curve no motion names is not read even when a motion names
 // another; DEATH is checked on every card of a node group and without ENDTIM; a scale

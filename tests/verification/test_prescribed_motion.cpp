@@ -26,6 +26,16 @@
 //    the top's force M A u / L, M = E (1 - nu) / ((1 + nu) (1 - 2 nu)), plus the dynamic
 //    part of a column driven at constant speed v, a step wave rho c v A that doubles on
 //    reflection from the fixed base: tolerance 2 rho c v A (5% of the final static force).
+// 4. A constraint that stops (or starts) nodes and particles at t = 0 gives them an impulse
+//    there, which the first row's reactions hold (as a rigid wall's force does): times the
+//    first step's velocity interval, the reactions are the change of momentum from the
+//    deck's initial velocities to the first step's (Newton, the internal forces cancelling;
+//    tolerance 1e-12 relative, round-off).
+// 5. A body driven rigidly at a constant acceleration (every node on a velocity ramp):
+//    the work-energy theorem, kinetic energy = the reactions' work at every row but the
+//    last (whose step is shortened to land on the end time, exactly). Tolerance 1e-12 of
+//    the kinetic energy (round-off of the sums; the work was ahead by F v dt / 2 before
+//    QA round 24).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -217,7 +227,10 @@ TEST(PrescribedMotion, ReactionsBalanceMomentumAndTheStaticForce) {
   Simulation sim(test::deck(deck), world);
   double worst_balance = 0, largest_impulse = 0, worst_static = 0;
   while (!sim.finished()) {
-    const auto p0 = test::node_momentum(sim);
+    // The first row (t = 0) holds the impulse that set the top's velocity at t = 0, from the
+    // deck's (rest): its step starts from that momentum.
+    const auto p0 =
+        sim.clock().cycle == 0 ? std::array<double, 4>{0, 0, 0, 0} : test::node_momentum(sim);
     const double dt_before = sim.clock().dt;
     sim.step();
     const double dt_avg = 0.5 * (dt_before + sim.clock().dt);
@@ -229,8 +242,10 @@ TEST(PrescribedMotion, ReactionsBalanceMomentumAndTheStaticForce) {
       worst_balance = std::max(worst_balance, std::abs(sum * dt_avg - (p1[i] - p0[i])));
       largest_impulse = std::max(largest_impulse, std::abs(sum * dt_avg));
     }
+    // (Not at t = 0: the top starts at full speed, an impulse in the first row.)
     const double u = u_max * std::min(s.time / T, 1.0);
-    worst_static = std::max(worst_static, std::abs(s.reaction[3 * 5 + 2] - M * A * u / L));
+    if (s.cycle > 0)
+      worst_static = std::max(worst_static, std::abs(s.reaction[3 * 5 + 2] - M * A * u / L));
   }
   EXPECT_LT(worst_balance, 1e-9 * largest_impulse);
   const double bound = 2 * rho * c * v * A;
@@ -240,6 +255,82 @@ TEST(PrescribedMotion, ReactionsBalanceMomentumAndTheStaticForce) {
                 "the static M A u / L by at most %.1f N (bound 2 rho c v A = %.1f N, static "
                 "force at the end %.1f N)\n",
                 worst_balance, largest_impulse, worst_static, bound, M * A * u_max / L);
+}
+
+TEST(PrescribedMotion, RigidlyDrivenBodyGainsTheWorkOfItsReactions) {
+  const double end = 2.0e-5;
+  const std::string deck = fmt::format(R"(
+termination: {{time: {}}}
+materials:
+  steel: {{model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}}
+parts:
+  box:
+    mesh: {{generate: box, min: [0, 0, 0], max: [0.01, 0.01, 0.01], divisions: [3, 3, 3]}}
+    material: steel
+boundary_conditions:
+  - {{set: {{part: box}}, velocity: [0.3, 0, 1.0], curve: [[0, 0], [4.0e-5, 2]]}}
+)",
+                                       end);
+  const Comm world = Comm::world();
+  Simulation sim(test::deck(deck), world);
+  double worst = 0;
+  int rows = 0;
+  while (!sim.finished()) {
+    sim.step();
+    if (sim.finished()) break; // (the shortened last step's row)
+    const Sample s = sim.sample();
+    worst = std::max(worst, std::abs(s.kinetic - s.external_work) / std::max(s.kinetic, 1e-300));
+    ++rows;
+  }
+  EXPECT_GT(rows, 50);
+  EXPECT_LT(worst, 1e-12) << "kinetic energy off the reactions' work";
+  EXPECT_EQ(sim.clock().time, end); // the last step lands on the end time exactly
+}
+
+TEST(PrescribedMotion, TheImpulseOfTimeZeroIsInTheFirstRow) {
+  const std::string deck = R"(
+termination: {cycles: 3}
+materials:
+  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+parts:
+  bar:
+    mesh: {generate: box, min: [0, 0, 0], max: [0.004, 0.004, 0.02], divisions: [2, 2, 10]}
+    material: steel
+particles:
+  ball: {generate: {shape: box, min: [0.01, 0, 0], max: [0.014, 0.004, 0.004], spacing: 1.0e-3},
+         material: steel}
+initial_conditions:
+  - {part: bar, velocity: [0, 3.0, -10.0]}
+  - {part: ball, velocity: [4.0, 0, 0]}
+boundary_conditions:
+  - {set: bar.zmin, fix: [z]}
+  - {set: {part: ball}, velocity: [-1.0, 0, 0], components: [x]}
+)";
+  const Comm world = Comm::world();
+  Simulation sim(test::deck(deck), world);
+  sim.step();
+  const Sample s = sim.sample();
+  ASSERT_EQ(s.cycle, 0);
+  const double dt_avg = 0.5 * sim.clock().dt; // the first step's interval: half its step
+  // Newton over the first step, from the deck's velocities (the internal forces cancel):
+  // the bar's z momentum was -10 M, the particles' x momentum 4 m.
+  const double M = sim.part_masses()[0];
+  double m = 0, px = 0;
+  const auto& pt = sim.sph()->particles();
+  for (std::size_t i = 0; i < pt.size(); ++i) {
+    m += pt.mass[i];
+    px += pt.mass[i] * pt.v[0][i];
+  }
+  m = world.sum(m);
+  px = world.sum(px);
+  const double pz = test::node_momentum(sim)[2];
+  EXPECT_NEAR(s.reaction[2] * dt_avg, pz - (-10.0 * M), 1e-12 * 10.0 * M);
+  EXPECT_NEAR(s.reaction[3] * dt_avg, px - 4.0 * m, 1e-12 * 5.0 * m);
+  EXPECT_GT(s.reaction[2] * dt_avg, 10.0 * M / 20); // at least the stop of the base (M / 20)
+  EXPECT_NEAR(px, -1.0 * m, 1e-12 * m);             // held at -1 m/s
+  // Later rows hold only the steps' forces: no impulse of t = 0 again.
+  sim.step();
+  EXPECT_LT(std::abs(sim.sample().reaction[3]), 1e-6 * m * 5.0 / dt_avg);
 }
 
 } // namespace

@@ -204,9 +204,15 @@ public:
   std::array<bool, 3> components() const {
     std::array<bool, 3> out{false, false, false};
     if (n_.IsScalar() && n_.Scalar() == "all") return {true, true, true};
+    if (n_.IsScalar())
+      fail(fmt::format("expected a list of x, y, z, or all, got '{}'", n_.Scalar()));
     const auto list = items();
     if (list.empty()) fail("give at least one of x, y, z, or all");
-    for (const auto& c : list) out[c.axis()] = true;
+    for (const auto& c : list) {
+      const int a = c.axis();
+      if (out[static_cast<std::size_t>(a)]) c.fail(fmt::format("{} is listed twice", "xyz"[a]));
+      out[static_cast<std::size_t>(a)] = true;
+    }
     return out;
   }
 
@@ -929,6 +935,14 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
         bc.value = n.child(moved ? "displacement" : "velocity").vec3();
         bc.components = n.has("components") ? n.child("components").components()
                                             : std::array<bool, 3>{true, true, true};
+        // A value on a component the condition leaves free would be dropped: a driver
+        // meant to move along x that holds only z would stand still in x (QA round 24).
+        for (std::size_t i = 0; i < 3; ++i)
+          if (!bc.components[i] && bc.value[static_cast<int>(i)] != 0)
+            n.child(moved ? "displacement" : "velocity")
+                .fail(fmt::format("{} on {}, which `components` leaves out: list {} there, or "
+                                  "give 0",
+                                  bc.value[static_cast<int>(i)], "xyz"[i], "xyz"[i]));
         if (n.has("curve")) bc.curve = parse_curve(n.child("curve"));
         if (moved && !bc.curve)
           n.fail("a displacement needs its time history: add curve: [[t0, 0], [t1, 1], ...]");

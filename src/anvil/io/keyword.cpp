@@ -1354,6 +1354,7 @@ private:
       if (const auto problem = time_history_problem(m.sf, tc, m.displacement); !problem.empty())
         throw InputError(m.at.loc(key + ".LCID"), fmt::format("curve {}: {}", m.lcid, problem));
       warn_if_curve_ends(m.lcid, cc);
+      warn_if_zero_scale(m.sf, m.at, key, warnings);
       BoundaryCondition bc;
       bc.nodes.name = set_name;
       bc.nodes.where = m.at.loc(key);
@@ -1479,6 +1480,7 @@ private:
       if (const auto problem = time_history_problem(bl.sf, cc.curve, false); !problem.empty())
         throw InputError(bl.at.loc(key + ".LCID"), fmt::format("curve {}: {}", bl.lcid, problem));
       warn_if_curve_ends(bl.lcid, cc);
+      warn_if_zero_scale(bl.sf, bl.at, key, warnings);
       BodyLoad load;
       load.acceleration[bl.axis] = -bl.sf;
       load.curve = cc.curve;
@@ -1501,6 +1503,16 @@ private:
           cc.at.str(), lcid, tc.t[last], endtim_));
   }
 
+  // SF = 0 written out: the motion or load is zero (a blank SF is 1). LS-DYNA may read such
+  // a 0 as the default 1 (QA round 24), so it is said.
+  static void warn_if_zero_scale(double sf, const Where& at, const std::string& key,
+                                 std::vector<std::string>& warnings) {
+    if (sf == 0)
+      warnings.push_back(fmt::format("{}: {}.SF is 0: anvil applies zero times the curve (a "
+                                     "blank SF is 1; give the scale you mean)",
+                                     at.str(), key));
+  }
+
   // Curve `lcid` of a load card, as the time history of SF times it (an error where it
   // cannot be one, a warning where it ends early).
   const TimeCurve& load_curve(std::int64_t lcid, double sf, const Where& at, const std::string& key,
@@ -1509,6 +1521,7 @@ private:
     if (const auto problem = time_history_problem(sf, cc.curve, false); !problem.empty())
       throw InputError(at.loc(key + ".LCID"), fmt::format("curve {}: {}", lcid, problem));
     curve_ends_early(lcid, cc, warnings);
+    warn_if_zero_scale(sf, at, key, warnings);
     return cc.curve;
   }
 
@@ -1940,10 +1953,10 @@ private:
     }
     for (const auto& [pair, count] : clashes)
       warnings.push_back(fmt::format(
-          "{}: {} node components this card holds are held by the card at {} too; the later "
+          "{}: {} node component{} this card holds {} held by the card at {} too; the later "
           "card wins there (anvil applies constraints and motions in card order)",
-          bcs[static_cast<std::size_t>(pair.second)].where.str(), count,
-          bcs[static_cast<std::size_t>(pair.first)].where.str()));
+          bcs[static_cast<std::size_t>(pair.second)].where.str(), count, count == 1 ? "" : "s",
+          count == 1 ? "is" : "are", bcs[static_cast<std::size_t>(pair.first)].where.str()));
   }
 
   void velocity_generation(const Block& b) {

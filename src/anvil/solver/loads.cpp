@@ -46,7 +46,9 @@ void Simulation::setup_loads(const Mesh& mesh) {
                                        "force, `gravity`)",
                                        held));
       }
-      for (const std::int64_t gid : resolve_selection(mesh, config_, load.target))
+      const auto ids = resolve_selection(mesh, config_, load.target);
+      warn_if_outside_model(ids, load.target.where);
+      for (const std::int64_t gid : ids)
         if (const int n = local(gid); n >= 0) {
           nodal_forces_.push_back({n, static_cast<int>(l)});
           mark[static_cast<std::size_t>(n)] |= 1;

@@ -334,19 +334,26 @@ void Simulation::warn_of_setup(const Mesh& mesh) {
         "continuity density (the default) for liquids and solids (docs/sph.md)",
         ps.where.str(), ps.name, ps.material));
   }
-  // A body load across the plane (line) of a 2-D (1-D) particle model: held by the plane's
-  // constraint, it does nothing (QA round 23c: a z gravity in a plane model, almost always
-  // meant along y).
-  if (pt && config_.sph.dimensions < 3)
-    for (const auto& load : config_.body_loads)
-      for (int i = config_.sph.dimensions; i < 3; ++i)
-        if (load.acceleration[i] != 0.0)
-          warnings_.push_back(fmt::format(
-              "{}: the body load's {} component acts across this {}-D model's {} and moves "
-              "nothing (the model's constraint holds it); a {}-D model's loads lie along {}",
-              load.where.str(), "xyz"[i], config_.sph.dimensions,
-              config_.sph.dimensions == 2 ? "plane" : "line", config_.sph.dimensions,
-              config_.sph.dimensions == 2 ? "x and y" : "x"));
+  // A body load or a prescribed motion across the plane (line) of a 2-D (1-D) particle
+  // model: held by the plane's constraint, it does nothing (QA round 23c: a z gravity in a
+  // plane model, almost always meant along y; round 24: a motion). Such a model has no mesh
+  // (it cannot be coupled to one), so every condition is on particles.
+  const int dims = config_.sph.dimensions;
+  auto across = [&](const SourceLocation& where, const char* what, int i) {
+    warnings_.push_back(fmt::format(
+        "{}: the {} {} component acts across this {}-D model's {} and moves nothing (the "
+        "model's constraint holds it); a {}-D model moves along {}",
+        where.str(), what, "xyz"[i], dims, dims == 2 ? "plane" : "line", dims,
+        dims == 2 ? "x and y" : "x"));
+  };
+  if (pt && dims < 3)
+    for (int i = dims; i < 3; ++i) {
+      for (const auto& load : config_.body_loads)
+        if (load.acceleration[i] != 0.0) across(load.where, "body load's", i);
+      for (const auto& bc : config_.boundary_conditions)
+        if (bc.prescribed && bc.components[static_cast<std::size_t>(i)] && bc.value[i] != 0.0)
+          across(bc.where, "prescribed", i);
+    }
 }
 
 std::vector<std::size_t> Simulation::contact_blocks(const Mesh& mesh) const {
@@ -420,10 +427,28 @@ double Simulation::owned_kinetic_energy() const {
   return ke;
 }
 
+// A selection of mesh nodes none of which an element uses acts on nothing: anvil's model
+// holds only the nodes of its elements (QA round 24: a keyword motion on a stray node was
+// accepted and did nothing). A warning, not an error: keyword decks hold constraints on the
+// nodes of parts anvil leaves out (shells), and say so already. Collective.
+void Simulation::warn_if_outside_model(const std::vector<std::int64_t>& ids,
+                                       const SourceLocation& where) {
+  std::int64_t held = 0;
+  for (std::size_t n = 0; n < fe_.node_gid.size(); ++n)
+    if (fe_.node_owned[n] && std::binary_search(ids.begin(), ids.end(), fe_.node_gid[n])) ++held;
+  if (comm_.sum(held) == 0 && !ids.empty())
+    warnings_.push_back(fmt::format("{}: the selection's {} node{} belong{} to no element: "
+                                    "anvil's model holds only the nodes of its elements, so "
+                                    "this acts on nothing",
+                                    where.str(), ids.size(), ids.size() == 1 ? "" : "s",
+                                    ids.size() == 1 ? "s" : ""));
+}
+
 void Simulation::apply_initial_conditions(const Mesh& mesh) {
   const std::size_t nn = fe_.node_gid.size();
   for (const auto& ic : config_.initial_conditions) {
     const auto ids = selected_nodes(mesh, ic.nodes);
+    warn_if_outside_model(ids, ic.nodes.where);
     for (std::size_t n = 0; n < nn; ++n) {
       if (!std::binary_search(ids.begin(), ids.end(), fe_.node_gid[n])) continue;
       const Vec3 r = Vec3{nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]} - ic.center;
@@ -448,6 +473,7 @@ void Simulation::apply_boundary_conditions(const Mesh& mesh) {
   for (std::size_t b = 0; b < bcs.size(); ++b) {
     const auto& bc = bcs[b];
     const auto ids = selected_nodes(mesh, bc.nodes);
+    warn_if_outside_model(ids, bc.nodes.where);
     for (std::size_t n = 0; n < nn; ++n) {
       if (!std::binary_search(ids.begin(), ids.end(), fe_.node_gid[n])) continue;
       for (int i = 0; i < 3; ++i) {
@@ -460,12 +486,18 @@ void Simulation::apply_boundary_conditions(const Mesh& mesh) {
     }
   }
   constrained_nodes_.clear();
+  initial_impulses_.clear();
   for (std::size_t n = 0; n < nn; ++n)
     if (constrained_[n]) {
       constrained_nodes_.push_back(static_cast<int>(n));
       for (int i = 0; i < 3; ++i) {
-        if (constrained_[n] & (1u << i)) nodes_.v[i][n] = v_bc_[i][n];
         const int b = source[i][n];
+        if (constrained_[n] & (1u << i)) {
+          if (fe_.node_owned[n] && v_bc_[i][n] != nodes_.v[i][n])
+            initial_impulses_.push_back(
+                {fe_.node_gid[n], b, i, 0, nodes_.mass[n] * (v_bc_[i][n] - nodes_.v[i][n])});
+          nodes_.v[i][n] = v_bc_[i][n];
+        }
         if (b >= 0 && bcs[static_cast<std::size_t>(b)].prescribed &&
             bcs[static_cast<std::size_t>(b)].curve)
           curved_components_.push_back({static_cast<int>(n), i, b});
@@ -730,7 +762,7 @@ void Simulation::predict() {
   // Work of the constraint reactions over this step (before the velocities change),
   // summed in a local whose address is not taken (work's is, below: the sum went through
   // memory at every term, a quarter of this function's time on the can crush).
-  double work_bc = 0;
+  double work_bc_nodes = 0, later_nodes = 0;
   update_prescribed_motions(clock_.time, dt);
   // The body acceleration of this step, at t(n) where its forces are; and the one of the
   // step before, at its middle, for the body force's work (below).
@@ -749,10 +781,16 @@ void Simulation::predict() {
       const double v_free = v_old + (dt_avg * nodes_.f[i][n] / nodes_.mass[n] + dt_avg * g[i]);
       const double v_new = v_bc_[i][n];
       bc_reaction_[i][n] = nodes_.mass[n] * (v_new - v_free) / dt_avg;
-      if (fe_.node_owned[n]) work_bc += nodes_.mass[n] * (v_new - v_forces) * 0.5 * (v_old + v_new);
+      if (fe_.node_owned[n]) {
+        const double impulse = nodes_.mass[n] * (v_new - v_forces);
+        work_bc_nodes += impulse * 0.5 * (v_old + v_new);
+        later_nodes += impulse * 0.125 * (v_old + 3 * v_new);
+      }
     }
   }
-  double work = work_bc; // (the same sum)
+  // (The particles' join these below.)
+  double work_bc = work_bc_nodes, work_bc_later = later_nodes;
+  double work = 0;
   double ke = 0;
   // Probe displacements at t(n); their velocities once correct() has set v(n+1/2).
   for (std::size_t p = 0; p < probe_node_.size(); ++p)
@@ -821,8 +859,9 @@ void Simulation::predict() {
           if (!((fixed[k] >> i) & 1u)) work += clock_.dt_prev * m[k] * g_before[i] * v_prev[i][k];
   gravity_work_before_ = g_before;
   work += load_work();
-  if (sph_) predict_particles(dt_avg, ke, work);
-  external_work_ += work;
+  if (sph_) predict_particles(dt_avg, ke, work_bc, work_bc_later, work);
+  work_bc_later_ = work_bc_later;
+  external_work_ += work_bc + work;
   kinetic_local_ = ke; // correct() adds what contact and walls change
   sample_time_ = clock_.time;
   sample_cycle_ = clock_.cycle;
@@ -994,7 +1033,9 @@ void Simulation::update() {
     for (std::size_t n = 0; n < nn; ++n) x[n] += dt * v[n];
   }
   if (sph_) update_particles(dt);
-  clock_.time += dt;
+  // A step shortened to land on the end time lands on it exactly (the sum could miss it by
+  // an ulp: the last fields' time read 2.0000000000000002e-05 for an end of 2e-05).
+  clock_.time = dt < dt_full_ ? config_.end_time : clock_.time + dt;
   clock_.cycle += 1;
   clock_.dt_prev = dt;
 }
@@ -1007,7 +1048,11 @@ Sample Simulation::sample() const {
   s.time = clock_.cycle == 0 ? 0.0 : sample_time_;
   s.cycle = clock_.cycle == 0 ? 0 : sample_cycle_;
   s.dt = sample_dt_;
-  double local[5] = {kinetic_local_, 0, 0, external_work_, contact_energy_};
+  // The constraints' work of step n, booked whole in its predict(), is not all done at t(n)
+  // (work_bc_later_). (Booked whole, a body driven at a constant acceleration showed work
+  // ahead of its kinetic energy by F v dt / 2 at every row, QA round 24; now the two agree
+  // to round-off, as a free fall's do.)
+  double local[5] = {kinetic_local_, 0, 0, external_work_ - work_bc_later_, contact_energy_};
   for (const auto& b : blocks_)
     for (int e = 0; e < b.size(); ++e) {
       local[1] += b.internal_energy[e];
@@ -1049,18 +1094,26 @@ std::vector<double> Simulation::reactions() const {
     if (!fe_.node_owned[static_cast<std::size_t>(n)]) continue;
     for (int i = 0; i < 3; ++i)
       if (const int b = bc_source_[i][n]; b >= 0)
-        mine.push_back({fe_.node_gid[n], b, i, bc_reaction_[i][n]});
+        mine.push_back({fe_.node_gid[n], b, i, 1, bc_reaction_[i][n]});
   }
   if (sph_) {
     const auto& pt = sph_->particles();
     for (std::size_t k = 0; k < std::min(pt.size(), p_reaction_[0].size()); ++k)
       for (int i = 0; i < 3; ++i)
         if (const int b = pt.bc_source[i][k]; b >= 0 && (pt.constrained[k] & (1u << i)))
-          mine.push_back({global_nodes_ + pt.gid[k], b, i, p_reaction_[i][k]});
+          mine.push_back({global_nodes_ + pt.gid[k], b, i, 1, p_reaction_[i][k]});
   }
+  // The first step's row (t = 0) holds the impulses that set the constrained components at
+  // t = 0 (apply_boundary_conditions), spread over its velocity interval as the walls'.
+  if (sample_cycle_ == 0 && clock_.cycle > 0)
+    for (ReactionTerm r : initial_impulses_) {
+      r.force /= dt_avg_;
+      mine.push_back(r);
+    }
   std::vector<ReactionTerm> all = comm_.allgatherv(std::span<const ReactionTerm>(mine));
   std::sort(all.begin(), all.end(), [](const ReactionTerm& a, const ReactionTerm& b) {
-    return std::tie(a.condition, a.key, a.component) < std::tie(b.condition, b.key, b.component);
+    return std::tie(a.condition, a.key, a.component, a.part) <
+           std::tie(b.condition, b.key, b.component, b.part);
   });
   for (const auto& r : all) out[3 * static_cast<std::size_t>(r.condition) + r.component] += r.force;
   return out;
@@ -1155,6 +1208,7 @@ void Simulation::restore(const Checkpoint& c) {
     throw InputError(from + " lacks element " + std::to_string(missing[1] + 1));
   clock_.time = c.time;
   clock_.cycle = c.cycle;
+  initial_impulses_.clear(); // (the t = 0 row is the interrupted run's)
   clock_.dt = c.dt;
   clock_.dt_prev = c.dt_prev;
   clock_.dt_initial = c.dt_initial;

@@ -148,6 +148,7 @@ private:
   void sample_probe_velocities(); // at the end of correct()
   ContactNodes contact_view();
   void update();
+  void warn_if_outside_model(const std::vector<std::int64_t>& ids, const SourceLocation& where);
   void apply_initial_conditions(const Mesh& mesh);
   void apply_boundary_conditions(const Mesh& mesh);
   void update_prescribed_motions(double t, double dt);
@@ -172,7 +173,8 @@ private:
   double particle_bc_velocity(int k, std::size_t i) const;
   double particle_kinetic_energy() const;
   double particle_internal_energy() const;
-  void predict_particles(double dt_avg, double& ke, double& work);
+  void predict_particles(double dt_avg, double& ke, double& work_bc, double& work_bc_later,
+                         double& work);
   std::vector<ContactNodeItem>& particle_contact_items(double dt);
   void correct_particles(double& contact_work, double& kinetic, double& reaction);
   void sample_particle_probe_velocities();
@@ -247,8 +249,12 @@ private:
   struct ReactionTerm { // one constrained component's force, for the ordered sum
     std::int64_t key;   // node gid, or global node count + particle gid
     std::int32_t condition, component;
+    std::int32_t part; // 0: the impulse of t = 0 (below), 1: the step's force
     double force;
   };
+  // The impulses (N s) that set constrained components at t = 0, on owned nodes and own
+  // particles: added to the first row's reactions.
+  std::vector<ReactionTerm> initial_impulses_;
   std::vector<double> reactions() const;
 
   // Contact (null without a contact definition): the contact decomposition and the
@@ -262,8 +268,13 @@ private:
   double dt_avg_ = 0;  // the velocity step of the last cycle (mean of the two intervals)
   double dt_full_ = 0; // the last cycle's step before shortening it to the end time
 
-  // Diagnostics accumulated by this rank over owned entities.
+  // Diagnostics accumulated by this rank over owned entities. The constraints' work of a
+  // step is booked whole in its predict() as impulse . v(n), but the impulse acts from
+  // t(n - 1/2) to t(n + 1/2) while the velocity goes from v(n - 1/2) to v(n + 1/2): the
+  // part after t(n), impulse . (v(n - 1/2) + 3 v(n + 1/2)) / 8 (the velocity taken linear
+  // over the interval), is work_bc_later_, which sample() leaves for the next row.
   double external_work_ = 0;
+  double work_bc_later_ = 0;
   double initial_energy_ = 0;
   bool have_initial_energy_ = false;
 

@@ -147,7 +147,13 @@ void Simulation::apply_particle_boundary_conditions() {
     }
   for (std::size_t i = 0; i < pt.size(); ++i)
     for (int k = 0; k < 3; ++k)
-      if (pt.constrained[i] & (1u << k)) pt.v[k][i] = particle_bc_velocity(k, i);
+      if (pt.constrained[i] & (1u << k)) {
+        const double v = particle_bc_velocity(k, i);
+        if (const int b = pt.bc_source[k][i]; b >= 0 && v != pt.v[k][i])
+          initial_impulses_.push_back(
+              {global_nodes_ + pt.gid[i], b, k, 0, pt.mass[i] * (v - pt.v[k][i])});
+        pt.v[k][i] = v;
+      }
 }
 
 // A constrained particle component's velocity over the current step: its value, times
@@ -161,8 +167,10 @@ double Simulation::particle_bc_velocity(int k, std::size_t i) const {
 // Cycle step 3 for the particles: v(n+1/2) = v(n-1/2) + dt_avg f / m (prescribed
 // components take their value), the specific energy gains the work of viscosity and
 // artificial stress over the same interval; adds the kinetic energy at the mid-point
-// velocity to `ke` and the constraints' work to `work` (J).
-void Simulation::predict_particles(double dt_avg, double& ke, double& work) {
+// velocity to `ke`, the constraints' work to `work_bc` (and its part after t(n) to
+// `work_bc_later`, as predict() does for nodes) and the body force's to `work` (J).
+void Simulation::predict_particles(double dt_avg, double& ke, double& work_bc,
+                                   double& work_bc_later, double& work) {
   auto& pt = sph_->particles();
   const std::size_t n = pt.size();
   const auto rate = sph_->energy_rate();
@@ -182,7 +190,9 @@ void Simulation::predict_particles(double dt_avg, double& ke, double& work) {
         nv = particle_bc_velocity(k, i);
         // (As for nodes: the reaction holds the body force, its work is all but the
         // forces'.)
-        work += pt.mass[i] * (nv - (old + dt_avg * pt.f[k][i] * inv_m)) * 0.5 * (old + nv);
+        const double impulse = pt.mass[i] * (nv - (old + dt_avg * pt.f[k][i] * inv_m));
+        work_bc += impulse * 0.5 * (old + nv);
+        work_bc_later += impulse * 0.125 * (old + 3 * nv);
         p_reaction_[k][i] = pt.mass[i] * (nv - free) / dt_avg;
       } else if (gravity_work_before_[k] != 0.0) {
         work += clock_.dt_prev * pt.mass[i] * gravity_work_before_[k] * old; // (predict())
