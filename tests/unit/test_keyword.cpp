@@ -676,6 +676,12 @@ TEST(Keyword, PrescribedMotionErrors) {
                {"*DEFINE_CURVE_TITLE.A1", "must increase"});
   expect_error(with(ok, "         5         0    1.0E-6", "         5         1    1.0E-6"),
                {"*DEFINE_CURVE_TITLE.SIDR", "dynamic relaxation"});
+  // A third value on a point card was dropped unseen (QA round 24).
+  expect_error(with(ok, "              1.0E-4                 3.0",
+                    "              1.0E-4                 3.0                 9.0"),
+               {"*DEFINE_CURVE.A2", "a point card holds one point"});
+  expect_error(with(ok, "              1.0E-4                 3.0", "1.0E-4, 3.0, 9.0"),
+               {"*DEFINE_CURVE.A2"});
   // Fields 7 and 8 (columns 61-80): DEATH and BIRTH.
   const std::string node_card = "        12         1         0         6";
   const std::string sf_vid(20, ' ');

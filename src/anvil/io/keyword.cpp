@@ -1890,7 +1890,13 @@ private:
     if (c1.integer(6, "DATTYP", 0) != 0)
       c1.fail("DATTYP", "DATTYP other than 0 (a general curve) is not supported");
     while (auto p = c.next_record()) {
-      const Card pt(b, *p, {20, 20});
+      const Card pt(b, *p, {20, 20, 20, 20});
+      // A third value (a table's, or a point split wrongly) would be dropped unseen (QA
+      // round 24): a point card holds A and O.
+      for (int k = 2; k < pt.size(); ++k)
+        if (!pt.blank(k))
+          pt.fail(k == 2 ? "A2" : "O2", "a point card holds one point, A and O (in two fields "
+                                        "of 20 columns): write one point per card");
       const double t = sfa * (pt.real(0, "A1") + offa);
       if (!cc.curve.t.empty() && !(t > cc.curve.t.back()))
         pt.fail("A1", fmt::format("the abscissae must increase from point to point: {} "
