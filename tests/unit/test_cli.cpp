@@ -45,6 +45,22 @@ std::string write_temp(const std::string& name, const std::string& text) {
   return path.string();
 }
 
+// Every example deck stays valid as the deck grows: `anvil check` accepts each one, with
+// no warning (an example shows the intended use).
+TEST(Cli, EveryExampleChecks) {
+  int seen = 0;
+  for (const auto& e :
+       std::filesystem::directory_iterator(std::string(anvil::test::source_dir()) + "/examples")) {
+    if (e.path().extension() != ".yaml") continue;
+    ++seen;
+    const auto r = run("check " + e.path().string() + " 2>&1");
+    EXPECT_EQ(r.status, 0) << e.path() << "\n" << r.out;
+    EXPECT_EQ(r.out.find("warning"), std::string::npos) << e.path() << "\n" << r.out;
+    EXPECT_NE(r.out.find("deck and mesh are valid"), std::string::npos) << r.out;
+  }
+  EXPECT_GE(seen, 5);
+}
+
 TEST(Cli, HelpAndVersion) {
   auto r = run("--help");
   EXPECT_EQ(r.status, 0);
