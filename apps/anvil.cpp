@@ -64,12 +64,13 @@ std::string describe_condition(std::size_t n, const anvil::BoundaryCondition& bc
 }
 
 // One line of `check` per external load: what it applies, and where.
-std::string describe_load(std::size_t n, const anvil::Load& load, std::int64_t targets) {
-  std::string what =
-      load.kind == anvil::Load::Kind::force
-          ? fmt::format("force [{:g}, {:g}, {:g}] N on each of {}", load.force.x, load.force.y,
-                        load.force.z, count_of(targets, "node"))
-          : fmt::format("pressure {:g} Pa on {}", load.pressure, count_of(targets, "face"));
+std::string describe_load(std::size_t n, const anvil::Load& load, std::int64_t targets,
+                          double area) {
+  std::string what = load.kind == anvil::Load::Kind::force
+                         ? fmt::format("force [{:g}, {:g}, {:g}] N on each of {}", load.force.x,
+                                       load.force.y, load.force.z, count_of(targets, "node"))
+                         : fmt::format("pressure {:g} Pa on {} ({:.4g} m^2)", load.pressure,
+                                       count_of(targets, "face"), area);
   if (load.curve)
     what += fmt::format(" x curve of {}",
                         count_of(static_cast<std::int64_t>(load.curve->t.size()), "point"));
@@ -92,6 +93,7 @@ int check(const std::string& deck, const anvil::Comm& comm) {
     comm.sum(std::span<double>(set_mass));
   }
   const std::vector<std::int64_t> load_targets = sim.load_targets();
+  const std::vector<double> pressed_area = sim.pressed_area();
   if (comm.rank() != 0) return 0;
   std::printf("deck        %s%s\n", deck.c_str(),
               config.title.empty() ? "" : fmt::format("  ({})", config.title).c_str());
@@ -126,7 +128,8 @@ int check(const std::string& deck, const anvil::Comm& comm) {
   if (!config.loads.empty()) {
     std::printf("loads       %zu\n", config.loads.size());
     for (std::size_t l = 0; l < config.loads.size(); ++l)
-      std::printf("%s\n", describe_load(l, config.loads[l], load_targets[l]).c_str());
+      std::printf("%s\n",
+                  describe_load(l, config.loads[l], load_targets[l], pressed_area[l]).c_str());
   }
   if (sim.global_elements() == 0) {
     // The particles' step needs their first phase (wave speeds from the materials).

@@ -130,6 +130,9 @@ TEST(Deck, Loads) {
   const Comm self = Comm::self();
   Simulation sim(c, self);
   EXPECT_EQ(sim.load_targets(), (std::vector<std::int64_t>{16, 25}));
+  const auto area = sim.pressed_area(); // the top, 1 cm square; none for the force
+  EXPECT_NEAR(area[0], 1e-4, 1e-18);
+  EXPECT_EQ(area[1], 0.0);
 
   auto error = [&](const std::string& item) {
     return model_error(std::string(block) + "loads:\n  - " + item + "\n");

@@ -9,6 +9,7 @@
 // So every copy of a node adds the same numbers in the same order, on any number of
 // ranks. A force on a node is the node's own: every holder adds the loads in deck order.
 #include <algorithm>
+#include <cmath>
 #include <span>
 
 #include <fmt/format.h>
@@ -99,6 +100,25 @@ std::vector<std::int64_t> Simulation::load_targets() const {
       ++count[static_cast<std::size_t>(nf.load)];
   comm_.sum(std::span<std::int64_t>(count));
   return count;
+}
+
+std::vector<double> Simulation::pressed_area() const {
+  std::vector<double> area(config_.loads.size(), 0.0);
+  for (const PressedFace& p : pressed_) {
+    const auto& conn = fe_.blocks[static_cast<std::size_t>(p.block)].conn;
+    double x[4][3], u[4][3];
+    for (int a = 0; a < 4; ++a) {
+      const auto n = static_cast<std::size_t>(conn[static_cast<std::size_t>(p.element)]
+                                                  [hex_faces[static_cast<std::size_t>(p.face)][a]]);
+      for (int i = 0; i < 3; ++i) x[a][i] = nodes_.x[i][n];
+    }
+    unit_pressure_forces(x, u); // their sum: minus the face's vector area
+    area[static_cast<std::size_t>(p.load)] +=
+        std::hypot(u[0][0] + u[1][0] + u[2][0] + u[3][0], u[0][1] + u[1][1] + u[2][1] + u[3][1],
+                   u[0][2] + u[1][2] + u[2][2] + u[3][2]);
+  }
+  comm_.sum(std::span<double>(area));
+  return area;
 }
 
 // The pressed faces' corner forces at x(n) and t(n), into their slots: each slot the sum of

@@ -133,6 +133,9 @@ public:
   // Per external load, the faces it presses or the nodes it pushes, over all ranks
   // (collective).
   std::vector<std::int64_t> load_targets() const;
+  // Per external load, the area of the faces it presses now, m^2 (0 for a force; the sum
+  // of each face's |vector area|; collective).
+  std::vector<double> pressed_area() const;
   // What the setup found questionable (the same on every rank), for the user.
   const std::vector<std::string>& warnings() const { return warnings_; }
 
