@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -682,14 +683,22 @@ TEST(Keyword, PrescribedMotionErrors) {
                {"*DEFINE_CURVE.A2", "a point card holds one point"});
   expect_error(with(ok, "              1.0E-4                 3.0", "1.0E-4, 3.0, 9.0"),
                {"*DEFINE_CURVE.A2"});
-  // Fields 7 and 8 (columns 61-80): DEATH and BIRTH.
+  // Fields 7 and 8 (columns 61-80): DEATH and BIRTH, the condition's window (DEATH 0 or
+  // LS-DYNA's 1e28: never).
   const std::string node_card = "        12         1         0         6";
   const std::string sf_vid(20, ' ');
-  expect_error(with(ok, node_card, node_card + sf_vid + "       0.0    1.0E-5"),
-               {"*BOUNDARY_PRESCRIBED_MOTION_NODE.BIRTH"});
-  expect_error(with(ok, node_card, node_card + sf_vid + "    5.0E-5"),
-               {"*BOUNDARY_PRESCRIBED_MOTION_NODE.DEATH", "before the end time"});
-  EXPECT_NO_THROW(kw(with(ok, node_card, node_card + sf_vid + "    1.0E-4")));
+  const Config w = kw(with(ok, node_card, node_card + sf_vid + "    5.0E-5    1.0E-5"));
+  EXPECT_EQ(w.boundary_conditions.at(2).birth, 1.0e-5);
+  EXPECT_EQ(w.boundary_conditions.at(2).death, 5.0e-5);
+  EXPECT_EQ(w.boundary_conditions.at(3).birth, 0.0); // node 11's card: a group of its own
+  EXPECT_EQ(w.boundary_conditions.at(3).death, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(
+      kw(with(ok, node_card, node_card + sf_vid + "   1.0E+28")).boundary_conditions.at(2).death,
+      std::numeric_limits<double>::infinity());
+  expect_error(with(ok, node_card, node_card + sf_vid + "    1.0E-5    5.0E-5"),
+               {"*BOUNDARY_PRESCRIBED_MOTION_NODE.DEATH", "not after BIRTH"});
+  expect_error(with(ok, node_card, node_card + sf_vid + "       0.0   -1.0E-5"),
+               {"*BOUNDARY_PRESCRIBED_MOTION_NODE.BIRTH", "negative"});
   // A curve that ends before ENDTIM while still changing: held, with a warning (LS-DYNA
   // extrapolates its last slope).
   const Config c = kw(with(ok, "              1.0E-4", "              5.0E-5"));
@@ -726,8 +735,8 @@ TEST(Keyword, ZeroScaleAndNodesOutsideTheModelAreWarnedOf) {
 
 // QA round 23: conditions apply in card order (a later card wins on the components two
 // hold, with a warning); a curve no motion names is not read even when a motion names
-// another; DEATH is checked on every card of a node group and without ENDTIM; a scale
-// factor that overflows the curve is an input error, not an inverted element later.
+// another; a node group's cards share a window (BIRTH, DEATH); a scale factor that
+// overflows the curve is an input error, not an inverted element later.
 TEST(Keyword, PrescribedMotionsInCardOrder) {
   const std::string motion =
       "*BOUNDARY_PRESCRIBED_MOTION_SET\n         7         3         0         6\n";
@@ -765,17 +774,16 @@ TEST(Keyword, PrescribedMotionsInCardOrder) {
   // A curve for dynamic relaxation that no motion names: not read, no error.
   const std::string sidr1 = "*DEFINE_CURVE\n         9         1\n                 0.0       0.0\n";
   EXPECT_NO_THROW(kw(with(good, "*END", motion + curve6 + sidr1 + "*END")));
-  // DEATH on the second card of a node group, and DEATH without ENDTIM.
+  // A DEATH on the second card of a node group makes a group of its own (the window is
+  // part of what the group's cards share).
   const std::string nodes =
       "*BOUNDARY_PRESCRIBED_MOTION_NODE\n        12         1         0         6\n"
       "        11         1         0         6" +
       std::string(20, ' ') + "    5.0E-5\n"; // SF, VID blank; DEATH
-  expect_error(with(good, "*END", nodes + curve6 + "*END"),
-               {"*BOUNDARY_PRESCRIBED_MOTION_NODE.DEATH", "before the end time"});
-  expect_error(
-      with(with(good, "   1.0E-04\n", "       0.0       100\n"), "*END",
-           motion.substr(0, motion.size() - 1) + "                    5.0E-5\n" + curve6 + "*END"),
-      {"*BOUNDARY_PRESCRIBED_MOTION_SET.DEATH", "no ENDTIM"});
+  c = kw(with(good, "*END", nodes + curve6 + "*END"));
+  ASSERT_EQ(c.boundary_conditions.size(), 3u);
+  EXPECT_EQ(c.boundary_conditions[1].death, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(c.boundary_conditions[2].death, 5.0e-5);
   // SF 1e308 times a curve value of 3: not a finite velocity.
   expect_error(with(good, "*END",
                     "*BOUNDARY_PRESCRIBED_MOTION_SET\n         7         3         0         6"

@@ -296,9 +296,15 @@ TEST(Keyword, NodeAndSegmentLoads) {
                   "*LOAD_SEGMENT.N4: the segment refers to node 99"));
   EXPECT_TRUE(has(keyword_error(seg + "         1         2         6         5        13\n"),
                   "*LOAD_SEGMENT.N5: higher-order segments"));
-  EXPECT_TRUE(has(keyword_error("*LOAD_SEGMENT\n         3     2.0E6    1.0E-5         1         "
+  EXPECT_TRUE(has(keyword_error("*LOAD_SEGMENT\n         3     2.0E6   -1.0E-5         1         "
                                 "2         6         5\n"),
-                  "*LOAD_SEGMENT.AT: AT > 0"));
+                  "*LOAD_SEGMENT.AT: AT = -1e-05 is negative"));
+  // AT: the pressure's birth.
+  EXPECT_EQ(keyword("*LOAD_SEGMENT\n         3     2.0E6    1.0E-5         1         2         6 "
+                    "        5\n")
+                .loads.at(0)
+                .birth,
+            1.0e-5);
   EXPECT_TRUE(has(keyword_error("*LOAD_SEGMENT_SET\n         8         3\n"),
                   "*LOAD_SEGMENT_SET.SSID: segment set 8 is not defined (*SET_SEGMENT)"));
   EXPECT_TRUE(has(keyword_error("*LOAD_SEGMENT_SET\n         5         4\n*SET_SEGMENT\n         "

@@ -32,6 +32,10 @@
 // 5. The same column loaded from an LS-DYNA keyword deck (*SET_SEGMENT and
 //    *LOAD_SEGMENT_SET; *LOAD_SEGMENT with the segment reversed and a negative scale;
 //    *LOAD_NODE_POINT) moves as the YAML deck's: tolerance 1e-12 of the amplitude.
+// 6. A load acts from its birth to its death: a force F on each node of a free block from
+//    10 us to 30 us gives it the momentum N F (30 - 10) us (Newton), to within one step's
+//    impulse N F dt (the steps that start inside the window carry the load), and none
+//    before its birth.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -275,6 +279,34 @@ TEST(Loads, KeywordLoadsMatchTheYamlDeck) {
   const double amplitude = p0 / (rho * c);
   EXPECT_LT(worst, 1e-12 * amplitude) << "keyword and YAML runs differ by " << worst << " m/s";
   EXPECT_LT(b.back().probes[5], -0.5 * amplitude);
+}
+
+TEST(Loads, ALoadActsFromBirthToDeath) {
+  const double F = 3.0;
+  const std::string deck = fmt::format(R"(
+termination: {{time: 5.0e-5}}
+materials:
+  steel: {{model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}}
+parts:
+  box:
+    mesh: {{generate: box, min: [0, 0, 0], max: [0.004, 0.004, 0.004], divisions: [2, 2, 2]}}
+    material: steel
+loads:
+  - {{set: {{part: box}}, force: [0, 0, {}], birth: 1.0e-5, death: 3.0e-5}}
+)",
+                                       F);
+  const Comm world = Comm::world();
+  Simulation sim(test::deck(deck), world);
+  const double N = 27; // the block's nodes
+  double dt_max = 0;
+  while (!sim.finished()) {
+    const double t = sim.clock().time;
+    sim.step();
+    dt_max = std::max(dt_max, sim.clock().dt);
+    if (t < 1.0e-5) EXPECT_EQ(test::node_momentum(sim)[2], 0.0);
+  }
+  const double pz = test::node_momentum(sim)[2], expected = N * F * 2.0e-5;
+  EXPECT_NEAR(pz, expected, N * F * dt_max) << "momentum " << pz << " N s";
 }
 
 } // namespace

@@ -36,6 +36,11 @@
 //    last (whose step is shortened to land on the end time, exactly). Tolerance 1e-12 of
 //    the kinetic energy (round-off of the sums; the work was ahead by F v dt / 2 before
 //    QA round 24).
+// 6. A condition holds only from its birth to its death (LS-DYNA's BIRTH and DEATH): a free
+//    block and a particle cube at rest, driven at 2 m/s from 10 us to 30 us, keep still
+//    before (Newton: no force, momentum 0 exactly), move at the driven speed between, and
+//    coast at it after, free (no force: the momentum stays, to round-off of 1e-12, and the
+//    reactions are 0).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -285,6 +290,57 @@ boundary_conditions:
   EXPECT_GT(rows, 50);
   EXPECT_LT(worst, 1e-12) << "kinetic energy off the reactions' work";
   EXPECT_EQ(sim.clock().time, end); // the last step lands on the end time exactly
+}
+
+TEST(PrescribedMotion, ConditionsHoldFromBirthToDeath) {
+  const std::string deck = R"(
+termination: {time: 5.0e-5}
+materials:
+  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+parts:
+  box:
+    mesh: {generate: box, min: [0, 0, 0], max: [0.004, 0.004, 0.004], divisions: [2, 2, 2]}
+    material: steel
+particles:
+  ball: {generate: {shape: box, min: [0.01, 0, 0], max: [0.014, 0.004, 0.004], spacing: 1.0e-3},
+         material: steel}
+boundary_conditions:
+  - {set: {part: box}, velocity: [0, 0, 2.0], birth: 1.0e-5, death: 3.0e-5}
+  - {set: {part: ball}, velocity: [2.0, 0, 0], components: [x], birth: 1.0e-5, death: 3.0e-5}
+)";
+  const Comm world = Comm::world();
+  Simulation sim(test::deck(deck), world);
+  double M = sim.part_masses()[0], m = 0;
+  for (const double x : sim.sph()->particles().mass) m += x;
+  m = world.sum(m);
+  int before = 0, during = 0, after = 0;
+  while (!sim.finished()) {
+    const double t = sim.clock().time; // the step's start: the window's test
+    sim.step();
+    const Sample s = sim.sample();
+    const double pz = test::node_momentum(sim)[2];
+    double px = 0;
+    const auto& pt = sim.sph()->particles();
+    for (std::size_t i = 0; i < pt.size(); ++i) px += pt.mass[i] * pt.v[0][i];
+    px = world.sum(px);
+    if (t < 1.0e-5) {
+      ++before;
+      EXPECT_EQ(pz, 0.0);
+      EXPECT_EQ(px, 0.0);
+    } else if (t < 3.0e-5) {
+      ++during;
+      EXPECT_NEAR(pz, 2.0 * M, 1e-12 * M);
+      EXPECT_NEAR(px, 2.0 * m, 1e-12 * m);
+    } else {
+      ++after;
+      EXPECT_NEAR(pz, 2.0 * M, 1e-12 * M); // coasting, free
+      EXPECT_NEAR(px, 2.0 * m, 1e-12 * m);
+      for (const double r : s.reaction) EXPECT_EQ(r, 0.0);
+    }
+  }
+  EXPECT_GT(before, 5);
+  EXPECT_GT(during, 5);
+  EXPECT_GT(after, 5);
 }
 
 TEST(PrescribedMotion, TheImpulseOfTimeZeroIsInTheFirstRow) {

@@ -125,6 +125,10 @@ struct BoundaryCondition {
   Vec3 value;
   std::optional<TimeCurve> curve;
   std::array<bool, 3> components{false, false, false}; // components it prescribes
+  // The condition holds its components from `birth` to `death` (s; LS-DYNA's BIRTH and
+  // DEATH): a step that starts at t(n) with birth <= t(n) < death; outside, they are free.
+  double birth = 0, death = std::numeric_limits<double>::infinity();
+  bool active(double t) const { return birth <= t && t < death; }
   SourceLocation where;
 };
 
@@ -147,6 +151,12 @@ struct Load {
   Vec3 force;          // N on each node
   double pressure = 0; // Pa; positive pushes into the body, against the outward normal
   std::optional<TimeCurve> curve;
+  // The load acts from `birth` to `death` (s; LS-DYNA's AT of *LOAD_SEGMENT is a birth),
+  // and is 0 outside.
+  double birth = 0, death = std::numeric_limits<double>::infinity();
+  double factor(double t) const {
+    return birth <= t && t < death ? (curve ? curve->at(t) : 1.0) : 0.0;
+  }
   SourceLocation where;
 };
 

@@ -628,6 +628,18 @@ Selection parse_inline_selection(const Node& n) {
   return s;
 }
 
+// `birth` and `death` (s) of a timed condition or load: 0 <= birth < death.
+void parse_window(const Node& n, double& birth, double& death) {
+  if (n.has("birth")) {
+    birth = n.child("birth").number();
+    if (birth < 0) n.child("birth").fail("must not be negative");
+  }
+  if (n.has("death")) {
+    death = n.child("death").number();
+    if (!(death > birth)) n.child("death").fail(fmt::format("must be after the birth ({})", birth));
+  }
+}
+
 // A set reference: a name, or an inline selection.
 Selection parse_set_ref(const Node& n) {
   if (n.is_map()) return parse_inline_selection(n);
@@ -914,9 +926,11 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 
   if (top.has("boundary_conditions")) {
     for (const auto& n : top.child("boundary_conditions").items()) {
-      n.check_keys({"set", "fix", "velocity", "displacement", "curve", "components"});
+      n.check_keys(
+          {"set", "fix", "velocity", "displacement", "curve", "components", "birth", "death"});
       BoundaryCondition bc;
       bc.where = n.where();
+      parse_window(n, bc.birth, bc.death);
       bc.nodes = parse_set_ref(n.required("set"));
       check_name(bc.nodes);
       if (int(n.has("fix")) + int(n.has("velocity")) + int(n.has("displacement")) != 1)
@@ -1051,9 +1065,10 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
   // loads: forces on nodes, pressures on faces, each optionally times a time history.
   if (top.has("loads")) {
     for (const auto& n : top.child("loads").items()) {
-      n.check_keys({"set", "force", "surface", "pressure", "curve"});
+      n.check_keys({"set", "force", "surface", "pressure", "curve", "birth", "death"});
       Load load;
       load.where = n.where();
+      parse_window(n, load.birth, load.death);
       if (n.has("force") == n.has("pressure")) n.fail("give exactly one of 'force' or 'pressure'");
       double amplitude = 0;
       if (n.has("force")) {

@@ -606,7 +606,8 @@ struct MotionCard {
   int dof = 0;                    // 0, 1, 2: x, y, z
   bool displacement = false;      // VAD 2 (else 0, velocity)
   std::int64_t lcid = 0;
-  double sf = 1, death = 0;
+  double sf = 1;
+  double birth = 0, death = std::numeric_limits<double>::infinity(); // (DEATH 0: never)
   Where at;
   std::string keyword;
   std::int64_t seq = 0; // the card's place among the constraints and motions
@@ -639,6 +640,7 @@ struct SegmentLoadCard {
   std::array<std::int64_t, 4> nodes{}; // *LOAD_SEGMENT: N1-N4 (node ids)
   std::int64_t lcid = 0;
   double sf = 1;
+  double arrival = 0; // AT: the pressure acts from then on
   Where at;
   std::string keyword;
 };
@@ -1316,23 +1318,6 @@ private:
     // new group at its own place (QA round 23: a *NODE TC joined a group before a motion
     // card on its node, and the motion won).
 
-    // A motion card's own checks (each card of a group of single nodes too).
-    auto check_motion = [&](const MotionCard& m) {
-      const std::string key = "*" + m.keyword + ".DEATH";
-      // LS-DYNA's "never" is 1e28; anything below 1e20 is a time.
-      if (m.death == 0 || m.death >= 1e20) return;
-      if (endtim_ == 0)
-        throw InputError(m.at.loc(key),
-                         fmt::format("DEATH = {} with no ENDTIM (*CONTROL_TERMINATION) is not "
-                                     "supported: anvil prescribes the motion to the end of the "
-                                     "run, so give an ENDTIM no later than DEATH",
-                                     m.death));
-      if (m.death < endtim_)
-        throw InputError(m.at.loc(key),
-                         fmt::format("DEATH = {} before the end time {} is not supported: anvil "
-                                     "prescribes the motion to the end of the run",
-                                     m.death, endtim_));
-    };
     auto warn_if_curve_ends = [&](std::int64_t lcid, const CurveCard& cc) {
       curve_ends_early(lcid, cc, warnings);
     };
@@ -1364,6 +1349,8 @@ private:
       bc.components[static_cast<std::size_t>(m.dof)] = true;
       bc.value[m.dof] = m.sf;
       bc.curve = tc;
+      bc.birth = m.birth;
+      bc.death = m.death;
       bc.where = bc.nodes.where;
       ordered.emplace_back(seq, std::move(bc));
     };
@@ -1391,7 +1378,7 @@ private:
       const MotionCard* motion; // its first card, for a motion group
     };
     std::vector<Group> groups;
-    using GroupKey = std::tuple<int, int, bool, std::int64_t, double>;
+    using GroupKey = std::tuple<int, int, bool, std::int64_t, double, double, double>;
     std::map<GroupKey, std::size_t> latest;
     auto add_single = [&](const GroupKey& key, std::int64_t pos, std::array<bool, 3> on,
                           std::int64_t seq, const Where& at, const std::string& keyword,
@@ -1422,18 +1409,18 @@ private:
         } else {
           const auto pos =
               node_position(sp.node, sp.at, "*" + sp.keyword + ".NID", "the constraint");
-          add_single({0, mask, false, 0, 0.0}, pos, sp.fix, seq, sp.at, sp.keyword, nullptr);
+          add_single({0, mask, false, 0, 0.0, 0.0, 0.0}, pos, sp.fix, seq, sp.at, sp.keyword,
+                     nullptr);
         }
       } else if (kind == 1) {
         // TC: 1 x, 2 y, 3 z, 4 x and y, 5 y and z, 6 z and x, 7 all.
         static constexpr int masks[8] = {0, 1, 2, 4, 3, 6, 5, 7};
         const NodeTc& t = node_tc_[k];
         const int mask = masks[t.tc];
-        add_single({0, mask, false, 0, 0.0}, node_index_.at(t.nid),
+        add_single({0, mask, false, 0, 0.0, 0.0, 0.0}, node_index_.at(t.nid),
                    {(mask & 1) != 0, (mask & 2) != 0, (mask & 4) != 0}, seq, t.at, "NODE", nullptr);
       } else {
         const MotionCard& m = motions_[k];
-        check_motion(m);
         std::array<bool, 3> on{false, false, false};
         on[static_cast<std::size_t>(m.dof)] = true;
         if (m.set != 0) {
@@ -1442,7 +1429,8 @@ private:
           for (const auto pos : mesh.node_sets.at(name)) hold(pos, on, seq);
         } else {
           const auto pos = node_position(m.node, m.at, "*" + m.keyword + ".NID", "the motion");
-          add_single({1, m.dof, m.displacement, m.lcid, m.sf}, pos, on, seq, m.at, m.keyword, &m);
+          add_single({1, m.dof, m.displacement, m.lcid, m.sf, m.birth, m.death}, pos, on, seq, m.at,
+                     m.keyword, &m);
         }
       }
     }
@@ -1641,14 +1629,15 @@ private:
         load.kind = Load::Kind::pressure;
         load.pressure = r ? -card.sf : card.sf;
         load.curve = curve;
+        load.birth = card.arrival;
         load.where = card.at.loc("*" + card.keyword);
         load.target.name = set;
         load.target.where = load.where;
         c.loads.push_back(load);
       }
     };
-    // Single segments grouped by (LCID, SF), each group at its first card's place.
-    std::map<std::pair<std::int64_t, double>, std::size_t> groups;
+    // Single segments grouped by (LCID, SF, AT), each group at its first card's place.
+    std::map<std::tuple<std::int64_t, double, double>, std::size_t> groups;
     struct Group {
       const SegmentLoadCard* first;
       std::vector<std::array<std::int64_t, 4>> segments;
@@ -1667,7 +1656,7 @@ private:
                      "*SET_SEGMENT", sl, curve);
         continue;
       }
-      const auto [it, fresh] = groups.emplace(std::pair{sl.lcid, sl.sf}, group.size());
+      const auto [it, fresh] = groups.emplace(std::tuple{sl.lcid, sl.sf, sl.arrival}, group.size());
       if (fresh) group.push_back({&sl, {}, {}});
       group[it->second].segments.push_back(sl.nodes);
       group[it->second].at.push_back(sl.at);
@@ -1762,8 +1751,8 @@ private:
 
   // *LOAD_SEGMENT: any number of cards LCID, SF, AT, N1, N2, N3, N4 (N5: a higher-order
   // segment's, not supported); *LOAD_SEGMENT_SET: any number of cards SSID, LCID, SF, AT.
-  // The _ID option adds one card (ID, HEADING) first. A pressure that arrives later (AT > 0)
-  // is not supported: anvil applies it from t = 0 (a curve that is 0 until then does it).
+  // The _ID option adds one card (ID, HEADING) first. AT (the arrival time): the pressure
+  // acts from then on, SF times the curve's value at the time (the curve is not shifted).
   void segment_load(const Block& b, bool set) {
     Cursor c(b);
     if (ends_with(b.name, "_ID")) c.next();
@@ -1778,9 +1767,8 @@ private:
       sl.lcid = card.integer(base, "LCID", 0);
       if (sl.lcid <= 0) card.fail("LCID", "LCID must be the id of a *DEFINE_CURVE");
       sl.sf = card.real(base + 1, "SF", 1.0);
-      if (card.real(base + 2, "AT", 0) > 0)
-        card.fail("AT", "AT > 0 (a pressure that arrives later) is not supported: anvil applies "
-                        "the pressure from t = 0; give a curve that is 0 until then");
+      sl.arrival = card.real(base + 2, "AT", 0);
+      if (sl.arrival < 0) card.fail("AT", fmt::format("AT = {} is negative", sl.arrival));
       if (!set) {
         for (int a = 0; a < 4; ++a) {
           const std::string name = fmt::format("N{}", a + 1);
@@ -1829,7 +1817,8 @@ private:
   // Any number of cards NSID (NID), DOF, VAD, LCID, SF, VID, DEATH, BIRTH (LS-DYNA
   // manual, *BOUNDARY_PRESCRIBED_MOTION), after the ID card of the _ID option. anvil
   // prescribes translations (DOF 1-3) by velocity (VAD 0) or displacement (VAD 2) from
-  // t = 0 to the end; anything else would run another problem, so it is an error.
+  // BIRTH to DEATH (0, or LS-DYNA's "never" 1e28: to the end); anything else would run
+  // another problem, so it is an error.
   void prescribed_motion(const Block& b, bool set) {
     Cursor c(b);
     if (ends_with(b.name, "_ID")) c.next();
@@ -1855,9 +1844,12 @@ private:
       m.lcid = card.integer(3, "LCID", 0);
       if (m.lcid <= 0) card.fail("LCID", "LCID must be the id of a *DEFINE_CURVE");
       m.sf = card.real(4, "SF", 1.0);
-      m.death = card.real(6, "DEATH", 0);
-      if (card.real(7, "BIRTH", 0) > 0)
-        card.fail("BIRTH", "BIRTH > 0 is not supported: anvil prescribes the motion from t = 0");
+      const double death = card.real(6, "DEATH", 0);
+      if (death != 0 && death < 1e20) m.death = death; // (LS-DYNA's "never" is 1e28)
+      m.birth = card.real(7, "BIRTH", 0);
+      if (m.birth < 0) card.fail("BIRTH", fmt::format("BIRTH = {} is negative", m.birth));
+      if (!(m.death > m.birth))
+        card.fail("DEATH", fmt::format("DEATH = {} is not after BIRTH = {}", m.death, m.birth));
       m.at = where_of(*l);
       m.keyword = b.name;
       m.seq = card_seq_++;

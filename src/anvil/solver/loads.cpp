@@ -124,10 +124,8 @@ std::vector<double> Simulation::pressed_area() const {
 // The pressed faces' corner forces at x(n) and t(n), into their slots: each slot the sum of
 // its element's faces in ascending face and load.
 void Simulation::press_faces() {
-  for (std::size_t l = 0; l < config_.loads.size(); ++l) {
-    const auto& c = config_.loads[l].curve;
-    load_factor_[l] = c ? c->at(clock_.time) : 1.0;
-  }
+  for (std::size_t l = 0; l < config_.loads.size(); ++l)
+    load_factor_[l] = config_.loads[l].factor(clock_.time);
   if (pressed_.empty()) return;
   for (const PressedFace& p : pressed_) {
     const auto& lb = fe_.blocks[static_cast<std::size_t>(p.block)];
@@ -190,10 +188,7 @@ void Simulation::add_loads() {
 double Simulation::load_work() const {
   if (config_.loads.empty() || clock_.dt_prev == 0.0) return 0.0;
   const double t_mid = clock_.time - 0.5 * clock_.dt_prev;
-  auto factor = [&](int l) {
-    const auto& c = config_.loads[static_cast<std::size_t>(l)].curve;
-    return c ? c->at(t_mid) : 1.0;
-  };
+  auto factor = [&](int l) { return config_.loads[static_cast<std::size_t>(l)].factor(t_mid); };
   double work = 0;
   for (std::size_t k = 0; k < pressed_.size(); ++k) {
     const PressedFace& p = pressed_[k];

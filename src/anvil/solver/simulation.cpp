@@ -488,20 +488,20 @@ void Simulation::apply_boundary_conditions(const Mesh& mesh) {
   constrained_nodes_.clear();
   initial_impulses_.clear();
   for (std::size_t n = 0; n < nn; ++n)
-    if (constrained_[n]) {
-      constrained_nodes_.push_back(static_cast<int>(n));
-      for (int i = 0; i < 3; ++i) {
-        const int b = source[i][n];
-        if (constrained_[n] & (1u << i)) {
-          if (fe_.node_owned[n] && v_bc_[i][n] != nodes_.v[i][n])
-            initial_impulses_.push_back(
-                {fe_.node_gid[n], b, i, 0, nodes_.mass[n] * (v_bc_[i][n] - nodes_.v[i][n])});
-          nodes_.v[i][n] = v_bc_[i][n];
-        }
-        if (b >= 0 && bcs[static_cast<std::size_t>(b)].prescribed &&
-            bcs[static_cast<std::size_t>(b)].curve)
-          curved_components_.push_back({static_cast<int>(n), i, b});
+    if (constrained_[n]) constrained_nodes_.push_back(static_cast<int>(n));
+  refresh_node_constraints(); // those of the conditions active at t = 0
+  for (const int n : constrained_nodes_)
+    for (int i = 0; i < 3; ++i) {
+      const int b = source[i][n];
+      if (constrained_[n] & (1u << i)) {
+        if (fe_.node_owned[n] && v_bc_[i][n] != nodes_.v[i][n])
+          initial_impulses_.push_back(
+              {fe_.node_gid[n], b, i, 0, nodes_.mass[n] * (v_bc_[i][n] - nodes_.v[i][n])});
+        nodes_.v[i][n] = v_bc_[i][n];
       }
+      if (b >= 0 && bcs[static_cast<std::size_t>(b)].prescribed &&
+          bcs[static_cast<std::size_t>(b)].curve)
+        curved_components_.push_back({n, i, b});
     }
   apply_particle_boundary_conditions();
 }
@@ -522,6 +522,19 @@ std::array<double, 3> Simulation::body_acceleration(double t) const {
 // follows the curve without drift (with dt = 0, at setup: the rate just after t).
 void Simulation::update_prescribed_motions(double t, double dt) {
   const auto& bcs = config_.boundary_conditions;
+  // The conditions that hold their components over this step (birth <= t < death); where
+  // that changes, the constrained components do.
+  bool changed = bc_active_.size() != bcs.size();
+  bc_active_.resize(bcs.size());
+  for (std::size_t b = 0; b < bcs.size(); ++b) {
+    const std::uint8_t on = bcs[b].active(t) ? 1 : 0;
+    changed = changed || on != bc_active_[b];
+    bc_active_[b] = on;
+  }
+  if (changed) {
+    refresh_node_constraints();
+    refresh_particle_constraints();
+  }
   motion_factor_.resize(bcs.size());
   for (std::size_t b = 0; b < bcs.size(); ++b) {
     const auto& c = bcs[b].curve;
@@ -535,6 +548,18 @@ void Simulation::update_prescribed_motions(double t, double dt) {
   for (const auto& cc : curved_components_)
     v_bc_[cc.component][cc.node] = config_.boundary_conditions[cc.condition].value[cc.component] *
                                    motion_factor_[cc.condition];
+}
+
+// The constrained components of the nodes some condition holds: those whose condition
+// (the last in the deck to hold them) is active over the current step (bc_active_).
+void Simulation::refresh_node_constraints() {
+  for (const int n : constrained_nodes_) {
+    std::uint8_t bits = 0;
+    for (int i = 0; i < 3; ++i)
+      if (const int b = bc_source_[i][n]; b >= 0 && bc_active_[static_cast<std::size_t>(b)])
+        bits |= static_cast<std::uint8_t>(1u << i);
+    constrained_[n] = bits;
+  }
 }
 
 void Simulation::locate_probes(const Mesh& mesh) {
@@ -1093,7 +1118,7 @@ std::vector<double> Simulation::reactions() const {
   for (const int n : constrained_nodes_) {
     if (!fe_.node_owned[static_cast<std::size_t>(n)]) continue;
     for (int i = 0; i < 3; ++i)
-      if (const int b = bc_source_[i][n]; b >= 0)
+      if (const int b = bc_source_[i][n]; b >= 0 && (constrained_[n] & (1u << i)))
         mine.push_back({fe_.node_gid[n], b, i, 1, bc_reaction_[i][n]});
   }
   if (sph_) {

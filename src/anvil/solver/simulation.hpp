@@ -155,6 +155,8 @@ private:
   void apply_initial_conditions(const Mesh& mesh);
   void apply_boundary_conditions(const Mesh& mesh);
   void update_prescribed_motions(double t, double dt);
+  void refresh_node_constraints();
+  void refresh_particle_constraints();
   // External loads (loads.cpp): resolved at setup; the pressed faces' corner forces at t(n)
   // before the corner exchange, the loads' nodal forces added after it; their work over the
   // step before (predict).
@@ -219,7 +221,8 @@ private:
     int condition;
   };
   std::vector<double> motion_factor_;
-  double gravity_[3] = {0, 0, 0}; // body acceleration of the current step, m/s^2
+  std::vector<std::uint8_t> bc_active_; // per condition: 1 if it holds over the current step
+  double gravity_[3] = {0, 0, 0};       // body acceleration of the current step, m/s^2
   std::array<double, 3> gravity_work_before_{0, 0, 0}; // of the step before (its work)
   std::int64_t stalled_steps_ = 0; // steps in a row that did not advance the time
   std::vector<CurvedComponent> curved_components_;

@@ -145,6 +145,7 @@ void Simulation::apply_particle_boundary_conditions() {
       pt.v_bc[k][i] = 0.0;
       pt.bc_source[k][i] = -1; // (the model's plane, not a condition of the deck)
     }
+  refresh_particle_constraints(); // those of the conditions active at t = 0
   for (std::size_t i = 0; i < pt.size(); ++i)
     for (int k = 0; k < 3; ++k)
       if (pt.constrained[i] & (1u << k)) {
@@ -153,6 +154,21 @@ void Simulation::apply_particle_boundary_conditions() {
           initial_impulses_.push_back(
               {global_nodes_ + pt.gid[i], b, k, 0, pt.mass[i] * (v - pt.v[k][i])});
         pt.v[k][i] = v;
+      }
+}
+
+// The components the deck's conditions hold on own particles, of the conditions active over
+// the current step (bc_active_); the model's plane keeps its own.
+void Simulation::refresh_particle_constraints() {
+  if (!sph_) return;
+  auto& pt = sph_->particles();
+  for (std::size_t i = 0; i < pt.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      if (const int b = pt.bc_source[k][i]; b >= 0) {
+        const auto bit = static_cast<std::uint8_t>(1u << k);
+        pt.constrained[i] = bc_active_[static_cast<std::size_t>(b)]
+                                ? static_cast<std::uint8_t>(pt.constrained[i] | bit)
+                                : static_cast<std::uint8_t>(pt.constrained[i] & ~bit);
       }
 }
 
