@@ -149,6 +149,8 @@ TEST(Deck, Loads) {
   EXPECT_TRUE(
       has(error("{surface: blk.zmax, pressure: 1, curve: [[1, 0], [0, 1]]}"), "loads[0].curve"));
   EXPECT_TRUE(has(error("{surface: blk.zmax, pressure: 1, ramp: 2}"), "unknown key 'ramp'"));
+  EXPECT_TRUE(has(error("{surface: blk.zmax, pressure: 1, curve: [[-1.7e308, 0], [1.7e308, 1]]}"),
+                  "span more than a number can hold"));
   EXPECT_TRUE(
       has(error("{surface: blk.zmax, pressure: 1e308, curve: [[0, 0], [1, 10]]}"), "overflows"));
   // Selections that hold no face of the surface: an inner box, and a single edge's nodes.
@@ -158,6 +160,44 @@ TEST(Deck, Loads) {
   EXPECT_TRUE(has(error("{surface: {box: {min: [0, 0, 0], max: [0.01, 0, 0]}}, pressure: 1}"),
                   "no four are the corners"));
   EXPECT_EQ(error("{surface: {part: blk}, pressure: 1}"), "");
+}
+
+// A mesh file's side set is a surface (tests/data/meshes/box_2x2x2.exo: side set `top`, 4
+// faces of 0.5 m^2, after a generated part, so its elements are renumbered); a mistyped
+// name lists both kinds of sets, and a side set given to `set` says what it is (QA round
+// 25: both said "node set ... not defined").
+TEST(Deck, LoadsOnMeshFileSideSets) {
+  const std::string deck = fmt::format(R"(
+termination: {{cycles: 3}}
+materials:
+  steel: {{model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}}
+parts:
+  gen:
+    mesh: {{generate: box, min: [5, 0, 0], max: [6, 1, 1], divisions: [1, 1, 1]}}
+    material: steel
+  m:
+    mesh: {{file: {}/tests/data/meshes/box_2x2x2.exo}}
+    material: steel
+loads:
+  - LOAD
+)",
+                                       test::source_dir());
+  auto with = [&](const std::string& item) {
+    std::string t = deck;
+    t.replace(t.find("LOAD"), 4, item);
+    return t;
+  };
+  const Config c = test::deck(with("{surface: m.top, pressure: 1.0e5}"));
+  const Comm self = Comm::self();
+  Simulation sim(c, self);
+  EXPECT_EQ(sim.load_targets(), (std::vector<std::int64_t>{4}));
+  EXPECT_NEAR(sim.pressed_area()[0], 2.0, 1e-12);
+  EXPECT_NE(model_error(with("{surface: m.topp, pressure: 1}"))
+                .find("'m.topp' is neither a side set nor a node set (the part has "),
+            std::string::npos);
+  EXPECT_NE(model_error(with("{set: m.top, force: [0, 0, 1]}"))
+                .find("'m.top' is a side set (faces), not a node set"),
+            std::string::npos);
 }
 
 // Forces act on mesh nodes only; a pressure on faces of the mesh only.
@@ -322,6 +362,37 @@ TEST(Keyword, NodeAndSegmentLoads) {
                   "*LOAD_NODE_POINT.NID: the load refers to node 99"));
   EXPECT_TRUE(has(keyword_error("*LOAD_NODE_POINT\n         9         3\n"),
                   "*LOAD_NODE_POINT.LCID: LCID must be the id of a *DEFINE_CURVE"));
+}
+
+// QA round 25: loads add up, as LS-DYNA's do: a node's or a segment's repeated card (or a
+// segment listed twice in a set) loads it again, not once (a set holds a node or a face
+// once, so the repeats go into sets of their own).
+TEST(Keyword, RepeatedLoadCardsAddUp) {
+  const Config c = keyword(R"(*LOAD_NODE_POINT
+         9         3         3     -10.0
+         9         3         3     -10.0
+        10         3         3     -10.0
+*SET_SEGMENT
+         5
+         9        10        11        12
+         9        10        11        12
+*LOAD_SEGMENT_SET
+         5         3     1.0E6
+*LOAD_SEGMENT
+         3     2.0E6       0.0         1         2         6         5
+         3     2.0E6       0.0         1         2         6         5
+)");
+  std::vector<std::string> names;
+  for (const auto& l : c.loads) names.push_back(l.target.name);
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"load_nodes_1", "load_nodes_2", "segset_5", "segset_5_2",
+                                      "load_segments_1", "load_segments_1_2"}));
+  const Mesh mesh = build_mesh(c);
+  EXPECT_EQ(mesh.node_sets.at("load_nodes_1"), (std::vector<std::int64_t>{8, 9}));
+  EXPECT_EQ(mesh.node_sets.at("load_nodes_2"), (std::vector<std::int64_t>{8}));
+  const Comm self = Comm::self();
+  Simulation sim(c, self);
+  EXPECT_EQ(sim.load_targets(), (std::vector<std::int64_t>{2, 1, 1, 1, 1, 1}));
 }
 
 } // namespace

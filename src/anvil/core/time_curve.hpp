@@ -52,6 +52,11 @@ inline std::string time_history_problem(double amplitude, const TimeCurve& c, bo
                 "must be 0, found %g",
                 c.at(0.0));
   for (std::size_t k = 0; k < c.t.size(); ++k) {
+    // (Times whose span overflows made every value between them 0, QA round 25.)
+    if (k > 0 && !std::isfinite(c.t[k] - c.t[k - 1]))
+      return text("the times before t = %g span more than a number can hold (their "
+                  "difference overflows)",
+                  c.t[k]);
     if (!std::isfinite(amplitude * c.value[k]))
       return text("the value at t = %g overflows (the scale factor times the curve is not a "
                   "finite number)",

@@ -1522,8 +1522,11 @@ private:
   // against the segment's right-hand normal (N1-N2-N3-N4), anvil's against the face's
   // outward one: the reversed faces take -SF.
   void loads(Config& c, Mesh& mesh, std::vector<std::string>& warnings) {
-    // Forces: a set's card is a load; single nodes are grouped by (DOF, LCID, SF).
-    std::map<std::tuple<int, std::int64_t, double>, std::size_t> node_groups;
+    // Forces: a set's card is a load; single nodes are grouped by (DOF, LCID, SF), a node's
+    // second card of the same kind into a second group, and so on (LS-DYNA adds repeated
+    // loads; a set holds a node once, QA round 25).
+    std::map<std::tuple<int, std::int64_t, double>, std::vector<std::size_t>> node_groups;
+    int node_group_count = 0;
     for (const auto& nl : node_loads_) {
       const std::string key = "*" + nl.keyword;
       Load load;
@@ -1538,14 +1541,22 @@ private:
         continue;
       }
       const auto pos = node_position(nl.node, nl.at, key + ".NID", "the load");
-      const auto [it, fresh] =
-          node_groups.emplace(std::tuple{nl.dof, nl.lcid, nl.sf}, c.loads.size());
-      if (fresh) {
-        load.target.name = fmt::format("load_nodes_{}", node_groups.size());
-        c.loads.push_back(load);
+      auto& layers = node_groups[std::tuple{nl.dof, nl.lcid, nl.sf}];
+      std::vector<std::int64_t>* ids = nullptr;
+      for (const std::size_t l : layers) {
+        auto& set = mesh.node_sets[c.loads[l].target.name];
+        if (!std::binary_search(set.begin(), set.end(), pos)) {
+          ids = &set;
+          break;
+        }
       }
-      auto& ids = mesh.node_sets[c.loads[it->second].target.name];
-      ids.insert(std::lower_bound(ids.begin(), ids.end(), pos), pos);
+      if (!ids) {
+        load.target.name = fmt::format("load_nodes_{}", ++node_group_count);
+        layers.push_back(c.loads.size());
+        c.loads.push_back(load);
+        ids = &mesh.node_sets[load.target.name];
+      }
+      ids->insert(std::lower_bound(ids->begin(), ids->end(), pos), pos);
     }
     if (segment_loads_.empty()) return;
 
@@ -1615,26 +1626,31 @@ private:
                             const std::vector<std::array<std::int64_t, 4>>& segments,
                             const std::vector<Where>& at, const std::string& key,
                             const SegmentLoadCard& card, const TimeCurve& curve) {
-      std::vector<SideEntry> side[2];
+      // Per orientation, layers: a face's k-th segment goes into layer k (a segment listed
+      // twice is pressed twice, as LS-DYNA does; a side set holds a face once).
+      std::vector<std::vector<SideEntry>> side[2];
+      std::map<std::pair<std::int64_t, int>, std::size_t> seen[2];
       for (std::size_t k = 0; k < segments.size(); ++k) {
         const auto [entry, reversed] = face_of(segments[k], at[k], key);
-        side[reversed ? 1 : 0].push_back(entry);
+        const std::size_t layer = seen[reversed][{entry.element, entry.face}]++;
+        if (side[reversed].size() <= layer) side[reversed].resize(layer + 1);
+        side[reversed][layer].push_back(entry);
       }
-      for (int r = 0; r < 2; ++r) {
-        if (side[r].empty()) continue;
-        const std::string set = r ? name + "_reversed" : name;
-        auto& dst = mesh.side_sets[set];
-        dst.insert(dst.end(), side[r].begin(), side[r].end());
-        Load load;
-        load.kind = Load::Kind::pressure;
-        load.pressure = r ? -card.sf : card.sf;
-        load.curve = curve;
-        load.birth = card.arrival;
-        load.where = card.at.loc("*" + card.keyword);
-        load.target.name = set;
-        load.target.where = load.where;
-        c.loads.push_back(load);
-      }
+      for (int r = 0; r < 2; ++r)
+        for (std::size_t layer = 0; layer < side[r].size(); ++layer) {
+          const std::string set = (r ? name + "_reversed" : name) +
+                                  (layer > 0 ? fmt::format("_{}", layer + 1) : std::string());
+          if (!mesh.side_sets.count(set)) mesh.side_sets[set] = side[r][layer];
+          Load load;
+          load.kind = Load::Kind::pressure;
+          load.pressure = r ? -card.sf : card.sf;
+          load.curve = curve;
+          load.birth = card.arrival;
+          load.where = card.at.loc("*" + card.keyword);
+          load.target.name = set;
+          load.target.where = load.where;
+          c.loads.push_back(load);
+        }
     };
     // Single segments grouped by (LCID, SF, AT), each group at its first card's place.
     std::map<std::tuple<std::int64_t, double, double>, std::size_t> groups;

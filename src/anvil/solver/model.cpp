@@ -248,6 +248,10 @@ std::vector<std::int64_t> resolve_selection(const Mesh& mesh, const Config& conf
       ids = resolve_selection(mesh, config, it->second);
     } else if (auto m = mesh.node_sets.find(sel.name); m != mesh.node_sets.end()) {
       ids = m->second;
+    } else if (mesh.side_sets.count(sel.name)) {
+      throw InputError(sel.where, fmt::format("'{}' is a side set (faces), not a node set: a "
+                                              "pressure takes it as its surface",
+                                              sel.name));
     } else {
       // A name PART.SET of a part read from a file: the sets its file has (the deck's
       // reader lists a generated part's own).
@@ -307,6 +311,23 @@ std::vector<SideEntry> resolve_surface(const Mesh& mesh, const Config& config,
       Selection named = it->second;
       named.where = sel.where;
       return resolve_surface(mesh, config, named);
+    }
+    // Neither: the part's side sets and node sets, both of which a surface takes.
+    if (!mesh.node_sets.count(sel.name)) {
+      std::string known;
+      if (const auto dot = sel.name.find('.'); dot != std::string::npos) {
+        const std::string prefix = sel.name.substr(0, dot + 1);
+        for (const auto& [name, faces] : mesh.side_sets)
+          if (name.compare(0, prefix.size(), prefix) == 0)
+            known += (known.empty() ? "" : ", ") + name;
+        for (const auto& [name, nodes] : mesh.node_sets)
+          if (name.compare(0, prefix.size(), prefix) == 0)
+            known += (known.empty() ? "" : ", ") + name;
+      }
+      throw InputError(
+          sel.where,
+          fmt::format("'{}' is neither a side set nor a node set{}", sel.name,
+                      known.empty() ? std::string() : fmt::format(" (the part has {})", known)));
     }
   }
   if (sel.part && part_index(config, *sel.part) == config.parts.size() &&

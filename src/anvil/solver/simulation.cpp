@@ -789,12 +789,10 @@ void Simulation::predict() {
   // memory at every term, a quarter of this function's time on the can crush).
   double work_bc_nodes = 0, later_nodes = 0;
   update_prescribed_motions(clock_.time, dt);
-  // The body acceleration of this step, at t(n) where its forces are; and the one of the
-  // step before, at its middle, for the body force's work (below).
+  // The body acceleration of this step, at t(n) where its forces are.
   const auto g_now = body_acceleration(clock_.time);
   const double g[3] = {g_now[0], g_now[1], g_now[2]};
   for (int i = 0; i < 3; ++i) gravity_[i] = g[i];
-  const auto g_before = body_acceleration(clock_.time - 0.5 * clock_.dt_prev);
   for (int n : constrained_nodes_) {
     for (int i = 0; i < 3; ++i) {
       if (!(constrained_[n] & (1u << i))) continue;
@@ -813,9 +811,9 @@ void Simulation::predict() {
       }
     }
   }
-  // (The particles' join these below.)
-  double work_bc = work_bc_nodes, work_bc_later = later_nodes;
-  double work = 0;
+  // The work of the step's impulses, the constraints' (the particles' join them below) and
+  // the loads', and its part after t(n) (work_later_).
+  double impulse_work = work_bc_nodes, impulse_work_later = later_nodes;
   double ke = 0;
   // Probe displacements at t(n); their velocities once correct() has set v(n+1/2).
   for (std::size_t p = 0; p < probe_node_.size(); ++p)
@@ -873,20 +871,27 @@ void Simulation::predict() {
     if (owned[n]) ke_nodes += e;
   }
   ke = ke_nodes; // (ke is 0 before the nodes: the same sum)
-  // The body force's work on the free components: m g . (x(n) - x(n-1)), the step before's
-  // displacement dt(n-1/2) v(n-1/2), so that the work to t(n) is m g . (x(n) - x(0)) for a
-  // constant g, which is exactly the kinetic energy a free fall from rest reports at t(n)
-  // (a midpoint rule on v(n) lagged half a step: 1/N of it after N steps).
-  if (g_before[0] != 0.0 || g_before[1] != 0.0 || g_before[2] != 0.0)
+  // The body force's impulse m g dt_v on the free components, booked as the constraints'
+  // and the loads' are (its work to t(n) then equals a free fall's kinetic energy at t(n)
+  // to round-off, whatever g does; on constrained components the reactions hold it). In
+  // locals whose address is not taken (see work_bc_nodes).
+  if (g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0) {
+    double gravity_work = 0, gravity_later = 0;
     for (std::size_t k = 0; k < nn; ++k)
       if (owned[k])
         for (int i = 0; i < 3; ++i)
-          if (!((fixed[k] >> i) & 1u)) work += clock_.dt_prev * m[k] * g_before[i] * v_prev[i][k];
-  gravity_work_before_ = g_before;
-  work += load_work();
-  if (sph_) predict_particles(dt_avg, ke, work_bc, work_bc_later, work);
-  work_bc_later_ = work_bc_later;
-  external_work_ += work_bc + work;
+          if (!((fixed[k] >> i) & 1u)) {
+            const double impulse = m[k] * g[i] * dt_avg;
+            gravity_work += impulse * 0.5 * (v_prev[i][k] + v[i][k]);
+            gravity_later += impulse * 0.125 * (v_prev[i][k] + 3 * v[i][k]);
+          }
+    impulse_work += gravity_work;
+    impulse_work_later += gravity_later;
+  }
+  add_load_work(dt_avg, impulse_work, impulse_work_later);
+  if (sph_) predict_particles(dt_avg, ke, impulse_work, impulse_work_later);
+  work_later_ = impulse_work_later;
+  external_work_ += impulse_work;
   kinetic_local_ = ke; // correct() adds what contact and walls change
   sample_time_ = clock_.time;
   sample_cycle_ = clock_.cycle;
@@ -1073,11 +1078,11 @@ Sample Simulation::sample() const {
   s.time = clock_.cycle == 0 ? 0.0 : sample_time_;
   s.cycle = clock_.cycle == 0 ? 0 : sample_cycle_;
   s.dt = sample_dt_;
-  // The constraints' work of step n, booked whole in its predict(), is not all done at t(n)
-  // (work_bc_later_). (Booked whole, a body driven at a constant acceleration showed work
-  // ahead of its kinetic energy by F v dt / 2 at every row, QA round 24; now the two agree
-  // to round-off, as a free fall's do.)
-  double local[5] = {kinetic_local_, 0, 0, external_work_ - work_bc_later_, contact_energy_};
+  // The constraints' and the loads' work of step n, booked whole in its predict(), is not
+  // all done at t(n) (work_later_). (Booked whole, a body driven at a constant acceleration showed
+  // work ahead of its kinetic energy by F v dt / 2 at every row, QA round 24; now the two agree to
+  // round-off, as a free fall's do.)
+  double local[5] = {kinetic_local_, 0, 0, external_work_ - work_later_, contact_energy_};
   for (const auto& b : blocks_)
     for (int e = 0; e < b.size(); ++e) {
       local[1] += b.internal_energy[e];
