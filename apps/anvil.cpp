@@ -33,6 +33,13 @@ std::string count_of(std::int64_t n, const char* thing) {
   return fmt::format("{} {}{}", n, thing, n == 1 ? "" : "s");
 }
 
+// A birth/death window as `check` shows it ("" when it is the whole run).
+std::string describe_window(double birth, double death) {
+  if (birth == 0 && std::isinf(death)) return {};
+  return std::isinf(death) ? fmt::format(" from t = {:g} s", birth)
+                           : fmt::format(" from t = {:g} to {:g} s", birth, death);
+}
+
 // A selection as `check` shows it: its name, or its part and box.
 std::string describe_selection(const anvil::Selection& s) {
   std::string where = s.name;
@@ -60,7 +67,7 @@ std::string describe_condition(std::size_t n, const anvil::BoundaryCondition& bc
       what += fmt::format(" x curve of {}",
                           count_of(static_cast<std::int64_t>(bc.curve->t.size()), "point"));
   }
-  return fmt::format("  bc{:<3} {:<24} {}", n, where, what);
+  return fmt::format("  bc{:<3} {:<24} {}{}", n, where, what, describe_window(bc.birth, bc.death));
 }
 
 // One line of `check` per external load: what it applies, and where.
@@ -74,7 +81,8 @@ std::string describe_load(std::size_t n, const anvil::Load& load, std::int64_t t
   if (load.curve)
     what += fmt::format(" x curve of {}",
                         count_of(static_cast<std::int64_t>(load.curve->t.size()), "point"));
-  return fmt::format("  load{:<2} {:<24} {}", n, describe_selection(load.target), what);
+  return fmt::format("  load{:<2} {:<24} {}{}", n, describe_selection(load.target), what,
+                     describe_window(load.birth, load.death));
 }
 
 int check(const std::string& deck, const anvil::Comm& comm) {
