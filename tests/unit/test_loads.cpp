@@ -160,6 +160,13 @@ TEST(Deck, Loads) {
   EXPECT_TRUE(has(error("{surface: {box: {min: [0, 0, 0], max: [0.01, 0, 0]}}, pressure: 1}"),
                   "no four are the corners"));
   EXPECT_EQ(error("{surface: {part: blk}, pressure: 1}"), "");
+  // A load born at or after the end never acts: warned of (QA round 26).
+  const Config late = test::deck(std::string(block) +
+                                 "loads:\n  - {surface: blk.zmax, pressure: 1.0e6, birth: 1.0}\n");
+  Simulation unborn(late, self);
+  ASSERT_FALSE(unborn.warnings().empty());
+  EXPECT_TRUE(
+      has(unborn.warnings().back(), "the load is born at t = 1 s, not before the end time"));
 }
 
 // A mesh file's side set is a surface (tests/data/meshes/box_2x2x2.exo: side set `top`, 4
@@ -339,6 +346,19 @@ TEST(Keyword, NodeAndSegmentLoads) {
   EXPECT_TRUE(has(keyword_error("*LOAD_SEGMENT\n         3     2.0E6   -1.0E-5         1         "
                                 "2         6         5\n"),
                   "*LOAD_SEGMENT.AT: AT = -1e-05 is negative"));
+  // DT of *LOAD_SEGMENT_SET: the pressure's death; nothing after it.
+  const std::string segset = "*SET_SEGMENT\n         5\n         9        10        11        12\n";
+  EXPECT_EQ(
+      keyword(segset + "*LOAD_SEGMENT_SET\n         5         3     1.0E6    1.0E-5    3.0E-5\n")
+          .loads.at(0)
+          .death,
+      3.0e-5);
+  EXPECT_TRUE(has(keyword_error(segset + "*LOAD_SEGMENT_SET\n         5         3     1.0E6    "
+                                         "1.0E-5    3.0E-5       xyz\n"),
+                  "*LOAD_SEGMENT_SET.field 6: a *LOAD_SEGMENT_SET card holds SSID, LCID, SF, AT"));
+  EXPECT_TRUE(has(keyword_error(segset + "*LOAD_SEGMENT_SET\n         5         3     1.0E6    "
+                                         "3.0E-5    1.0E-5\n"),
+                  "*LOAD_SEGMENT_SET.DT: DT = 1e-05 is not after AT = 3e-05"));
   // AT: the pressure's birth.
   EXPECT_EQ(keyword("*LOAD_SEGMENT\n         3     2.0E6    1.0E-5         1         2         6 "
                     "        5\n")

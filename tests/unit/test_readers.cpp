@@ -20,6 +20,7 @@
 #include <fmt/format.h>
 
 #include "anvil/core/error.hpp"
+#include "anvil/mesh/mesh.hpp"
 #include "anvil/mesh/read_exodus.hpp"
 #include "anvil/mesh/read_gmsh.hpp"
 #include "test_support.hpp"
@@ -115,6 +116,18 @@ Vec3 face_normal(const Mesh& m, const SideEntry& s) {
 
 // ---------------------------------------------------------------------------------------
 // Exodus II
+
+// A generated mesh (no file ids: id = position + 1) followed by a file's (ids kept): the
+// ids of both, in order. (append_nodes read past its id list for the generated nodes
+// after the first, AddressSanitizer found; QA round 25's side-set test met it.)
+TEST(Mesh, AppendingAFilesIdsAfterGeneratedNodes) {
+  Mesh generated, file;
+  generated.nodes = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+  file.nodes = {{5, 0, 0}, {6, 0, 0}};
+  file.node_ids = {70, 40};
+  generated.append(file, "f");
+  EXPECT_EQ(generated.node_ids, (std::vector<std::int64_t>{1, 2, 3, 70, 40}));
+}
 
 TEST(ReadExodus, BoxBlocksSetsAndSides) {
   const Mesh m = read_exodus(data("box_2x2x2.exo"));

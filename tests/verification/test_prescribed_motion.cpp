@@ -40,7 +40,10 @@
 //    block and a particle cube at rest, driven at 2 m/s from 10 us to 30 us, keep still
 //    before (Newton: no force, momentum 0 exactly), move at the driven speed between, and
 //    coast at it after, free (no force: the momentum stays, to round-off of 1e-12, and the
-//    reactions are 0).
+//    reactions are 0). A component goes to the last item that holds it and is active: a
+//    driver that dies hands its nodes and particles to a fix born then, or to a fix listed
+//    before it (QA round 26: the later item owned the component even while inactive, so
+//    the driver never acted); exactly 2 m/s, then exactly 0.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -341,6 +344,52 @@ boundary_conditions:
   EXPECT_GT(before, 5);
   EXPECT_GT(during, 5);
   EXPECT_GT(after, 5);
+}
+
+TEST(PrescribedMotion, ADriverThatDiesHandsItsComponentsOn) {
+  const std::string base = R"(
+termination: {time: 4.0e-5}
+materials:
+  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+parts:
+  box:
+    mesh: {generate: box, min: [0, 0, 0], max: [0.004, 0.004, 0.004], divisions: [1, 1, 1]}
+    material: steel
+particles:
+  ball: {generate: {shape: box, min: [0.01, 0, 0], max: [0.012, 0.002, 0.002], spacing: 1.0e-3},
+         material: steel}
+boundary_conditions:
+)";
+  const std::string push = "  - {set: {part: box}, velocity: [0, 0, 2.0], death: 2.0e-5}\n"
+                           "  - {set: {part: ball}, velocity: [0, 0, 2.0], death: 2.0e-5}\n";
+  const std::string hold_later = "  - {set: {part: box}, fix: [z], birth: 2.0e-5}\n"
+                                 "  - {set: {part: ball}, fix: [z], birth: 2.0e-5}\n";
+  const std::string hold_always = "  - {set: {part: box}, fix: [z]}\n"
+                                  "  - {set: {part: ball}, fix: [z]}\n";
+  const Comm world = Comm::world();
+  for (const std::string& deck : {base + push + hold_later, base + hold_always + push}) {
+    Simulation sim(test::deck(deck), world);
+    const double M = sim.part_masses()[0];
+    double m = 0;
+    for (const double x : sim.sph()->particles().mass) m += x;
+    m = world.sum(m);
+    int pushed = 0, held = 0;
+    while (!sim.finished()) {
+      const double t = sim.clock().time;
+      sim.step();
+      const double pz = test::node_momentum(sim)[2];
+      double qz = 0;
+      const auto& pt = sim.sph()->particles();
+      for (std::size_t i = 0; i < pt.size(); ++i) qz += pt.mass[i] * pt.v[2][i];
+      qz = world.sum(qz);
+      const double v = t < 2.0e-5 ? 2.0 : 0.0;
+      (t < 2.0e-5 ? pushed : held)++;
+      EXPECT_NEAR(pz, v * M, 1e-12 * M) << "t = " << t;
+      EXPECT_NEAR(qz, v * m, 1e-12 * m) << "t = " << t;
+    }
+    EXPECT_GT(pushed, 5);
+    EXPECT_GT(held, 5);
+  }
 }
 
 TEST(PrescribedMotion, TheImpulseOfTimeZeroIsInTheFirstRow) {

@@ -640,7 +640,8 @@ struct SegmentLoadCard {
   std::array<std::int64_t, 4> nodes{}; // *LOAD_SEGMENT: N1-N4 (node ids)
   std::int64_t lcid = 0;
   double sf = 1;
-  double arrival = 0; // AT: the pressure acts from then on
+  double arrival = 0;                                     // AT: the pressure acts from then on
+  double death = std::numeric_limits<double>::infinity(); // DT of *LOAD_SEGMENT_SET
   Where at;
   std::string keyword;
 };
@@ -1646,6 +1647,7 @@ private:
           load.pressure = r ? -card.sf : card.sf;
           load.curve = curve;
           load.birth = card.arrival;
+          load.death = card.death;
           load.where = card.at.loc("*" + card.keyword);
           load.target.name = set;
           load.target.where = load.where;
@@ -1785,6 +1787,17 @@ private:
       sl.sf = card.real(base + 1, "SF", 1.0);
       sl.arrival = card.real(base + 2, "AT", 0);
       if (sl.arrival < 0) card.fail("AT", fmt::format("AT = {} is negative", sl.arrival));
+      if (set) {
+        // DT (a death time, in recent LS-DYNA versions; 0 or blank: never), then nothing.
+        const double dt = card.real(4, "DT", 0);
+        if (dt != 0 && dt < 1e20) sl.death = dt;
+        if (!(sl.death > sl.arrival))
+          card.fail("DT", fmt::format("DT = {} is not after AT = {}", dt, sl.arrival));
+        for (int k = 5; k < card.size(); ++k)
+          if (!card.blank(k))
+            card.fail(fmt::format("field {}", k + 1),
+                      "a *LOAD_SEGMENT_SET card holds SSID, LCID, SF, AT and DT");
+      }
       if (!set) {
         for (int a = 0; a < 4; ++a) {
           const std::string name = fmt::format("N{}", a + 1);

@@ -28,7 +28,11 @@ std::int64_t Mesh::append_nodes(const Mesh& other, const std::string& prefix) {
   const std::int64_t node_shift = num_nodes();
   // File ids where either mesh has them (a generated mesh's nodes: their position).
   if (!node_ids.empty() || !other.node_ids.empty()) {
-    for (std::size_t n = node_ids.size(); n < nodes.size(); ++n) node_ids.push_back(node_id(n));
+    // (Our nodes without ids are generated ones: id = position + 1. node_id(n) would read
+    // node_ids[n] once the first is pushed: past its end, ASan found, a generated part
+    // before a file's with ids.)
+    for (std::size_t n = node_ids.size(); n < nodes.size(); ++n)
+      node_ids.push_back(static_cast<std::int64_t>(n) + 1);
     for (std::size_t n = 0; n < other.nodes.size(); ++n)
       node_ids.push_back(other.node_ids.empty() ? node_shift + static_cast<std::int64_t>(n) + 1
                                                 : other.node_ids[n]);

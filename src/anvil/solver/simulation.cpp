@@ -334,6 +334,17 @@ void Simulation::warn_of_setup(const Mesh& mesh) {
         "continuity density (the default) for liquids and solids (docs/sph.md)",
         ps.where.str(), ps.name, ps.material));
   }
+  // A condition or a load born at or after the end never acts (QA round 26).
+  if (std::isfinite(config_.end_time)) {
+    auto unborn = [&](const SourceLocation& where, double birth, const char* what) {
+      if (birth >= config_.end_time)
+        warnings_.push_back(fmt::format("{}: the {} is born at t = {:g} s, not before the end "
+                                        "time {:g} s: it never acts",
+                                        where.str(), what, birth, config_.end_time));
+    };
+    for (const auto& bc : config_.boundary_conditions) unborn(bc.where, bc.birth, "condition");
+    for (const auto& load : config_.loads) unborn(load.where, load.birth, "load");
+  }
   // A body load or a prescribed motion across the plane (line) of a 2-D (1-D) particle
   // model: held by the plane's constraint, it does nothing (QA round 23c: a z gravity in a
   // plane model, almost always meant along y; round 24: a motion). Such a model has no mesh
@@ -463,46 +474,45 @@ void Simulation::apply_boundary_conditions(const Mesh& mesh) {
   const std::size_t nn = fe_.node_gid.size();
   const auto& bcs = config_.boundary_conditions;
   curved_components_.clear();
+  constrained_nodes_.clear();
   update_prescribed_motions(0.0, 0.0); // the factors at t = 0
   constrained_.assign(nn, 0);
   for (int i = 0; i < 3; ++i) v_bc_[i].assign(nn, 0.0);
-  // The condition that constrains each node component last (-1: none).
-  auto& source = bc_source_;
-  for (auto& s : source) s.assign(nn, -1);
+  for (auto& s : bc_source_) s.assign(nn, -1);
   for (auto& r : bc_reaction_) r.assign(nn, 0.0);
+  // The conditions that hold each node component, in deck order.
+  std::vector<std::vector<int>> held(3 * nn);
   for (std::size_t b = 0; b < bcs.size(); ++b) {
     const auto& bc = bcs[b];
     const auto ids = selected_nodes(mesh, bc.nodes);
     warn_if_outside_model(ids, bc.nodes.where);
     for (std::size_t n = 0; n < nn; ++n) {
       if (!std::binary_search(ids.begin(), ids.end(), fe_.node_gid[n])) continue;
-      for (int i = 0; i < 3; ++i) {
-        const bool on = bc.prescribed ? bc.components[i] : bc.fix[i];
-        if (!on) continue;
-        constrained_[n] |= static_cast<std::uint8_t>(1u << i);
-        v_bc_[i][n] = bc.prescribed ? bc.value[i] * motion_factor_[b] : 0.0;
-        source[i][n] = static_cast<int>(b);
-      }
+      for (std::size_t i = 0; i < 3; ++i)
+        if (bc.prescribed ? bc.components[i] : bc.fix[i])
+          held[3 * n + i].push_back(static_cast<int>(b));
     }
   }
-  constrained_nodes_.clear();
-  initial_impulses_.clear();
-  for (std::size_t n = 0; n < nn; ++n)
-    if (constrained_[n]) constrained_nodes_.push_back(static_cast<int>(n));
+  holder_start_.assign(1, 0);
+  holders_.clear();
+  for (std::size_t n = 0; n < nn; ++n) {
+    if (held[3 * n].empty() && held[3 * n + 1].empty() && held[3 * n + 2].empty()) continue;
+    constrained_nodes_.push_back(static_cast<int>(n));
+    for (std::size_t i = 0; i < 3; ++i) {
+      holders_.insert(holders_.end(), held[3 * n + i].begin(), held[3 * n + i].end());
+      holder_start_.push_back(static_cast<int>(holders_.size()));
+    }
+  }
   refresh_node_constraints(); // those of the conditions active at t = 0
+  initial_impulses_.clear();
   for (const int n : constrained_nodes_)
-    for (int i = 0; i < 3; ++i) {
-      const int b = source[i][n];
+    for (int i = 0; i < 3; ++i)
       if (constrained_[n] & (1u << i)) {
         if (fe_.node_owned[n] && v_bc_[i][n] != nodes_.v[i][n])
-          initial_impulses_.push_back(
-              {fe_.node_gid[n], b, i, 0, nodes_.mass[n] * (v_bc_[i][n] - nodes_.v[i][n])});
+          initial_impulses_.push_back({fe_.node_gid[n], bc_source_[i][n], i, 0,
+                                       nodes_.mass[n] * (v_bc_[i][n] - nodes_.v[i][n])});
         nodes_.v[i][n] = v_bc_[i][n];
       }
-      if (b >= 0 && bcs[static_cast<std::size_t>(b)].prescribed &&
-          bcs[static_cast<std::size_t>(b)].curve)
-        curved_components_.push_back({n, i, b});
-    }
   apply_particle_boundary_conditions();
 }
 
@@ -531,10 +541,6 @@ void Simulation::update_prescribed_motions(double t, double dt) {
     changed = changed || on != bc_active_[b];
     bc_active_[b] = on;
   }
-  if (changed) {
-    refresh_node_constraints();
-    refresh_particle_constraints();
-  }
   motion_factor_.resize(bcs.size());
   for (std::size_t b = 0; b < bcs.size(); ++b) {
     const auto& c = bcs[b].curve;
@@ -545,19 +551,38 @@ void Simulation::update_prescribed_motions(double t, double dt) {
     else
       motion_factor_[b] = dt > 0 ? (c->at(t + dt) - c->at(t)) / dt : c->slope_after(t);
   }
+  if (changed) {
+    refresh_node_constraints();
+    refresh_particle_constraints();
+  }
   for (const auto& cc : curved_components_)
     v_bc_[cc.component][cc.node] = config_.boundary_conditions[cc.condition].value[cc.component] *
                                    motion_factor_[cc.condition];
 }
 
-// The constrained components of the nodes some condition holds: those whose condition
-// (the last in the deck to hold them) is active over the current step (bc_active_).
+// The constrained components of the nodes some condition holds, over the current step:
+// each held by the last condition in the deck that holds it and is active (bc_active_), or
+// free while none is (a driver that dies hands its nodes to a fix born then). Sets the
+// components' source, prescribed value (times its condition's factor) and the list of
+// those that follow a time history.
 void Simulation::refresh_node_constraints() {
-  for (const int n : constrained_nodes_) {
+  const auto& bcs = config_.boundary_conditions;
+  curved_components_.clear();
+  for (std::size_t j = 0; j < constrained_nodes_.size(); ++j) {
+    const int n = constrained_nodes_[j];
     std::uint8_t bits = 0;
-    for (int i = 0; i < 3; ++i)
-      if (const int b = bc_source_[i][n]; b >= 0 && bc_active_[static_cast<std::size_t>(b)])
-        bits |= static_cast<std::uint8_t>(1u << i);
+    for (int i = 0; i < 3; ++i) {
+      int b = -1;
+      const std::size_t k = 3 * j + static_cast<std::size_t>(i);
+      for (int h = holder_start_[k + 1]; h > holder_start_[k] && b < 0; --h)
+        if (bc_active_[static_cast<std::size_t>(holders_[h - 1])]) b = holders_[h - 1];
+      bc_source_[i][n] = b;
+      if (b < 0) continue;
+      bits |= static_cast<std::uint8_t>(1u << i);
+      const auto& bc = bcs[static_cast<std::size_t>(b)];
+      v_bc_[i][n] = bc.prescribed ? bc.value[i] * motion_factor_[static_cast<std::size_t>(b)] : 0.0;
+      if (bc.prescribed && bc.curve) curved_components_.push_back({n, i, b});
+    }
     constrained_[n] = bits;
   }
 }

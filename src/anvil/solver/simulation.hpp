@@ -210,7 +210,10 @@ private:
   // and the prescribed velocity (0 where fixed).
   std::vector<std::uint8_t> constrained_;
   std::array<std::vector<double>, 3> v_bc_;
-  std::vector<int> constrained_nodes_; // local nodes with any constraint
+  std::vector<int> constrained_nodes_; // local nodes some condition holds (active or not)
+  // The conditions that hold them, per constrained node j and component i, in deck order:
+  // holders_[holder_start_[3 j + i], holder_start_[3 j + i + 1]).
+  std::vector<int> holder_start_, holders_;
   // Prescribed motions with a time history: each condition's factor on its value for the
   // current step (1 without a curve; update_prescribed_motions), and the node components
   // whose v_bc_ follows one (the condition that prescribes them last in the deck).

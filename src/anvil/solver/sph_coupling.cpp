@@ -5,6 +5,7 @@
 // exterior faces, with an id after every node and face id.
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -125,15 +126,15 @@ void Simulation::apply_particle_boundary_conditions() {
   for (std::size_t b = 0; b < bcs.size(); ++b) {
     const auto& bc = bcs[b];
     const auto mask = select_particles(bc.nodes);
+    const bool any = comm_.sum(static_cast<std::int64_t>(
+                         std::count(mask.begin(), mask.end(), std::uint8_t{1}))) > 0;
+    if (any && b >= 64)
+      throw InputError(bc.where, "a particle model takes at most 64 boundary conditions on its "
+                                 "particles (this is the 65th item of the list)");
     for (std::size_t i = 0; i < pt.size(); ++i) {
       if (!mask[i]) continue;
-      for (int k = 0; k < 3; ++k) {
-        const bool on = bc.prescribed ? bc.components[k] : bc.fix[k];
-        if (!on) continue;
-        pt.constrained[i] |= static_cast<std::uint8_t>(1u << k);
-        pt.v_bc[k][i] = bc.prescribed ? bc.value[k] : 0.0;
-        pt.bc_source[k][i] = static_cast<int>(b);
-      }
+      for (std::size_t k = 0; k < 3; ++k)
+        if (bc.prescribed ? bc.components[k] : bc.fix[k]) pt.bc_holders[k][i] |= 1ull << b;
     }
   }
   // Plane strain (1-D: uniaxial strain): the out-of-model velocity components are held
@@ -157,19 +158,32 @@ void Simulation::apply_particle_boundary_conditions() {
       }
 }
 
-// The components the deck's conditions hold on own particles, of the conditions active over
-// the current step (bc_active_); the model's plane keeps its own.
+// The components the deck's conditions hold on own particles over the current step: each
+// held by the last condition that holds it and is active (bc_active_), as for nodes
+// (refresh_node_constraints), or free while none is; the model's plane keeps its own.
 void Simulation::refresh_particle_constraints() {
   if (!sph_) return;
   auto& pt = sph_->particles();
+  std::uint64_t active = 0;
+  for (std::size_t b = 0; b < std::min<std::size_t>(bc_active_.size(), 64); ++b)
+    if (bc_active_[b]) active |= 1ull << b;
+  const auto& bcs = config_.boundary_conditions;
   for (std::size_t i = 0; i < pt.size(); ++i)
-    for (int k = 0; k < 3; ++k)
-      if (const int b = pt.bc_source[k][i]; b >= 0) {
-        const auto bit = static_cast<std::uint8_t>(1u << k);
-        pt.constrained[i] = bc_active_[static_cast<std::size_t>(b)]
-                                ? static_cast<std::uint8_t>(pt.constrained[i] | bit)
-                                : static_cast<std::uint8_t>(pt.constrained[i] & ~bit);
+    for (int k = 0; k < config_.sph.dimensions; ++k) { // (the plane's are held always)
+      if (pt.bc_holders[k][i] == 0) continue;
+      const std::uint64_t on = pt.bc_holders[k][i] & active;
+      const auto bit = static_cast<std::uint8_t>(1u << k);
+      if (on == 0) {
+        pt.bc_source[k][i] = -1;
+        pt.constrained[i] = static_cast<std::uint8_t>(pt.constrained[i] & ~bit);
+        continue;
       }
+      const int b = 63 - std::countl_zero(on); // the last in the deck
+      const auto& bc = bcs[static_cast<std::size_t>(b)];
+      pt.bc_source[k][i] = b;
+      pt.v_bc[k][i] = bc.prescribed ? bc.value[k] : 0.0;
+      pt.constrained[i] = static_cast<std::uint8_t>(pt.constrained[i] | bit);
+    }
 }
 
 // A constrained particle component's velocity over the current step: its value, times

@@ -36,6 +36,8 @@ struct Particles {
   // scales v_bc; its reaction sums the component's), or -1 (none, or the plane of a 2-D
   // model).
   std::array<std::vector<int>, 3> bc_source;
+  // Bit b: condition b (deck index, below 64) holds the component, active or not.
+  std::array<std::vector<std::uint64_t>, 3> bc_holders;
   std::vector<std::int64_t> last_face; // contact face touched last cycle, or -1
 
   std::size_t size() const { return mass.size(); }
@@ -60,6 +62,7 @@ struct Particles {
     fn(constrained);
     for (auto& a : v_bc) fn(a);
     for (auto& a : bc_source) fn(a);
+    for (auto& a : bc_holders) fn(a);
     fn(last_face);
   }
 };

@@ -90,6 +90,7 @@ SphPhase::SphPhase(const Config& config, const std::function<const Material*(int
   p_.constrained.assign(n, 0);
   for (auto& a : p_.v_bc) a.assign(n, 0.0);
   for (auto& a : p_.bc_source) a.assign(n, -1);
+  for (auto& a : p_.bc_holders) a.assign(n, 0);
   p_.last_face.assign(n, -1);
   std::size_t k = 0;
   for (std::int64_t g = first; g < last; ++g, ++k) {

@@ -116,6 +116,8 @@ private:
       return &tmp_l_;
     else if constexpr (std::is_same_v<T, int>)
       return &tmp_i_;
+    else if constexpr (std::is_same_v<T, std::uint64_t>)
+      return &tmp_q_;
     else
       return &tmp_u_;
   }
@@ -149,6 +151,7 @@ private:
   std::vector<std::int64_t> tmp_l_;
   std::vector<int> tmp_i_;
   std::vector<std::uint8_t> tmp_u_;
+  std::vector<std::uint64_t> tmp_q_;
   NeighbourWorkspace nwork_;
   // Candidate (Verlet) lists, kept with the ghost plan until a particle could have come
   // within the support of one it does not list: every pair closer than radius_ =
