@@ -174,21 +174,15 @@ void Simulation::add_loads() {
 
 // The loads' work of the current step, after predict() has set v(n + 1/2) (before contact
 // and walls correct it): on each owned loaded node the impulse dt_v f (dt_v the velocity
-// interval at t(n)) times v(n), the mean of v(n - 1/2) and v(n + 1/2), added to `work`;
-// and to `later` the part of it done after t(n), impulse . (v(n - 1/2) + 3 v(n + 1/2)) / 8,
-// as for the constraints (predict()): with the kinetic energy of v(n), the two agree to
-// round-off on a free node whatever the load does (QA round 25: booked as the force of
-// t(n - 1/2) times the step before's displacement, the work of a pressure on an element
-// that eroded was lost, 10% of an eroding column's balance).
-void Simulation::add_load_work(double dt_v, double& work, double& later) const {
+// interval at t(n)), added to `work` as the constraints' are (predict()): with the kinetic
+// energy of v(n), the work agrees to round-off on a free node whatever the load does (QA round 25:
+// booked as the force of t(n - 1/2) times the step before's displacement, the work of a pressure on
+// an element that eroded was lost, 10% of an eroding column's balance).
+void Simulation::add_load_work(double dt_v, ImpulseWork& work) const {
   for (const int n : loaded_nodes_) {
     const auto k = static_cast<std::size_t>(n);
     if (!fe_.node_owned[k]) continue;
-    for (int i = 0; i < 3; ++i) {
-      const double impulse = dt_v * f_load_[i][k], v_old = v_prev_[i][k], v_new = nodes_.v[i][k];
-      work += impulse * 0.5 * (v_old + v_new);
-      later += impulse * 0.125 * (v_old + 3 * v_new);
-    }
+    for (int i = 0; i < 3; ++i) work.add(dt_v * f_load_[i][k], v_prev_[i][k], nodes_.v[i][k]);
   }
 }
 

@@ -810,9 +810,9 @@ void Simulation::predict() {
   const std::size_t nn = nodes_.size();
 
   // Work of the constraint reactions over this step (before the velocities change),
-  // summed in a local whose address is not taken (work's is, below: the sum went through
-  // memory at every term, a quarter of this function's time on the can crush).
-  double work_bc_nodes = 0, later_nodes = 0;
+  // summed in a local whose address is not taken (`impulses`' is, below: the sum went
+  // through memory at every term, a quarter of this function's time on the can crush).
+  ImpulseWork constraint_work;
   update_prescribed_motions(clock_.time, dt);
   // The body acceleration of this step, at t(n) where its forces are.
   const auto g_now = body_acceleration(clock_.time);
@@ -829,16 +829,9 @@ void Simulation::predict() {
       const double v_free = v_old + (dt_avg * nodes_.f[i][n] / nodes_.mass[n] + dt_avg * g[i]);
       const double v_new = v_bc_[i][n];
       bc_reaction_[i][n] = nodes_.mass[n] * (v_new - v_free) / dt_avg;
-      if (fe_.node_owned[n]) {
-        const double impulse = nodes_.mass[n] * (v_new - v_forces);
-        work_bc_nodes += impulse * 0.5 * (v_old + v_new);
-        later_nodes += impulse * 0.125 * (v_old + 3 * v_new);
-      }
+      if (fe_.node_owned[n]) constraint_work.add(nodes_.mass[n] * (v_new - v_forces), v_old, v_new);
     }
   }
-  // The work of the step's impulses, the constraints' (the particles' join them below) and
-  // the loads', and its part after t(n) (work_later_).
-  double impulse_work = work_bc_nodes, impulse_work_later = later_nodes;
   double ke = 0;
   // Probe displacements at t(n); their velocities once correct() has set v(n+1/2).
   for (std::size_t p = 0; p < probe_node_.size(); ++p)
@@ -896,27 +889,24 @@ void Simulation::predict() {
     if (owned[n]) ke_nodes += e;
   }
   ke = ke_nodes; // (ke is 0 before the nodes: the same sum)
-  // The body force's impulse m g dt_v on the free components, booked as the constraints'
-  // and the loads' are (its work to t(n) then equals a free fall's kinetic energy at t(n)
-  // to round-off, whatever g does; on constrained components the reactions hold it). In
-  // locals whose address is not taken (see work_bc_nodes).
+  // The work of the step's external impulses: the constraints', the body force's on the
+  // free components (its work to t(n) then equals a free fall's kinetic energy at t(n) to
+  // round-off, whatever g does; on constrained components the reactions hold it), the
+  // loads' and the particles'. (Gravity's in a local whose address is not taken too.)
+  ImpulseWork impulses = constraint_work;
   if (g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0) {
-    double gravity_work = 0, gravity_later = 0;
+    ImpulseWork gravity_work;
     for (std::size_t k = 0; k < nn; ++k)
       if (owned[k])
         for (int i = 0; i < 3; ++i)
-          if (!((fixed[k] >> i) & 1u)) {
-            const double impulse = m[k] * g[i] * dt_avg;
-            gravity_work += impulse * 0.5 * (v_prev[i][k] + v[i][k]);
-            gravity_later += impulse * 0.125 * (v_prev[i][k] + 3 * v[i][k]);
-          }
-    impulse_work += gravity_work;
-    impulse_work_later += gravity_later;
+          if (!((fixed[k] >> i) & 1u))
+            gravity_work.add(m[k] * g[i] * dt_avg, v_prev[i][k], v[i][k]);
+    impulses += gravity_work;
   }
-  add_load_work(dt_avg, impulse_work, impulse_work_later);
-  if (sph_) predict_particles(dt_avg, ke, impulse_work, impulse_work_later);
-  work_later_ = impulse_work_later;
-  external_work_ += impulse_work;
+  add_load_work(dt_avg, impulses);
+  if (sph_) predict_particles(dt_avg, ke, impulses);
+  work_later_ = impulses.later;
+  external_work_ += impulses.whole;
   kinetic_local_ = ke; // correct() adds what contact and walls change
   sample_time_ = clock_.time;
   sample_cycle_ = clock_.cycle;

@@ -44,6 +44,22 @@ struct Clock {
   std::int64_t dt_particle = -1; // particle controlling dt, or -1 when an element does
 };
 
+// The work of external impulses (constraints, gravity, loads) over a step: an impulse J
+// that takes a velocity component from v(n - 1/2) to v(n + 1/2) does J v(n) in all, of
+// which J (v(n - 1/2) + 3 v(n + 1/2)) / 8 after t(n) (docs/cycle.md "Energies").
+struct ImpulseWork {
+  double whole = 0, later = 0;
+  void add(double impulse, double v_old, double v_new) {
+    whole += impulse * 0.5 * (v_old + v_new);
+    later += impulse * 0.125 * (v_old + 3 * v_new);
+  }
+  ImpulseWork& operator+=(const ImpulseWork& o) {
+    whole += o.whole;
+    later += o.later;
+    return *this;
+  }
+};
+
 // Global energies and probe values at one time (a history row).
 struct Sample {
   double time = 0;
@@ -163,7 +179,7 @@ private:
   void setup_loads(const Mesh& mesh);
   void press_faces();
   void add_loads();
-  void add_load_work(double dt_v, double& work, double& later) const;
+  void add_load_work(double dt_v, ImpulseWork& work) const;
   std::array<double, 3> body_acceleration(double t) const;
   void locate_probes(const Mesh& mesh);
   double owned_kinetic_energy() const;
@@ -178,7 +194,7 @@ private:
   double particle_bc_velocity(int k, std::size_t i) const;
   double particle_kinetic_energy() const;
   double particle_internal_energy() const;
-  void predict_particles(double dt_avg, double& ke, double& work, double& later);
+  void predict_particles(double dt_avg, double& ke, ImpulseWork& work);
   std::vector<ContactNodeItem>& particle_contact_items(double dt);
   void correct_particles(double& contact_work, double& kinetic, double& reaction);
   void sample_particle_probe_velocities();

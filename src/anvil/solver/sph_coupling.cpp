@@ -197,9 +197,9 @@ double Simulation::particle_bc_velocity(int k, std::size_t i) const {
 // Cycle step 3 for the particles: v(n+1/2) = v(n-1/2) + dt_avg f / m (prescribed
 // components take their value), the specific energy gains the work of viscosity and
 // artificial stress over the same interval; adds the kinetic energy at the mid-point
-// velocity to `ke`, the work of the constraints' and the body force's impulses to `work`
-// and its part after t(n) to `later` (J), as predict() does for nodes.
-void Simulation::predict_particles(double dt_avg, double& ke, double& work, double& later) {
+// velocity to `ke` and the work of the constraints' and the body force's impulses to
+// `work` (J), as predict() does for nodes.
+void Simulation::predict_particles(double dt_avg, double& ke, ImpulseWork& work) {
   auto& pt = sph_->particles();
   const std::size_t n = pt.size();
   const auto rate = sph_->energy_rate();
@@ -219,14 +219,10 @@ void Simulation::predict_particles(double dt_avg, double& ke, double& work, doub
         nv = particle_bc_velocity(k, i);
         // (As for nodes: the reaction holds the body force, its work is all but the
         // forces'.)
-        const double impulse = pt.mass[i] * (nv - (old + dt_avg * pt.f[k][i] * inv_m));
-        work += impulse * 0.5 * (old + nv);
-        later += impulse * 0.125 * (old + 3 * nv);
+        work.add(pt.mass[i] * (nv - (old + dt_avg * pt.f[k][i] * inv_m)), old, nv);
         p_reaction_[k][i] = pt.mass[i] * (nv - free) / dt_avg;
       } else if (gravity_[k] != 0.0) {
-        const double impulse = pt.mass[i] * gravity_[k] * dt_avg; // (predict())
-        work += impulse * 0.5 * (old + nv);
-        later += impulse * 0.125 * (old + 3 * nv);
+        work.add(pt.mass[i] * gravity_[k] * dt_avg, old, nv); // (predict())
       }
       pt.v[k][i] = nv;
       const double a = 0.5 * (old + nv);
