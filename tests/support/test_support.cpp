@@ -32,6 +32,40 @@ std::array<double, 4> node_momentum(const Simulation& sim) {
   return p;
 }
 
+std::array<double, 4> particle_momentum(const Simulation& sim) {
+  std::array<double, 4> p{0, 0, 0, 0};
+  if (const auto* sph = sim.sph()) {
+    const auto& pt = sph->particles();
+    for (std::size_t i = 0; i < pt.size(); ++i) {
+      for (int k = 0; k < 3; ++k) p[k] += pt.mass[i] * pt.v[k][i];
+      p[3] += pt.mass[i];
+    }
+  }
+  sim.comm().sum(std::span<double>(p));
+  return p;
+}
+
+const char* const two_bricks_keyword_mesh = R"(*NODE
+       1             0.0             0.0             0.0
+       2             1.0             0.0             0.0
+       3             1.0             1.0             0.0
+       4             0.0             1.0             0.0
+       5             0.0             0.0             1.0
+       6             1.0             0.0             1.0
+       7             1.0             1.0             1.0
+       8             0.0             1.0             1.0
+       9             0.0             0.0             2.0
+      10             1.0             0.0             2.0
+      11             1.0             1.0             2.0
+      12             0.0             1.0             2.0
+*ELEMENT_SOLID
+       1       1       1       2       3       4       5       6       7       8
+       2       1       5       6       7       8       9      10      11      12
+*SET_NODE_LIST
+         7
+         1         2         3         4
+)";
+
 std::string column_deck(double width, int cells, double end, const std::string& more) {
   return fmt::format(R"(
 termination: {{time: {}}}

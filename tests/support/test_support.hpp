@@ -20,6 +20,14 @@ Config deck(const std::string& yaml, const std::string& name = "test.yaml");
 // The nodes' total momentum (x, y, z) and, last, the sum of their |m v| (a scale for
 // tolerances), over every rank's owned nodes. Collective.
 std::array<double, 4> node_momentum(const Simulation& sim);
+// The particles' total momentum (x, y, z) and, last, their total mass, over every rank's
+// own particles (0 without particles). Collective.
+std::array<double, 4> particle_momentum(const Simulation& sim);
+
+// The two hexahedra stacked along z of the keyword tests (12 nodes, part 1, elements 1
+// and 2) and a node set 7 of the bottom face, as LS-DYNA *NODE, *ELEMENT_SOLID and
+// *SET_NODE_LIST cards.
+extern const char* const two_bricks_keyword_mesh;
 
 // The steel column of the 1-D wave tests (prescribed motions, loads): column_length = 0.1 m
 // along z, `width` square, `cells` elements along z, its sides held laterally (uniaxial

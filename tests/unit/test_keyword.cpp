@@ -28,27 +28,10 @@ using namespace anvil;
 namespace fs = std::filesystem;
 
 // Two hexahedra stacked along z (12 nodes), part 1, a node set of the bottom face.
-const std::string mesh_cards = R"(*NODE
-$#   nid               x               y               z      tc      rc
-       1             0.0             0.0             0.0
-       2             1.0             0.0             0.0
-       3             1.0             1.0             0.0
-       4             0.0             1.0             0.0
-       5             0.0             0.0             1.0
-       6             1.0             0.0             1.0
-       7             1.0             1.0             1.0
-       8             0.0             1.0             1.0
-       9             0.0             0.0             2.0
-      10             1.0             0.0             2.0
-      11             1.0             1.0             2.0
-      12             0.0             1.0             2.0
-*ELEMENT_SOLID
-       1       1       1       2       3       4       5       6       7       8
-       2       1       5       6       7       8       9      10      11      12
-*SET_NODE_LIST
-         7
-         1         2         3         4
-)";
+// (With a comment card after *NODE: the line numbers below count it.)
+const std::string mesh_cards =
+    "*NODE\n$#   nid               x               y               z      tc      rc\n" +
+    std::string(test::two_bricks_keyword_mesh).substr(6);
 
 const std::string good = R"(*KEYWORD
 *TITLE

@@ -313,19 +313,14 @@ boundary_conditions:
 )";
   const Comm world = Comm::world();
   Simulation sim(test::deck(deck), world);
-  double M = sim.part_masses()[0], m = 0;
-  for (const double x : sim.sph()->particles().mass) m += x;
-  m = world.sum(m);
+  const double M = sim.part_masses()[0], m = test::particle_momentum(sim)[3];
   int before = 0, during = 0, after = 0;
   while (!sim.finished()) {
     const double t = sim.clock().time; // the step's start: the window's test
     sim.step();
     const Sample s = sim.sample();
     const double pz = test::node_momentum(sim)[2];
-    double px = 0;
-    const auto& pt = sim.sph()->particles();
-    for (std::size_t i = 0; i < pt.size(); ++i) px += pt.mass[i] * pt.v[0][i];
-    px = world.sum(px);
+    const double px = test::particle_momentum(sim)[0];
     if (t < 1.0e-5) {
       ++before;
       EXPECT_EQ(pz, 0.0);
@@ -369,19 +364,13 @@ boundary_conditions:
   const Comm world = Comm::world();
   for (const std::string& deck : {base + push + hold_later, base + hold_always + push}) {
     Simulation sim(test::deck(deck), world);
-    const double M = sim.part_masses()[0];
-    double m = 0;
-    for (const double x : sim.sph()->particles().mass) m += x;
-    m = world.sum(m);
+    const double M = sim.part_masses()[0], m = test::particle_momentum(sim)[3];
     int pushed = 0, held = 0;
     while (!sim.finished()) {
       const double t = sim.clock().time;
       sim.step();
       const double pz = test::node_momentum(sim)[2];
-      double qz = 0;
-      const auto& pt = sim.sph()->particles();
-      for (std::size_t i = 0; i < pt.size(); ++i) qz += pt.mass[i] * pt.v[2][i];
-      qz = world.sum(qz);
+      const double qz = test::particle_momentum(sim)[2];
       const double v = t < 2.0e-5 ? 2.0 : 0.0;
       (t < 2.0e-5 ? pushed : held)++;
       EXPECT_NEAR(pz, v * M, 1e-12 * M) << "t = " << t;
@@ -420,14 +409,8 @@ boundary_conditions:
   // Newton over the first step, from the deck's velocities (the internal forces cancel):
   // the bar's z momentum was -10 M, the particles' x momentum 4 m.
   const double M = sim.part_masses()[0];
-  double m = 0, px = 0;
-  const auto& pt = sim.sph()->particles();
-  for (std::size_t i = 0; i < pt.size(); ++i) {
-    m += pt.mass[i];
-    px += pt.mass[i] * pt.v[0][i];
-  }
-  m = world.sum(m);
-  px = world.sum(px);
+  const auto particles = test::particle_momentum(sim);
+  const double m = particles[3], px = particles[0];
   const double pz = test::node_momentum(sim)[2];
   EXPECT_NEAR(s.reaction[2] * dt_avg, pz - (-10.0 * M), 1e-12 * 10.0 * M);
   EXPECT_NEAR(s.reaction[3] * dt_avg, px - 4.0 * m, 1e-12 * 5.0 * m);

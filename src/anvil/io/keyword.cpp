@@ -1738,6 +1738,23 @@ private:
     bodies_.push_back(bc);
   }
 
+  // Field 1 of a card on a node (NID) or a node set (NSID): a positive id.
+  static std::int64_t node_or_set_id(const Card& card, bool set) {
+    const char* what = set ? "NSID" : "NID";
+    const std::int64_t id = card.integer(0, what, 0);
+    if (id <= 0) card.fail(what, fmt::format("{} must be a positive id", what));
+    return id;
+  }
+
+  // Field 2, DOF: a translation, 1, 2 or 3 (x, y, z), returned as 0, 1, 2; `anvil_does`
+  // ends the message for any other ("anvil ...").
+  static int translation_dof(const Card& card, const char* anvil_does) {
+    const auto dof = card.integer(1, "DOF", 0);
+    if (dof < 1 || dof > 3)
+      card.fail("DOF", fmt::format("DOF = {} is not supported: anvil {}", dof, anvil_does));
+    return static_cast<int>(dof - 1);
+  }
+
   // Any number of cards NID (NSID), DOF, LCID, SF, CID, M1, M2, M3 (LS-DYNA manual,
   // *LOAD_NODE). anvil applies forces along x, y, z (DOF 1-3) in the global system; a
   // follower force, a moment or a local system would be another load, so it is an error.
@@ -1745,17 +1762,10 @@ private:
     Cursor c(b);
     while (auto l = c.next_record()) {
       const Card card(b, *l, {10, 10, 10, 10, 10, 10, 10, 10});
-      const char* what = set ? "NSID" : "NID";
       NodeLoadCard nl;
-      (set ? nl.set : nl.node) = card.integer(0, what, 0);
-      if ((set ? nl.set : nl.node) <= 0)
-        card.fail(what, fmt::format("{} must be a positive id", what));
-      const auto dof = card.integer(1, "DOF", 0);
-      if (dof < 1 || dof > 3)
-        card.fail("DOF", fmt::format("DOF = {} is not supported: anvil applies forces along x, "
-                                     "y, z (DOF 1, 2, 3); solid nodes take no moments",
-                                     dof));
-      nl.dof = static_cast<int>(dof - 1);
+      (set ? nl.set : nl.node) = node_or_set_id(card, set);
+      nl.dof = translation_dof(card, "applies forces along x, y, z (DOF 1, 2, 3); solid nodes "
+                                     "take no moments");
       nl.lcid = card.integer(2, "LCID", 0);
       if (nl.lcid <= 0) card.fail("LCID", "LCID must be the id of a *DEFINE_CURVE");
       nl.sf = card.real(3, "SF", 1.0);
@@ -1853,17 +1863,10 @@ private:
     if (ends_with(b.name, "_ID")) c.next();
     while (auto l = c.next_record()) {
       const Card card(b, *l, {10, 10, 10, 10, 10, 10, 10, 10});
-      const char* what = set ? "NSID" : "NID";
       MotionCard m;
-      (set ? m.set : m.node) = card.integer(0, what, 0);
-      if ((set ? m.set : m.node) <= 0)
-        card.fail(what, fmt::format("{} must be a positive id", what));
-      const auto dof = card.integer(1, "DOF", 0);
-      if (dof < 1 || dof > 3)
-        card.fail("DOF", fmt::format("DOF = {} is not supported: anvil prescribes the "
-                                     "translations x, y, z (DOF 1, 2, 3) of solid nodes",
-                                     dof));
-      m.dof = static_cast<int>(dof - 1);
+      (set ? m.set : m.node) = node_or_set_id(card, set);
+      m.dof = translation_dof(card, "prescribes the translations x, y, z (DOF 1, 2, 3) of "
+                                    "solid nodes");
       const auto vad = card.integer(2, "VAD", 0);
       if (vad != 0 && vad != 2)
         card.fail("VAD", fmt::format("VAD = {} is not supported: anvil prescribes a velocity "
