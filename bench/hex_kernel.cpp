@@ -30,7 +30,7 @@ struct Fixture {
                   {"poissons_ratio", 0.3},
                   {"yield_stress", 250e6},
                   {"hardening_modulus", 1e9}};
-    material = find_material_model(model)->make(p);
+    material = find_material_model(model)->make(p, {});
     block.material = material.get();
     block.hourglass.model = hg;
     block.thick_shell.points = thick_shell_points;

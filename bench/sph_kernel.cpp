@@ -41,7 +41,7 @@ particles:
                                     n * s, n * s, n * s, s, epsilon),
                         "bench.yaml", ".");
     const auto& mc = config.materials[0];
-    material = make_material(mc.model, mc.params, "", {});
+    material = make_material(mc.model, mc.params, mc.tables, "", {});
     phase = std::make_unique<sph::SphPhase>(
         config, [&](int) { return material.get(); }, comm);
     auto& pt = phase->particles();

@@ -84,6 +84,47 @@ TEST(Deck, UnknownKeyNamesKeyAndLine) {
                {"deck.yaml:6", "materials.copper.hardnening", "unknown parameter"});
 }
 
+// piecewise_linear_plasticity (LS-DYNA MAT_024): the hardening curve as a list of
+// [plastic strain, yield stress] points, and the model's own rules, each at its key.
+TEST(Deck, PiecewiseLinearPlasticity) {
+  const std::string j2 = "model: j2_plasticity";
+  const std::string tail = "yield_stress: 0.4e9, hardening_modulus: 0.1e9}";
+  std::string text = good;
+  text.replace(text.find(j2), j2.size(), "model: piecewise_linear_plasticity");
+  text.replace(text.find(tail), tail.size(),
+               "hardening_curve: [[0, 0.4e9], [0.1, 0.41e9], [0.5, 0.43e9]],\n"
+               "           cowper_symonds_C: 40, cowper_symonds_p: 5}");
+  const Config c = test::deck(text);
+  const MaterialConfig& m = c.materials[0];
+  EXPECT_EQ(m.model, "piecewise_linear_plasticity");
+  ASSERT_EQ(m.tables.count("hardening_curve"), 1u);
+  EXPECT_EQ(m.tables.at("hardening_curve").x, (std::vector<double>{0, 0.1, 0.5}));
+  EXPECT_EQ(m.tables.at("hardening_curve").y, (std::vector<double>{0.4e9, 0.41e9, 0.43e9}));
+  EXPECT_EQ(m.params.at("cowper_symonds_C"), 40);
+
+  const std::string from = "model: j2_plasticity, density: 8930, youngs_modulus: 117.0e9,\n"
+                           "           poissons_ratio: 0.35, " +
+                           tail;
+  const std::string head = "model: piecewise_linear_plasticity, density: 8930, "
+                           "youngs_modulus: 117.0e9,\n           poissons_ratio: 0.35, ";
+  expect_error(from, head + "hardening_curve: [[0, 4.0e8], [0.1, 3.0e8]]}",
+               {"deck.yaml:6", "materials.copper.hardening_curve", "softening"});
+  expect_error(from, head + "hardening_curve: [[0.01, 4.0e8], [0.1, 5.0e8]]}",
+               {"deck.yaml:6", "materials.copper.hardening_curve", "start at plastic strain 0"});
+  expect_error(from, head + "hardening_curve: [[0, 4.0e8], [0, 5.0e8]]}",
+               {"deck.yaml:6", "hardening_curve[1][0]", "plastic strains must increase"});
+  expect_error(from, head + "hardening_curve: [[0, 4.0e8, 1]]}",
+               {"deck.yaml:6", "hardening_curve[0]", "[plastic strain, yield stress]"});
+  expect_error(from, head + "yield_stress: 4.0e8, hardening_curve: [[0, 4.0e8]]}",
+               {"deck.yaml:6", "materials.copper.yield_stress", "not both"});
+  expect_error(from, head + "cowper_symonds_C: 40}",
+               {"deck.yaml:5", "materials.copper.yield_stress", "or hardening_curve"});
+  expect_error(from, head + "yield_stress: 4.0e8, cowper_symonds_C: 40}",
+               {"deck.yaml:5", "materials.copper.cowper_symonds_p", "both C and p"});
+  expect_error(from, head + "yield_stress: 4.0e8, hardening_curv: []}",
+               {"deck.yaml:6", "unknown parameter", "hardening_curve"});
+}
+
 TEST(Deck, WrongTypes) {
   expect_error("density: 8930", "density: heavy",
                {"deck.yaml:5", "materials.copper.density", "number"});

@@ -215,7 +215,7 @@ TEST(Kernel, NormalisedAndConsistent) {
 TEST(Eos, MieGruneisenReplacesThePressure) {
   const ParamValues p{{"density", 8930}, {"youngs_modulus", 117e9}, {"poissons_ratio", 0.35}};
   const ParamValues e{{"c0", 3940}, {"s", 1.49}, {"gamma0", 2.0}};
-  const auto m = make_material("elastic", p, "mie_gruneisen", e);
+  const auto m = make_material("elastic", p, {}, "mie_gruneisen", e);
   EXPECT_TRUE(m->needs_energy());
   double d[6] = {0, 0, 0, 0, 0, 0}, s[6] = {0, 0, 0, 1e6, 0, 0};
   double rho = 8930 * 1.1, energy = 0, ep = 0, T = 0, c = 0;

@@ -337,6 +337,90 @@ TEST(Keyword, PlasticKinematicIsJ2Plasticity) {
                {"model.k:", "*MAT_003.ETAN", "tangent modulus"});
 }
 
+// *MAT_PIECEWISE_LINEAR_PLASTICITY (MAT_024): the yield stress from curve LCSS, else from
+// the points EPS/ES, else SIGY and ETAN (LS-DYNA's precedence); C and P the Cowper-Symonds
+// law. *MAT_PLASTIC_KINEMATIC with SRC and SRP is the same model in its bilinear form.
+TEST(Keyword, PiecewiseLinearPlasticity) {
+  const std::string elastic = "*MAT_ELASTIC\n         1    7850.0   2.0E+11       0.3\n";
+  // LCSS = 5: a curve with SFO 1e6 (MPa values), points at 0, 0.1 and 0.5.
+  const std::string lcss = R"(*MAT_PIECEWISE_LINEAR_PLASTICITY_TITLE
+copper
+         1    8930.0  117.0E+9      0.35     1.0E9
+      40.0       5.0         5
+
+*DEFINE_CURVE
+         5         0       1.0     1.0E6
+                 0.0               400.0
+                 0.1               410.0
+                 0.5               430.0
+)";
+  Config c = kw(with(good, elastic, lcss));
+  const MaterialConfig& m = c.materials.at(0);
+  ASSERT_EQ(m.model, "piecewise_linear_plasticity");
+  ASSERT_EQ(m.tables.count("hardening_curve"), 1u);
+  EXPECT_EQ(m.tables.at("hardening_curve").x, (std::vector<double>{0, 0.1, 0.5}));
+  EXPECT_EQ(m.tables.at("hardening_curve").y, (std::vector<double>{400e6, 410e6, 430e6}));
+  EXPECT_EQ(m.params.at("cowper_symonds_C"), 40);
+  EXPECT_EQ(m.params.at("cowper_symonds_p"), 5);
+  EXPECT_EQ(m.params.at("yield_stress"), 0); // SIGY is not used with LCSS: a warning says so
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("SIGY, ETAN and EPS/ES are not used"), std::string::npos)
+      << c.warnings[0];
+  // The points EPS1-EPS8, ES1-ES8 (three used), no rate law.
+  const std::string points = R"(*MAT_024
+         1    8930.0  117.0E+9      0.35
+
+       0.0      0.05       0.2
+     3.0E8     3.5E8     3.8E8
+)";
+  c = kw(with(good, elastic, points));
+  EXPECT_EQ(c.materials.at(0).tables.at("hardening_curve").x, (std::vector<double>{0, 0.05, 0.2}));
+  EXPECT_EQ(c.materials.at(0).tables.at("hardening_curve").y,
+            (std::vector<double>{3e8, 3.5e8, 3.8e8}));
+  EXPECT_EQ(c.materials.at(0).params.at("cowper_symonds_C"), 0);
+  EXPECT_TRUE(c.warnings.empty()) << c.warnings.at(0);
+  // SIGY and ETAN: the bilinear form, H = E ETAN / (E - ETAN) as for *MAT_003.
+  c = kw(with(good, elastic, "*MAT_024\n1,8930.0,117.0E+9,0.35,0.4E+9,1.0E+8\n\n\n\n"));
+  EXPECT_EQ(c.materials.at(0).params.at("yield_stress"), 0.4e9);
+  EXPECT_LT(test::relative_error(c.materials.at(0).params.at("hardening_modulus"),
+                                 117e9 * 1e8 / (117e9 - 1e8)),
+            1e-14);
+  // *MAT_003 with SRC, SRP: Cowper-Symonds on the bilinear form.
+  c = kw(with(good, elastic, "*MAT_003\n1,8930.0,117.0E+9,0.35,0.4E+9,1.0E+8,1.0\n40.0,5.0\n"));
+  EXPECT_EQ(c.materials.at(0).model, "piecewise_linear_plasticity");
+  EXPECT_EQ(c.materials.at(0).params.at("cowper_symonds_C"), 40);
+  EXPECT_EQ(c.materials.at(0).params.at("yield_stress"), 0.4e9);
+  EXPECT_TRUE(c.warnings.empty()) << c.warnings.at(0);
+
+  // Errors at their fields.
+  const std::string softening = with(lcss, "430.0", "380.0");
+  expect_error(with(good, elastic, softening),
+               {"model.k:", "*MAT_PIECEWISE_LINEAR_PLASTICITY_TITLE.LCSS", "softening"});
+  expect_error(with(good, elastic, with(lcss, "                 0.0 ", "                0.01 ")),
+               {"*MAT_PIECEWISE_LINEAR_PLASTICITY_TITLE.LCSS", "start at plastic strain 0"});
+  expect_error(with(good, elastic, with(lcss, "         5\n\n", "         6\n\n")),
+               {"*MAT_PIECEWISE_LINEAR_PLASTICITY_TITLE.LCSS", "curve 6 is not defined"});
+  expect_error(with(good, elastic, with(lcss, "         5\n\n", "         5         7\n\n")),
+               {"*MAT_PIECEWISE_LINEAR_PLASTICITY_TITLE.LCSR", "give the Cowper-Symonds"});
+  expect_error(with(good, elastic, with(lcss, "       5.0", "          ")),
+               {"*MAT_PIECEWISE_LINEAR_PLASTICITY_TITLE.P", "must be positive"});
+  expect_error(with(good, elastic, with(points, "      0.05", "       0.0")),
+               {"*MAT_024.EPS2", "must increase"});
+  expect_error(with(good, elastic, with(points, "     3.5E8", "     2.5E8")),
+               {"*MAT_024.ES1", "softening"});
+  expect_error(with(good, elastic, "*MAT_024\n1,8930.0,117.0E+9,0.35\n\n\n\n"),
+               {"*MAT_024.SIGY", "LCSS, or EPS and ES"});
+  expect_error(with(good, elastic, "*MAT_003\n1,8930.0,117.0E+9,0.35,0.4E+9,1.0E+8,1.0\n40.0\n"),
+               {"*MAT_003.SRP", "must be positive"});
+  // VP = 1 (viscoplastic), FAIL, TDEL: warnings.
+  c = kw(with(good, elastic,
+              "*MAT_024\n1,8930.0,117.0E+9,0.35,0.4E+9,1.0E+8,0.3,1.0E-9\n40.0,5.0,,,1\n\n\n"));
+  ASSERT_EQ(c.warnings.size(), 3u);
+  EXPECT_NE(c.warnings[0].find("FAIL"), std::string::npos) << c.warnings[0];
+  EXPECT_NE(c.warnings[1].find("TDEL"), std::string::npos) << c.warnings[1];
+  EXPECT_NE(c.warnings[2].find("VP = 1"), std::string::npos) << c.warnings[2];
+}
+
 TEST(Keyword, JohnsonCookAndItsEquationOfState) {
   const std::string jc = R"(*MAT_JOHNSON_COOK
 $      mid        ro         g         e        pr

@@ -5,6 +5,7 @@
 
 #include "anvil/material/johnson_cook.hpp"
 #include "anvil/material/material.hpp"
+#include "anvil/material/piecewise_linear_plasticity.hpp"
 
 namespace {
 
@@ -32,7 +33,7 @@ struct Point {
 // sqrt((K + 4G/3) / rho). Tolerance 1e-12 relative (round-off over 100 increments).
 TEST(Materials, ElasticHydrostaticAndWaveSpeed) {
   const ParamValues p{{"density", 7850}, {"youngs_modulus", 200e9}, {"poissons_ratio", 0.3}};
-  const auto m = find_material_model("elastic")->make(p);
+  const auto m = find_material_model("elastic")->make(p, {});
   Point pt;
   pt.rho = 7850;
   for (int k = 0; k < 3; ++k) pt.d[k] = -1.0;
@@ -53,7 +54,7 @@ TEST(Materials, J2SimpleShearFollowsTheAnalyticCurve) {
                       {"poissons_ratio", nu},
                       {"yield_stress", Y0},
                       {"hardening_modulus", H}};
-  const auto m = find_material_model("j2_plasticity")->make(p);
+  const auto m = find_material_model("j2_plasticity")->make(p, {});
   const double G = E / (2 * (1 + nu));
   Point pt;
   pt.rho = 7850;
@@ -115,6 +116,148 @@ TEST(Materials, JohnsonCookConsistencyAndAdiabaticHeating) {
   // Thermal softening to zero strength at melt.
   EXPECT_EQ(jc.yield_stress(0.1, 1.0, 1793), 0.0);
   EXPECT_NEAR(jc.yield_stress(0.0, 1.0, 293), 792e6, 1e-6);
+}
+
+// piecewise_linear_plasticity (LS-DYNA MAT_024): the hardening curve of the tests below,
+// three segments (slopes 2 GPa, 0.5 GPa, 0.1 GPa, the last one extended past 0.05).
+const ParamTable plp_curve{{0.0, 0.002, 0.01, 0.05}, {250e6, 254e6, 258e6, 262e6}};
+double plp_sigma(double ep) {
+  const auto& c = plp_curve;
+  std::size_t k = 0;
+  while (k + 2 < c.x.size() && ep > c.x[k + 1]) ++k;
+  return c.y[k] + (c.y[k + 1] - c.y[k]) / (c.x[k + 1] - c.x[k]) * (ep - c.x[k]);
+}
+ParamValues plp_params(double C = 0, double p = 0) {
+  return {{"density", 7850},      {"youngs_modulus", 200e9}, {"poissons_ratio", 0.3},
+          {"yield_stress", 0},    {"hardening_modulus", 0},  {"cowper_symonds_C", C},
+          {"cowper_symonds_p", p}};
+}
+
+// Simple shear, gamma-dot = 1/s (tensor D_xy = 0.5): once plastic, von Mises q = sqrt(3)
+// tau equals sigma(ep) on the curve, and tau = G (gamma - sqrt(3) ep) (gamma_p = sqrt(3)
+// ep). So ep solves sqrt(3) G (gamma - sqrt(3) ep) = sigma(ep), linear on each segment;
+// radial return is exact on this proportional path. Tolerance 1e-10 relative on tau, in
+// 500 small steps and in one step from 0 to gamma = 0.1 that crosses every segment.
+TEST(Materials, PiecewiseLinearSimpleShearFollowsTheCurve) {
+  const TableValues t{{"hardening_curve", plp_curve}};
+  ASSERT_TRUE(PiecewiseLinearPlasticity::check(plp_params(), t).why.empty());
+  const auto m = find_material_model("piecewise_linear_plasticity")->make(plp_params(), t);
+  const double G = 200e9 / 2.6, s3 = std::sqrt(3.0);
+  auto exact = [&](double gamma) { // tau at gamma, and ep
+    if (s3 * G * gamma <= plp_curve.y[0]) return std::array<double, 2>{G * gamma, 0.0};
+    for (std::size_t k = 0; k + 1 < plp_curve.x.size(); ++k) {
+      const double H =
+          (plp_curve.y[k + 1] - plp_curve.y[k]) / (plp_curve.x[k + 1] - plp_curve.x[k]);
+      // sqrt3 G gamma - 3 G ep = y_k + H (ep - x_k)
+      const double ep = (s3 * G * gamma - plp_curve.y[k] + H * plp_curve.x[k]) / (3 * G + H);
+      if (ep <= plp_curve.x[k + 1] || k + 2 == plp_curve.x.size())
+        return std::array<double, 2>{G * (gamma - s3 * ep), ep};
+    }
+    return std::array<double, 2>{0, 0};
+  };
+  Point pt;
+  pt.rho = 7850;
+  pt.d[3] = 0.5;
+  const double dt = 2e-4;
+  double gamma = 0;
+  for (int n = 0; n < 500; ++n) {
+    pt.step(*m, dt);
+    gamma += dt;
+    const auto [tau, ep] = exact(gamma);
+    ASSERT_NEAR(pt.s[3], tau, 1e-10 * tau) << "gamma " << gamma;
+    ASSERT_NEAR(pt.ep, ep, 1e-10 * std::max(ep, 1e-3)) << "gamma " << gamma;
+    if (ep > 0) ASSERT_NEAR(s3 * pt.s[3], plp_sigma(pt.ep), 1e-10 * plp_sigma(pt.ep));
+  }
+  EXPECT_GT(pt.ep, 0.05); // past the last point, on the extended slope
+  Point big;
+  big.rho = 7850;
+  big.d[3] = 0.5;
+  big.step(*m, 0.1);
+  const auto [tau, ep] = exact(0.1);
+  EXPECT_NEAR(big.s[3], tau, 1e-10 * tau);
+  EXPECT_NEAR(big.ep, ep, 1e-10 * ep);
+}
+
+// The bilinear form (yield_stress, hardening_modulus) and a two-point curve on the same
+// line are j2_plasticity: the same stresses on a mixed path (shear and stretch) to 1e-12
+// relative (the same radial return, its terms in another order).
+TEST(Materials, PiecewiseLinearBilinearIsJ2) {
+  const double Y0 = 250e6, H = 1e9;
+  ParamValues bilinear = plp_params();
+  bilinear["yield_stress"] = Y0;
+  bilinear["hardening_modulus"] = H;
+  const TableValues line{{"hardening_curve", ParamTable{{0.0, 0.5}, {Y0, Y0 + 0.5 * H}}}};
+  ParamValues j2p = bilinear;
+  for (const char* k : {"cowper_symonds_C", "cowper_symonds_p"}) j2p.erase(k);
+  const auto j2 = find_material_model("j2_plasticity")->make(j2p, {});
+  const auto* model = find_material_model("piecewise_linear_plasticity");
+  const auto a = model->make(bilinear, {}), b = model->make(plp_params(), line);
+  Point p0, p1, p2;
+  for (Point* p : {&p0, &p1, &p2}) {
+    p->rho = 7850;
+    p->d[0] = 1.0;
+    p->d[1] = -0.3;
+    p->d[3] = 0.4;
+  }
+  for (int n = 0; n < 300; ++n) {
+    p0.step(*j2, 2e-5);
+    p1.step(*a, 2e-5);
+    p2.step(*b, 2e-5);
+  }
+  ASSERT_GT(p0.ep, 0.001);
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_NEAR(p1.s[k], p0.s[k], 1e-12 * 300e6) << k;
+    EXPECT_NEAR(p2.s[k], p0.s[k], 1e-12 * 300e6) << k;
+  }
+  EXPECT_NEAR(p1.ep, p0.ep, 1e-12 * p0.ep);
+  EXPECT_NEAR(p2.ep, p0.ep, 1e-12 * p0.ep);
+}
+
+// Cowper-Symonds (Cowper and Symonds 1957; LS-DYNA MAT_024 VP = 0): at a constant
+// equivalent strain rate r the flow stress is sigma(ep) (1 + (r / C)^(1/p)). Simple shear
+// at gamma-dot gives r = gamma-dot / sqrt(3). Steel's C = 40 /s, p = 5 at gamma-dot = 100 /s:
+// factor 1.97. Tolerance 1e-10 relative on q = sqrt(3) tau once plastic.
+TEST(Materials, PiecewiseLinearCowperSymondsScalesTheYield) {
+  const TableValues t{{"hardening_curve", plp_curve}};
+  const auto m = find_material_model("piecewise_linear_plasticity")->make(plp_params(40, 5), t);
+  const double rate = 100 / std::sqrt(3.0), factor = 1 + std::pow(rate / 40, 1.0 / 5);
+  Point pt;
+  pt.rho = 7850;
+  pt.d[3] = 50; // gamma-dot 100 /s
+  int plastic = 0;
+  for (int n = 0; n < 400; ++n) {
+    pt.step(*m, 2e-6);
+    if (pt.ep == 0) continue;
+    ++plastic;
+    const double q = std::sqrt(3.0) * pt.s[3];
+    ASSERT_NEAR(q, factor * plp_sigma(pt.ep), 1e-10 * q) << "step " << n;
+  }
+  EXPECT_GT(plastic, 100);
+  EXPECT_GT(pt.ep, 0.01);
+}
+
+// The model's cross-parameter rules (both deck readers report them with file and line).
+TEST(Materials, PiecewiseLinearChecksItsParameters) {
+  const auto check = [](ParamValues p, TableValues t) {
+    return PiecewiseLinearPlasticity::check(p, t);
+  };
+  const TableValues curve{{"hardening_curve", plp_curve}};
+  EXPECT_EQ(check(plp_params(), {}).key, "yield_stress"); // neither form
+  ParamValues both = plp_params();
+  both["yield_stress"] = 1e8;
+  EXPECT_EQ(check(both, curve).key, "yield_stress");
+  ParamValues slope = plp_params();
+  slope["hardening_modulus"] = 1e9;
+  EXPECT_EQ(check(slope, curve).key, "hardening_modulus");
+  EXPECT_EQ(check(plp_params(), {{"hardening_curve", ParamTable{{0.01, 0.1}, {1e8, 2e8}}}}).key,
+            "hardening_curve"); // not from 0
+  const auto soft = check(plp_params(), {{"hardening_curve", ParamTable{{0, 0.1}, {2e8, 1e8}}}});
+  EXPECT_NE(soft.why.find("softening"), std::string::npos) << soft.why;
+  EXPECT_EQ(check(plp_params(), {{"hardening_curve", ParamTable{{0}, {0}}}}).key,
+            "hardening_curve");
+  EXPECT_EQ(check(plp_params(40, 0), curve).key, "cowper_symonds_p");
+  EXPECT_EQ(check(plp_params(0, 5), curve).key, "cowper_symonds_C");
+  EXPECT_TRUE(check(plp_params(40, 5), curve).why.empty());
 }
 
 } // namespace

@@ -117,7 +117,8 @@ TEST(NodalAssembly, SameBitsAsTheGather) {
                                     {"youngs_modulus", 200e9},
                                     {"poissons_ratio", 0.3},
                                     {"yield_stress", 250e6},
-                                    {"hardening_modulus", 1e9}});
+                                    {"hardening_modulus", 1e9}},
+                                   {});
   for (int ranks : {1, 3})
     for (int rank = 0; rank < ranks; ++rank) {
       const Phase a = run(mesh, *material, rank, ranks, false);

@@ -27,7 +27,7 @@ struct KernelRig {
       : mesh(std::move(m)) {
     fe = decompose_fe(mesh, std::vector<int>(static_cast<std::size_t>(mesh.num_elements()), 0), 0,
                       1);
-    material = find_material_model(model)->make(params);
+    material = find_material_model(model)->make(params, {});
     block.material = material.get();
     block.hourglass = hourglass;
     block.bulk_viscosity = bulk;

@@ -25,6 +25,7 @@ struct MaterialConfig {
   std::string name;
   std::string model;      // registry name (material.hpp)
   ParamValues params;     // every parameter of the model, defaults filled in
+  TableValues tables;     // its tabulated parameters that the deck gives
   std::string eos_model;  // equation of state replacing the pressure (empty: none)
   ParamValues eos_params; // its parameters, defaults filled in
   SourceLocation where;

@@ -223,21 +223,29 @@ private:
   int fallback_line_;
 };
 
+// A list of points `[[x0, y0], [x1, y1], ...]`, x strictly increasing, at least one.
+void parse_points(const Node& n, std::string_view x_name, std::string_view y_name,
+                  std::vector<double>& x, std::vector<double>& y) {
+  const auto points = n.items();
+  if (points.empty())
+    n.fail(fmt::format("expected a list of [{}, {}] points, at least one", x_name, y_name));
+  for (const auto& p : points) {
+    if (!p.is_seq() || p.items().size() != 2)
+      p.fail(fmt::format("expected a point [{}, {}]", x_name, y_name));
+    const auto xy = p.items();
+    const double xi = xy[0].number();
+    if (!x.empty() && !(xi > x.back()))
+      xy[0].fail(fmt::format("{}s must increase from point to point: {} follows {}", x_name, xi,
+                             x.back()));
+    x.push_back(xi);
+    y.push_back(xy[1].number());
+  }
+}
+
 // A time history `[[t0, v0], [t1, v1], ...]`, times strictly increasing.
 TimeCurve parse_curve(const Node& n) {
   TimeCurve c;
-  const auto points = n.items();
-  if (points.empty()) n.fail("expected a list of [time, value] points, at least one");
-  for (const auto& p : points) {
-    if (!p.is_seq() || p.items().size() != 2) p.fail("expected a point [time, value]");
-    const auto tv = p.items();
-    const double t = tv[0].number();
-    if (!c.t.empty() && !(t > c.t.back()))
-      tv[0].fail(
-          fmt::format("times must increase from point to point: {} follows {}", t, c.t.back()));
-    c.t.push_back(t);
-    c.value.push_back(tv[1].number());
-  }
+  parse_points(n, "time", "value", c.t, c.value);
   return c;
 }
 
@@ -335,19 +343,30 @@ MaterialConfig parse_material(const std::string& name, const Node& n) {
     }
     // A named copy: clang before 16 cannot capture a structured binding in a lambda.
     const std::string& name = key;
+    if (const auto table = std::find_if(info->tables.begin(), info->tables.end(),
+                                        [&](const TableSpec& t) { return t.name == name; });
+        table != info->tables.end()) {
+      ParamTable& t = m.tables[key];
+      parse_points(v, table->x_name, table->y_name, t.x, t.y);
+      continue;
+    }
     const auto spec = std::find_if(info->params.begin(), info->params.end(),
                                    [&](const ParamSpec& p) { return p.name == name; });
     if (spec == info->params.end()) {
       std::string list;
       for (const auto& p : info->params) list += (list.empty() ? "" : ", ") + std::string(p.name);
+      for (const auto& t : info->tables) list += ", " + std::string(t.name);
       v.fail(fmt::format("unknown parameter '{}' for model {} (expected: {})", key, model, list));
     }
     m.params[key] = parameter_value(*spec, key, v);
   }
   fill_defaults(info->params, m.params, m.where, "", model);
-  if (model == "johnson_cook" && !(m.params["melt_temperature"] > m.params["room_temperature"]))
-    throw InputError({m.where.file, m.where.line, m.where.key + ".melt_temperature"},
-                     "melt_temperature must exceed room_temperature");
+  if (info->check)
+    if (const ParamProblem problem = info->check(m.params, m.tables); !problem.why.empty()) {
+      // At the key's own line when the deck gives it, else at the material's.
+      if (n.has(problem.key)) n.child(problem.key).fail(problem.why);
+      throw InputError({m.where.file, m.where.line, m.where.key + "." + problem.key}, problem.why);
+    }
   if (m.params.count("youngs_modulus"))
     if (const std::string why = elastic_wave_problem(m.params); !why.empty())
       throw InputError({m.where.file, m.where.line, m.where.key + ".density"}, why);

@@ -564,6 +564,12 @@ struct MaterialCard {
   ParamValues params;
   std::vector<std::string> notes; // warnings, given only if a part uses the material
   Where at;
+  TableValues tables;
+  // *MAT_PIECEWISE_LINEAR_PLASTICITY's LCSS: the hardening curve, read from its
+  // *DEFINE_CURVE when a part uses the material (0: none).
+  std::int64_t lcss = 0;
+  // The card field each of anvil's parameters came from (for the model's own checks).
+  std::map<std::string, SourceLocation, std::less<>> field_of;
 };
 
 struct EosCard {
@@ -752,6 +758,9 @@ private:
     if (n == "MAT_JOHNSON_COOK" || n == "MAT_015" || n == "MAT_JOHNSON_COOK_TITLE" ||
         n == "MAT_015_TITLE")
       return mat_johnson_cook(b);
+    if (n == "MAT_PIECEWISE_LINEAR_PLASTICITY" || n == "MAT_024" ||
+        n == "MAT_PIECEWISE_LINEAR_PLASTICITY_TITLE" || n == "MAT_024_TITLE")
+      return mat_piecewise_linear_plasticity(b);
     if (starts_with(n, "MAT_")) return other_material(b);
     if (starts_with(n, "EOS_")) return eos(b);
     if (n == "HOURGLASS" || n == "HOURGLASS_TITLE") return hourglass(b);
@@ -1099,7 +1108,7 @@ private:
     const Line l = c.next();
     const Card card(b, l, {10, 10, 10, 10, 10, 10, 10});
     const std::int64_t mid = material_id(card);
-    MaterialCard m{b.name, "elastic", {}, {}, where_of(l)};
+    MaterialCard m{b.name, "elastic", {}, {}, where_of(l), {}, 0, {}};
     elastic_fields(card, m.params, 1, 2, 3);
     add_material(card, mid, std::move(m));
   }
@@ -1110,7 +1119,7 @@ private:
     const Line l = c.next();
     const Card card(b, l, {10, 10, 10, 10, 10, 10, 10});
     const std::int64_t mid = material_id(card);
-    MaterialCard m{b.name, "j2_plasticity", {}, {}, where_of(l)};
+    MaterialCard m{b.name, "j2_plasticity", {}, {}, where_of(l), {}, 0, {}};
     elastic_fields(card, m.params, 1, 2, 3);
     const double E = m.params["youngs_modulus"];
     const double sigy = card.real(4, "SIGY");
@@ -1127,23 +1136,133 @@ private:
     m.params["hardening_modulus"] = etan * E / (E - etan);
     if (beta < 1)
       m.notes.push_back(fmt::format(
-          "{}: material {}: BETA = {} asks for {} hardening; anvil's j2_plasticity hardens "
+          "{}: material {}: BETA = {} asks for {} hardening; anvil hardens "
           "isotropically only and uses BETA = 1 (same yield curve in monotonic loading, "
           "no Bauschinger effect)",
           m.at.str(), mid, beta, beta == 0 ? "kinematic" : "mixed"));
     const Line l2 = c.next();
     const Card card2(b, l2, {10, 10, 10, 10});
-    if (card2.real(0, "SRC") != 0 || card2.real(1, "SRP") != 0)
-      m.notes.push_back(fmt::format("{}: material {}: the Cowper-Symonds strain-rate factors "
-                                    "SRC, SRP are ignored (rate-independent yield)",
-                                    where_of(l2).str(), mid));
-    if (card2.real(2, "FS") != 0)
-      m.notes.push_back(fmt::format("{}: material {}: the failure strain FS is ignored: a "
-                                    "keyword deck does not map it to anvil's erosion, so these "
-                                    "elements are never deleted (a YAML deck's part key "
-                                    "`erosion: {{plastic_strain: ...}}` deletes them)",
-                                    where_of(l2).str(), mid));
+    // Cowper-Symonds: anvil's piecewise_linear_plasticity in its bilinear form.
+    if (cowper_symonds(card2, 0, "SRC", 1, "SRP", m)) m.model = "piecewise_linear_plasticity";
+    rate_form(card2, 3, mid, m);
+    failure_strain_note(card2, 2, "FS", mid, m);
     add_material(card, mid, std::move(m));
+  }
+
+  // The Cowper-Symonds constants C and P of a material card into m; true when they turn
+  // the rate effect on (C = 0: LS-DYNA's "rate effects are not considered").
+  static bool cowper_symonds(const Card& card, int ic, const char* c_name, int ip,
+                             const char* p_name, MaterialCard& m) {
+    const double C = card.real(ic, c_name, 0), P = card.real(ip, p_name, 0);
+    if (C < 0)
+      card.fail(c_name, fmt::format("the strain-rate constant {} must not be negative", c_name));
+    if (C == 0) return false;
+    if (!(P > 0))
+      card.fail(p_name, fmt::format("the Cowper-Symonds exponent {} must be positive when {} = {} "
+                                    "turns the rate effect on",
+                                    p_name, c_name, C));
+    m.params["cowper_symonds_C"] = C;
+    m.params["cowper_symonds_p"] = P;
+    return true;
+  }
+
+  // VP, the rate form of MAT_003 and MAT_024: anvil scales the yield stress by the
+  // Cowper-Symonds factor of the equivalent strain rate (VP = 0); the viscoplastic forms
+  // are replaced by it with a warning, only where a rate law is on.
+  static void rate_form(const Card& card, int field, std::int64_t mid, MaterialCard& m) {
+    const double vp = card.real(field, "VP", 0);
+    if (vp != -1 && vp != 0 && vp != 1 && vp != 3)
+      card.fail("VP", fmt::format("VP = {} is not one of LS-DYNA's -1, 0, 1, 3", vp));
+    if (vp != 0 && vp != -1 && m.params.count("cowper_symonds_C"))
+      m.notes.push_back(fmt::format("{}: material {}: VP = {} (the viscoplastic form of the rate "
+                                    "law) is replaced by anvil's scaled yield stress (VP = 0)",
+                                    m.at.str(), mid, vp));
+  }
+
+  // FS of MAT_003, FAIL of MAT_024: not mapped to anvil's erosion.
+  static void failure_strain_note(const Card& card, int field, const char* name, std::int64_t mid,
+                                  MaterialCard& m) {
+    if (card.real(field, name, 0) == 0) return;
+    m.notes.push_back(fmt::format("{}: material {}: the failure strain {} is ignored: a keyword "
+                                  "deck does not map it to anvil's erosion, so these elements are "
+                                  "never deleted (a YAML deck's part key "
+                                  "`erosion: {{plastic_strain: ...}}` deletes them)",
+                                  m.at.str(), mid, name));
+  }
+
+  // MID, RO, E, PR, SIGY, ETAN, FAIL, TDEL; C, P, LCSS, LCSR, VP; EPS1-EPS8; ES1-ES8
+  // (LS-DYNA manual, *MAT_PIECEWISE_LINEAR_PLASTICITY). The yield stress against the
+  // effective plastic strain: curve LCSS, else the points (EPS, ES), else SIGY with the
+  // tangent ETAN (LS-DYNA's order of precedence).
+  void mat_piecewise_linear_plasticity(const Block& b) {
+    Cursor c(b);
+    skip_title(b, c);
+    const Line l = c.next();
+    const Card c1(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+    const std::int64_t mid = material_id(c1);
+    MaterialCard m{b.name, "piecewise_linear_plasticity", {}, {}, where_of(l), {}, 0, {}};
+    elastic_fields(c1, m.params, 1, 2, 3);
+    const double E = m.params["youngs_modulus"];
+    const double sigy = c1.real(4, "SIGY", 0), etan = c1.real(5, "ETAN", 0);
+    failure_strain_note(c1, 6, "FAIL", mid, m);
+    if (c1.real(7, "TDEL", 0) != 0)
+      m.notes.push_back(fmt::format("{}: material {}: TDEL (the time step below which elements "
+                                    "are deleted) is ignored",
+                                    m.at.str(), mid));
+    const Line l2 = c.next();
+    const Card c2(b, l2, {10, 10, 10, 10, 10, 10});
+    cowper_symonds(c2, 0, "C", 1, "P", m);
+    m.lcss = c2.integer(2, "LCSS", 0);
+    if (m.lcss < 0) c2.fail("LCSS", "LCSS must be a curve id (> 0) or blank");
+    if (m.lcss > 0) m.field_of["hardening_curve"] = where_of(l2).loc("*" + b.name + ".LCSS");
+    if (c2.integer(3, "LCSR", 0) != 0)
+      c2.fail("LCSR", "a curve of strain-rate scale factors (LCSR) is not supported: give the "
+                      "Cowper-Symonds constants C and P");
+    rate_form(c2, 4, mid, m);
+    if (!c2.blank(5) && c2.real(5, "LCF", 0) != 0)
+      c2.fail("LCF", "LCF (a failure curve) is not supported");
+    const Line l3 = c.next(), l4 = c.next();
+    const Card c3(b, l3, {10, 10, 10, 10, 10, 10, 10, 10}),
+        c4(b, l4, {10, 10, 10, 10, 10, 10, 10, 10});
+    ParamTable points;
+    bool ended = false;
+    for (int i = 0; i < 8; ++i) {
+      const std::string eps = fmt::format("EPS{}", i + 1), es = fmt::format("ES{}", i + 1);
+      const double x = c3.real(i, eps.c_str(), 0), y = c4.real(i, es.c_str(), 0);
+      if (i > 0 && x == 0 && y == 0) {
+        ended = true;
+        continue;
+      }
+      if (ended)
+        c3.fail(eps, fmt::format("{} follows an unused point (EPS and ES both 0): the points "
+                                 "must come first, in order",
+                                 eps));
+      if (i > 0 && !(x > points.x.back()))
+        c3.fail(eps, fmt::format("the plastic strains must increase: {} = {} follows {}", eps, x,
+                                 points.x.back()));
+      points.x.push_back(x);
+      points.y.push_back(y);
+    }
+    const bool tabulated =
+        std::any_of(points.y.begin(), points.y.end(), [](double y) { return y != 0; });
+    if (m.lcss > 0) {
+      if (sigy != 0 || etan != 0 || tabulated)
+        m.notes.push_back(fmt::format("{}: material {}: the curve LCSS = {} gives the yield "
+                                      "stress; SIGY, ETAN and EPS/ES are not used",
+                                      m.at.str(), mid, m.lcss));
+    } else if (tabulated) {
+      m.tables["hardening_curve"] = std::move(points);
+      m.field_of["hardening_curve"] = where_of(l4).loc("*" + b.name + ".ES1");
+    } else {
+      if (!(sigy > 0))
+        c1.fail("SIGY", "the yield stress SIGY must be positive (or give LCSS, or EPS and ES)");
+      if (!(etan >= 0 && etan < E))
+        c1.fail("ETAN",
+                fmt::format("the tangent modulus ETAN = {} must be in [0, E = {})", etan, E));
+      m.params["yield_stress"] = sigy;
+      m.params["hardening_modulus"] = etan * E / (E - etan); // as *MAT_PLASTIC_KINEMATIC
+    }
+    add_material(c1, mid, std::move(m));
   }
 
   void mat_johnson_cook(const Block& b) {
@@ -1152,7 +1271,7 @@ private:
     const Line l = c.next();
     const Card c1(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
     const std::int64_t mid = material_id(c1);
-    MaterialCard m{b.name, "johnson_cook", {}, {}, where_of(l)};
+    MaterialCard m{b.name, "johnson_cook", {}, {}, where_of(l), {}, 0, {}};
     const double ro = c1.real(1, "RO"), G = c1.real(2, "G"), E = c1.real(3, "E"),
                  pr = c1.real(4, "PR");
     if (!(ro > 0)) c1.fail("RO", "the density RO must be positive");
@@ -1240,7 +1359,8 @@ private:
       } catch (const InputError&) {
         mid = 0;
       }
-      if (mid > 0) materials_.emplace(mid, MaterialCard{b.name, "", {}, {}, where_of(l)});
+      if (mid > 0)
+        materials_.emplace(mid, MaterialCard{b.name, "", {}, {}, where_of(l), {}, 0, {}});
     }
     c.skip_rest(); // the keyword is listed as ignored, whatever its cards
     unsupported(b);
@@ -1892,8 +2012,8 @@ private:
   // LCID, SIDR, SFA, SFO, OFFA, OFFO, DATTYP, LCINT, then one point (A, O) per card in
   // fields of 20 columns; the offsets are applied before the scale factors (LS-DYNA
   // manual, *DEFINE_CURVE): t = SFA (A + OFFA), value = SFO (O + OFFO). Read only when a
-  // prescribed motion names the curve (curve()): decks carry curves for materials and
-  // loads anvil does not model, and those are no concern of the run.
+  // motion, a load or a material names the curve (curve()): decks carry curves for
+  // things anvil does not model, and those are no concern of the run.
   static CurveCard read_curve(const Block& b) {
     Cursor c(b);
     skip_title(b, c);
@@ -2403,7 +2523,8 @@ private:
 // Fills in the defaults of the model's optional parameters and checks every value against
 // the registry's range (the keyword checks above name LS-DYNA's fields; this is the net
 // under them, in anvil's names).
-void complete_material(MaterialConfig& m) {
+void complete_material(MaterialConfig& m,
+                       const std::map<std::string, SourceLocation, std::less<>>& field_of) {
   const MaterialModel* info = find_material_model(m.model);
   if (!info) throw InputError(m.where, fmt::format("no material model '{}'", m.model));
   for (const auto& p : info->params) {
@@ -2422,6 +2543,11 @@ void complete_material(MaterialConfig& m) {
       throw InputError(m.where,
                        fmt::format("{} = {} is outside the range of anvil's {}", name, x, m.model));
   }
+  if (info->check)
+    if (const ParamProblem problem = info->check(m.params, m.tables); !problem.why.empty()) {
+      const auto field = field_of.find(problem.key);
+      throw InputError(field != field_of.end() ? field->second : m.where, problem.why);
+    }
   if (m.params.count("youngs_modulus"))
     if (const std::string why = elastic_wave_problem(m.params); !why.empty())
       throw InputError(m.where, why);
@@ -2514,7 +2640,7 @@ Config KeywordReader::config(const std::string& deck_file) {
       throw InputError(p.at.loc("*PART.MID"),
                        fmt::format("part {}: material {} is a *{} (at {}), which anvil does not "
                                    "have (supported: *MAT_ELASTIC, *MAT_PLASTIC_KINEMATIC, "
-                                   "*MAT_JOHNSON_COOK)",
+                                   "*MAT_PIECEWISE_LINEAR_PLASTICITY, *MAT_JOHNSON_COOK)",
                                    p.pid, p.mid, mc.keyword, mc.at.str()));
     std::string mname = fmt::format("mat{}", p.mid);
     ParamValues params = mc.params; // this part's copy: its EOS may complete it
@@ -2560,8 +2686,14 @@ Config KeywordReader::config(const std::string& deck_file) {
       }
     }
     if (material_names.insert(mname).second) {
-      MaterialConfig m{mname, mc.model, params, {}, {}, mc.at.loc("*" + mc.keyword)};
-      complete_material(m);
+      MaterialConfig m{mname, mc.model, params, mc.tables, {}, {}, mc.at.loc("*" + mc.keyword)};
+      if (mc.lcss > 0) {
+        // The hardening curve: plastic strain against yield stress (the curve's abscissae
+        // and values, its scale factors and offsets applied).
+        const CurveCard& cc = curve(mc.lcss, mc.field_of.at("hardening_curve"));
+        m.tables["hardening_curve"] = {cc.curve.t, cc.curve.value};
+      }
+      complete_material(m, mc.field_of);
       if (material_notes_given.insert(p.mid).second) {
         const double rho = m.params["density"];
         if (rho < 10 || rho > 1e5)

@@ -42,20 +42,9 @@ double JohnsonCook::yield_stress(double ep, double rate, double T) const {
   return (A_ + B_ * std::pow(std::max(ep, 0.0), n_)) * rate_factor * thermal;
 }
 
-namespace {
-// Equivalent total strain rate sqrt(2/3 D':D') of point p.
-double equivalent_rate(const MaterialBatch& b, int p) {
-  const double d[6] = {b.d[0][p], b.d[1][p], b.d[2][p], b.d[3][p], b.d[4][p], b.d[5][p]};
-  const double dm = (d[0] + d[1] + d[2]) / 3;
-  const double dd = (d[0] - dm) * (d[0] - dm) + (d[1] - dm) * (d[1] - dm) +
-                    (d[2] - dm) * (d[2] - dm) + 2 * (d[3] * d[3] + d[4] * d[4] + d[5] * d[5]);
-  return std::sqrt(2.0 / 3.0 * dd);
-}
-} // namespace
-
 void JohnsonCook::flow_stress(const MaterialBatch& b, double* out) const {
   for (int p = 0; p < b.n; ++p)
-    out[p] = yield_stress(b.plastic_strain[p], equivalent_rate(b, p), b.temperature[p]);
+    out[p] = yield_stress(b.plastic_strain[p], equivalent_strain_rate(b, p), b.temperature[p]);
 }
 
 void JohnsonCook::update(const MaterialBatch& b) const {
@@ -73,7 +62,7 @@ void JohnsonCook::update(const MaterialBatch& b) const {
     const double j2 = 0.5 * (dev[0] * dev[0] + dev[1] * dev[1] + dev[2] * dev[2]) +
                       dev[3] * dev[3] + dev[4] * dev[4] + dev[5] * dev[5];
     const double q = std::sqrt(3.0 * j2);
-    const double rate = equivalent_rate(b, p);
+    const double rate = equivalent_strain_rate(b, p);
     const double ep = b.plastic_strain[p];
     const double T = b.temperature[p];
     double dgamma = 0;

@@ -9,6 +9,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace anvil {
 
@@ -40,6 +41,25 @@ struct ParamSpec {
   std::string_view doc;
 };
 using ParamValues = std::map<std::string, double, std::less<>>;
+
+// A tabulated parameter of a model (a hardening curve): points (x[i], y[i]), x strictly
+// increasing. The spec names it and its two units; what makes a table admissible beyond
+// that (its first x, monotone y) is the model's own check (MaterialModel::check).
+struct TableSpec {
+  std::string_view name;
+  std::string_view x_name, x_unit, y_name, y_unit;
+  std::string_view doc;
+};
+struct ParamTable {
+  std::vector<double> x, y;
+};
+using TableValues = std::map<std::string, ParamTable, std::less<>>;
+
+// What is wrong with a complete set of parameters beyond each one's range (a model's
+// cross-parameter rules), and under which key: empty `why` when nothing is.
+struct ParamProblem {
+  std::string key, why;
+};
 
 // Isotropic elastic constants shared by every solid model.
 struct ElasticConstants {
@@ -92,8 +112,12 @@ private:
 struct MaterialModel {
   std::string_view name;
   std::span<const ParamSpec> params;
-  std::unique_ptr<Material> (*make)(const ParamValues&);
+  std::span<const TableSpec> tables; // tabulated parameters (all optional)
+  std::unique_ptr<Material> (*make)(const ParamValues&, const TableValues&);
   std::string_view doc;
+  // The model's rules across its parameters, after every parameter has passed its range
+  // and the defaults are filled in (null: none). Both deck readers call it.
+  ParamProblem (*check)(const ParamValues&, const TableValues&) = nullptr;
 };
 std::span<const MaterialModel> material_models();
 const MaterialModel* find_material_model(std::string_view name);
@@ -122,6 +146,12 @@ const EosModel* find_eos_model(std::string_view name);
 // A material as the deck defines it: the strength model `model` with `params`, and, when
 // eos_model is not empty, its pressure replaced by that equation of state.
 std::unique_ptr<Material> make_material(std::string_view model, const ParamValues& params,
-                                        std::string_view eos_model, const ParamValues& eos_params);
+                                        const TableValues& tables, std::string_view eos_model,
+                                        const ParamValues& eos_params);
+
+// The equivalent (von Mises) strain rate sqrt(2/3 D':D') of point p of a batch, D' the
+// deviator of the rate of deformation: the rate of a uniaxial test, which the rate laws'
+// constants (Johnson-Cook's C, Cowper-Symonds' C and p) are fitted to.
+double equivalent_strain_rate(const MaterialBatch& b, int p);
 
 } // namespace anvil

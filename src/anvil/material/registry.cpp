@@ -2,34 +2,62 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 #include <vector>
+
+#include <fmt/format.h>
 
 #include "anvil/material/elastic.hpp"
 #include "anvil/material/ideal_gas.hpp"
 #include "anvil/material/j2_plasticity.hpp"
 #include "anvil/material/johnson_cook.hpp"
 #include "anvil/material/mie_gruneisen.hpp"
+#include "anvil/material/piecewise_linear_plasticity.hpp"
 
 namespace anvil {
 
 namespace {
 template <class M>
-std::unique_ptr<Material> make(const ParamValues& p) {
-  return std::make_unique<M>(p);
+std::unique_ptr<Material> make(const ParamValues& p, const TableValues& t) {
+  if constexpr (std::is_constructible_v<M, const ParamValues&, const TableValues&>)
+    return std::make_unique<M>(p, t);
+  else
+    return std::make_unique<M>(p);
+}
+
+ParamProblem johnson_cook_check(const ParamValues& p, const TableValues&) {
+  if (!(p.at("melt_temperature") > p.at("room_temperature")))
+    return {"melt_temperature", fmt::format("melt_temperature {} must exceed room_temperature {}",
+                                            p.at("melt_temperature"), p.at("room_temperature"))};
+  return {};
 }
 template <class E>
 std::unique_ptr<Eos> make_eos(const ParamValues& p) {
   return std::make_unique<E>(p);
 }
 
-const std::array<MaterialModel, 4>& models() {
-  static const std::array<MaterialModel, 4> list = {{
-      {"elastic", Elastic::params(), &make<Elastic>, "hypoelastic isotropic solid"},
-      {"j2_plasticity", J2Plasticity::params(), &make<J2Plasticity>,
+const std::array<MaterialModel, 5>& models() {
+  static const std::array<MaterialModel, 5> list = {{
+      {"elastic", Elastic::params(), {}, &make<Elastic>, "hypoelastic isotropic solid"},
+      {"j2_plasticity",
+       J2Plasticity::params(),
+       {},
+       &make<J2Plasticity>,
        "von Mises plasticity, linear isotropic hardening"},
-      {"johnson_cook", JohnsonCook::params(), &make<JohnsonCook>,
-       "Johnson-Cook viscoplasticity with adiabatic heating"},
-      {"ideal_gas", IdealGas::params(), &make<IdealGas>,
+      {"piecewise_linear_plasticity", PiecewiseLinearPlasticity::params(),
+       PiecewiseLinearPlasticity::tables(), &make<PiecewiseLinearPlasticity>,
+       "von Mises plasticity, tabulated hardening, Cowper-Symonds rate (LS-DYNA MAT_024)",
+       &PiecewiseLinearPlasticity::check},
+      {"johnson_cook",
+       JohnsonCook::params(),
+       {},
+       &make<JohnsonCook>,
+       "Johnson-Cook viscoplasticity with adiabatic heating",
+       &johnson_cook_check},
+      {"ideal_gas",
+       IdealGas::params(),
+       {},
+       &make<IdealGas>,
        "ideal gas p = (gamma - 1) rho e (particles only)"},
   }};
   return list;
@@ -81,6 +109,14 @@ private:
 };
 } // namespace
 
+double equivalent_strain_rate(const MaterialBatch& b, int p) {
+  const double d[6] = {b.d[0][p], b.d[1][p], b.d[2][p], b.d[3][p], b.d[4][p], b.d[5][p]};
+  const double dm = (d[0] + d[1] + d[2]) / 3;
+  const double dd = (d[0] - dm) * (d[0] - dm) + (d[1] - dm) * (d[1] - dm) +
+                    (d[2] - dm) * (d[2] - dm) + 2 * (d[3] * d[3] + d[4] * d[4] + d[5] * d[5]);
+  return std::sqrt(2.0 / 3.0 * dd);
+}
+
 void Material::flow_stress(const MaterialBatch& b, double* out) const {
   std::fill(out, out + b.n, std::numeric_limits<double>::infinity());
 }
@@ -106,8 +142,9 @@ const EosModel* find_eos_model(std::string_view name) {
 }
 
 std::unique_ptr<Material> make_material(std::string_view model, const ParamValues& params,
-                                        std::string_view eos_model, const ParamValues& eos_params) {
-  auto m = find_material_model(model)->make(params);
+                                        const TableValues& tables, std::string_view eos_model,
+                                        const ParamValues& eos_params) {
+  auto m = find_material_model(model)->make(params, tables);
   if (eos_model.empty()) return m;
   return std::make_unique<WithEos>(std::move(m), find_eos_model(eos_model)->make(eos_params));
 }

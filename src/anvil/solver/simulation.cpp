@@ -49,7 +49,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
 
   // Materials and element blocks (one per part).
   for (const auto& m : config_.materials)
-    materials_.push_back(make_material(m.model, m.params, m.eos_model, m.eos_params));
+    materials_.push_back(make_material(m.model, m.params, m.tables, m.eos_model, m.eos_params));
   auto material_of = [&](const std::string& name) -> const Material* {
     for (std::size_t i = 0; i < config_.materials.size(); ++i)
       if (config_.materials[i].name == name) return materials_[i].get();
