@@ -538,6 +538,65 @@ TEST(Keyword, ConstraintsVelocitiesContactWalls) {
   EXPECT_EQ(c.rigid_walls[0].friction, 0.3);
 }
 
+// Two-surface and eroding *CONTACT_ forms are anvil's general contact among the parts of
+// both sides (with a warning saying so); several contact cards are one contact among all
+// their parts, and must agree on the friction and the penalty scale (one contact has one).
+TEST(Keyword, TwoSurfaceContactsAreOneGeneralContact) {
+  // Element 2 in part 2 (the same material and section).
+  const std::string parts =
+      with(with(good, "       2       1       5", "       2       2       5"), "*SECTION_SOLID\n",
+           "block\n         2         1         1\n*SECTION_SOLID\n");
+  const std::string s2s = R"(*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE_ID
+        10impact
+         1         2         3         3
+      0.25
+
+
+*END)";
+  Config c = kw(with(parts, "*END", s2s));
+  ASSERT_EQ(c.contact.size(), 1u);
+  EXPECT_EQ(c.contact[0].parts, (std::vector<std::string>{"part1", "part2"}));
+  EXPECT_EQ(c.contact[0].friction, 0.25);
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("general contact among the parts of both sides (part1, part2)"),
+            std::string::npos)
+      << c.warnings[0];
+
+  // With an eroding single-surface card on a part set (its eroding card after card 3).
+  const std::string eroding = R"(*SET_PART_LIST
+         3
+         2
+*CONTACT_ERODING_SINGLE_SURFACE
+         3         0         2
+      0.25
+
+         1         1         1
+*END)";
+  c = kw(with(with(parts, "*END", s2s), "*END", eroding));
+  ASSERT_EQ(c.contact.size(), 1u);
+  EXPECT_EQ(c.contact[0].parts, (std::vector<std::string>{"part1", "part2"}));
+  ASSERT_EQ(c.warnings.size(), 2u) << c.warnings.back();
+  EXPECT_NE(c.warnings[1].find("the 2 *CONTACT_ definitions are one general contact"),
+            std::string::npos)
+      << c.warnings[1];
+  // Nodes to surface with "all" (SSTYP 5) on one side: all parts.
+  c = kw(with(parts, "*END",
+              "*CONTACT_NODES_TO_SURFACE\n         0         2         5         3\n\n\n*END"));
+  EXPECT_TRUE(c.contact.at(0).parts.empty());
+
+  // Errors at their fields.
+  expect_error(with(parts, "*END", with(s2s, "         3         3", "         3         0")),
+               {"*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE_ID.MSTYP", "MSTYP = 0 is not supported"});
+  expect_error(with(parts, "*END", with(s2s, "         3         3", "         4         3")),
+               {"*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE_ID.SSTYP", "node set"});
+  expect_error(with(parts, "*END", with(s2s, "         1         2", "         1          ")),
+               {"*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE_ID.MSID", "master side"});
+  expect_error(with(parts, "*END", with(s2s, "         1         2", "         1         9")),
+               {"*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE_ID.MSID", "part 9"});
+  expect_error(with(with(parts, "*END", s2s), "*END", with(eroding, "      0.25", "       0.1")),
+               {"*CONTACT_ERODING_SINGLE_SURFACE.FS", "differs from FS = 0.25"});
+}
+
 TEST(Keyword, UnsupportedKeywordsMakeOneWarning) {
   const Config c = kw(with(good, "*END", R"(*LOAD_SHELL_SET
          7         3         1

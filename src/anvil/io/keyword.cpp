@@ -23,6 +23,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "anvil/io/files.hpp"
 
@@ -669,7 +670,9 @@ struct VelocityGen {
 
 struct ContactCard {
   std::int64_t ssid, sstyp;
-  double fs, fd, dc, vdc, bt, dt, sfs;
+  std::int64_t msid, mstyp; // the master side of a two-surface form (msid 0: none)
+  bool two_surface;
+  double fs, fd, dc, vdc, bt, dt, sfs, sfm;
   Where at;
   std::string keyword;
 };
@@ -787,9 +790,7 @@ private:
     }
     if (n == "INITIAL_VELOCITY_GENERATION") return velocity_generation(b);
     if (n == "INITIAL_VELOCITY") return initial_velocity(b);
-    if (n == "CONTACT_AUTOMATIC_SINGLE_SURFACE" || n == "CONTACT_AUTOMATIC_SINGLE_SURFACE_ID" ||
-        n == "CONTACT_AUTOMATIC_SINGLE_SURFACE_TITLE")
-      return contact(b);
+    if (contact_form(n)) return contact(b);
     if (n == "CONTROL_CONTACT") return control_contact(b);
     if (n == "RIGIDWALL_PLANAR" || n == "RIGIDWALL_PLANAR_ID") return rigidwall(b);
     if (n == "CONTROL_TERMINATION") return control_termination(b);
@@ -2174,20 +2175,57 @@ private:
     }
   }
 
+  // The *CONTACT_ forms anvil reads (with or without _ID or _TITLE): 1 a single surface,
+  // 2 two surfaces (slave and master sides), 0 none. All become anvil's general contact.
+  static int contact_form(std::string_view n) {
+    if (!starts_with(n, "CONTACT_")) return 0;
+    n.remove_prefix(8);
+    if (ends_with(n, "_ID"))
+      n.remove_suffix(3);
+    else if (ends_with(n, "_TITLE"))
+      n.remove_suffix(6);
+    for (const char* f : {"AUTOMATIC_SINGLE_SURFACE", "SINGLE_SURFACE", "ERODING_SINGLE_SURFACE",
+                          "AUTOMATIC_GENERAL"})
+      if (n == f) return 1;
+    for (const char* f :
+         {"AUTOMATIC_SURFACE_TO_SURFACE", "SURFACE_TO_SURFACE", "ERODING_SURFACE_TO_SURFACE",
+          "AUTOMATIC_NODES_TO_SURFACE", "NODES_TO_SURFACE", "ERODING_NODES_TO_SURFACE"})
+      if (n == f) return 2;
+    return 0;
+  }
+
+  // A side of a contact (SSID with SSTYP, MSID with MSTYP): parts or a part set, or all
+  // parts (id 0, or type 5).
+  static void contact_side(const Card& c1, int id_field, const char* id_name, int type_field,
+                           const char* type_name, bool required, std::int64_t& id,
+                           std::int64_t& type) {
+    id = c1.id(id_field, id_name);
+    type = c1.integer(type_field, type_name, 0);
+    if (type == 5) id = 0; // "include all"
+    if (id == 0 && required && type != 5)
+      c1.fail(id_name, fmt::format("{} is blank: a two-surface contact needs its {} side", id_name,
+                                   id_field == 0 ? "slave" : "master"));
+    if (id != 0 && type != 2 && type != 3)
+      c1.fail(type_name,
+              fmt::format("{} = {} is not supported: anvil's contact is among parts; give a part "
+                          "set (2), a part (3) or all parts (5{})",
+                          type_name, type,
+                          type == 4 ? "; a node set's nodes belong to parts: list those" : ""));
+  }
+
   void contact(const Block& b) {
     Cursor c(b);
-    if (!ends_with(b.name, "SINGLE_SURFACE")) c.next(); // _ID / _TITLE: CID and HEADING
+    if (ends_with(b.name, "_ID") || ends_with(b.name, "_TITLE")) c.next(); // CID and HEADING
     const Line l = c.next();
     const Card c1(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
     ContactCard k{};
-    k.ssid = c1.id(0, "SSID");
-    k.sstyp = c1.integer(2, "SSTYP", 0);
-    if (k.ssid != 0 && k.sstyp != 2 && k.sstyp != 3)
-      c1.fail("SSTYP", fmt::format("SSTYP {} is not supported: give a part set (2), a part (3), "
-                                   "or SSID 0 for all parts",
-                                   k.sstyp));
+    k.two_surface = contact_form(b.name) == 2;
+    contact_side(c1, 0, "SSID", 2, "SSTYP", k.two_surface, k.ssid, k.sstyp);
+    if (k.two_surface) contact_side(c1, 1, "MSID", 3, "MSTYP", true, k.msid, k.mstyp);
     if (c1.integer(4, "SBOXID", 0) != 0)
       c1.fail("SBOXID", "a box restriction (SBOXID) is not supported");
+    if (k.two_surface && c1.integer(5, "MBOXID", 0) != 0)
+      c1.fail("MBOXID", "a box restriction (MBOXID) is not supported");
     const Line l2 = c.next();
     const Card c2(b, l2, {10, 10, 10, 10, 10, 10, 10, 10});
     k.fs = c2.real(0, "FS");
@@ -2202,6 +2240,12 @@ private:
     k.sfs = c3.real(0, "SFS", 1);
     if (k.sfs == 0) k.sfs = 1; // LS-DYNA's default
     if (k.sfs < 0) c3.fail("SFS", "the penalty scale SFS must be positive");
+    k.sfm = c3.real(1, "SFM", 1);
+    if (k.sfm == 0) k.sfm = 1;
+    if (k.sfm < 0) c3.fail("SFM", "the penalty scale SFM must be positive");
+    // The eroding forms' own card (ISYM, EROSOP, IADJ): anvil's contact always follows the
+    // faces that erosion uncovers (docs/contact.md).
+    if (b.name.find("ERODING") != std::string::npos) c.next();
     optional_cards(b, c, 7, true); // optional cards A to G
     k.at = where_of(l);
     k.keyword = b.name;
@@ -2784,28 +2828,48 @@ Config KeywordReader::config(const std::string& deck_file) {
   const auto shared = std::make_shared<const Mesh>(std::move(mesh));
   for (auto& pc : c.parts) pc.mesh.embedded = shared;
 
-  // Contact: single-surface contact is anvil's general contact among the listed parts.
-  if (contacts_.size() > 1)
-    throw InputError(contacts_[1].at.loc("*" + contacts_[1].keyword),
-                     fmt::format("anvil supports one contact definition; the first is at {}",
-                                 contacts_[0].at.str()));
+  // Contact: every *CONTACT_ card becomes anvil's general contact among its parts (both
+  // sides of a two-surface form), and several cards one contact among all their parts.
+  std::optional<ContactConfig> merged;
   for (const auto& k : contacts_) {
     ContactConfig cc;
     cc.where = k.at.loc("*" + k.keyword);
-    if (k.ssid != 0) {
-      if (k.sstyp == 3) {
-        if (part_ref(k.ssid, k.at, "*" + k.keyword + ".SSID"))
-          cc.parts.push_back(part_name(k.ssid));
-      } else {
-        cc.parts = part_set(k.ssid, k.at, "*" + k.keyword + ".SSID", kept);
+    bool all = false;
+    auto side = [&](std::int64_t id, std::int64_t type, const char* field) {
+      if (id == 0) {
+        all = true;
+        return;
       }
-      if (cc.parts.empty())
-        throw InputError(cc.where, "the contact's parts have no solid elements");
-    }
+      const std::string key = "*" + k.keyword + "." + field;
+      std::vector<std::string> parts;
+      if (type == 3) {
+        if (part_ref(id, k.at, key)) parts.push_back(part_name(id));
+      } else {
+        parts = part_set(id, k.at, key, kept);
+      }
+      if (parts.empty())
+        throw InputError(k.at.loc(key), fmt::format("the contact's {} side has no part with "
+                                                    "solid elements",
+                                                    field[0] == 'S' ? "slave" : "master"));
+      for (auto& p : parts)
+        if (std::find(cc.parts.begin(), cc.parts.end(), p) == cc.parts.end()) cc.parts.push_back(p);
+    };
+    side(k.ssid, k.sstyp, "SSID");
+    if (k.two_surface) side(k.msid, k.mstyp, "MSID");
+    if (all) cc.parts.clear();
+    if (k.two_surface)
+      warnings.push_back(fmt::format(
+          "{}: *{} is anvil's general contact among the parts of both sides ({}): symmetric "
+          "node-to-face contact, and contact within a side and self-contact are included",
+          k.at.str(), k.keyword, all ? "all parts" : fmt::format("{}", fmt::join(cc.parts, ", "))));
     cc.friction = k.fs;
     // LS-DYNA's penalty stiffness for solid segments is SLSFAC * SFS * K A^2 / V, anvil's
-    // penalty_scale * K A^2 / V.
+    // penalty_scale * K A^2 / V. Two sides with their own scales (SFS, SFM): the slave's.
     cc.penalty_scale = (slsfac_ > 0 ? slsfac_ : 0.1) * k.sfs;
+    if (k.two_surface && k.sfm != k.sfs)
+      warnings.push_back(fmt::format("{}: contact penalty scales SFS = {} and SFM = {}: anvil's "
+                                     "contact is symmetric and uses SFS on both sides",
+                                     k.at.str(), k.sfs, k.sfm));
     if (k.dc > 0 && k.fd != k.fs)
       warnings.push_back(fmt::format("{}: contact friction: anvil uses the static coefficient "
                                      "FS = {} throughout (FD and DC are ignored)",
@@ -2816,7 +2880,40 @@ Config KeywordReader::config(const std::string& deck_file) {
       warnings.push_back(fmt::format("{}: contact birth and death times (BT, DT) are ignored: "
                                      "the contact is active throughout",
                                      k.at.str()));
-    c.contact.push_back(cc);
+    if (!merged) {
+      merged = std::move(cc);
+      continue;
+    }
+    // anvil has one contact, with one friction coefficient and one penalty scale.
+    const ContactCard& first = contacts_.front();
+    if (cc.friction != merged->friction)
+      throw InputError(k.at.loc("*" + k.keyword + ".FS"),
+                       fmt::format("friction FS = {} differs from FS = {} of the contact at {}: "
+                                   "anvil's contacts are one general contact with one friction "
+                                   "coefficient (give every *CONTACT_ card the same FS)",
+                                   cc.friction, merged->friction, first.at.str()));
+    if (cc.penalty_scale != merged->penalty_scale)
+      throw InputError(k.at.loc("*" + k.keyword + ".SFS"),
+                       fmt::format("penalty scale SFS = {} differs from SFS = {} of the contact "
+                                   "at {}: anvil's contacts are one general contact with one "
+                                   "penalty scale",
+                                   k.sfs, first.sfs, first.at.str()));
+    if (merged->parts.empty() || cc.parts.empty())
+      merged->parts.clear();
+    else
+      for (auto& p : cc.parts)
+        if (std::find(merged->parts.begin(), merged->parts.end(), p) == merged->parts.end())
+          merged->parts.push_back(p);
+  }
+  if (merged) {
+    if (contacts_.size() > 1)
+      warnings.push_back(fmt::format(
+          "{}: the {} *CONTACT_ definitions are one general contact among {}: parts of "
+          "different definitions meet too where they touch",
+          contacts_.front().at.str(), contacts_.size(),
+          merged->parts.empty() ? "all parts"
+                                : fmt::format("parts {}", fmt::join(merged->parts, ", "))));
+    c.contact.push_back(std::move(*merged));
   }
 
   // Rigid walls: a plane through the tail with the normal towards the head.
