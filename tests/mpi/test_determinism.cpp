@@ -287,9 +287,14 @@ initial_conditions:
 rigid_walls:
   - {point: [0, 0, 0], normal: [0, 0, 1], friction: 0.3}
   - {point: [0.03, 0, 0], normal: [0, 0, 1], friction: 0.2}
+probes:
+  - {name: base, element_at: [0.004, 0.006, 0.0005]}
+  - {name: top, element_at: [0.009, 0.001, 0.0035]}
 )";
   const Config config = test::deck(deck);
-  // Per cycle: the two walls' forces, then the two conditions' six reaction components.
+  // Per cycle: the two walls' forces, then the two conditions' six reaction components;
+  // the element probes' values are compared apart (their 14 values a cycle).
+  std::vector<double> e;
   auto forces = [&](const Comm& comm) {
     Simulation sim(config, comm);
     std::vector<double> f;
@@ -298,12 +303,22 @@ rigid_walls:
       const Sample s = sim.sample();
       f.insert(f.end(), s.wall_force.begin(), s.wall_force.end());
       f.insert(f.end(), s.reaction.begin(), s.reaction.end());
+      e.insert(e.end(), s.element_probes.begin(), s.element_probes.end());
     }
     return f;
   };
   const std::vector<double> p = forces(Comm::world());
+  const std::vector<double> pe = std::exchange(e, {});
   if (Comm::world().rank() != 0) return;
   const std::vector<double> s = forces(Comm::self());
+  ASSERT_EQ(pe.size(), e.size());
+  std::int64_t differing_e = 0, stressed = 0;
+  for (std::size_t k = 0; k < e.size(); ++k) {
+    differing_e += !same_bits(pe[k], e[k]);
+    stressed += e[k] != 0;
+  }
+  EXPECT_EQ(differing_e, 0) << "element probe values differing from the 1-rank run";
+  EXPECT_GT(stressed, 1000); // of 120 x 14 values (the plastic strains are 0: elastic)
   ASSERT_EQ(p.size(), s.size());
   std::int64_t differing = 0, acting[8] = {};
   for (std::size_t k = 0; k < s.size(); ++k) {

@@ -329,6 +329,26 @@ TEST(Deck, ProbeNamesArePlain) {
   EXPECT_EQ(test::deck(text).probes[0].name, "Tip_1.z-2");
 }
 
+// Element probes (`element_at`) go to their own list, named like the probes, in one name
+// space with them; a probe gives one point, `at` or `element_at`.
+TEST(Deck, ElementProbes) {
+  const std::string tip = "  - {name: tip, at: [0, 0, 32.4e-3]}";
+  std::string text = good;
+  text.replace(text.find(tip), tip.size(), tip + "\n  - {name: gauge, element_at: [0, 0, 1.0e-3]}");
+  const Config c = test::deck(text);
+  ASSERT_EQ(c.probes.size(), 1u);
+  ASSERT_EQ(c.element_probes.size(), 1u);
+  EXPECT_EQ(c.element_probes[0].name, "gauge");
+  EXPECT_EQ(c.element_probes[0].at, (Vec3{0, 0, 1.0e-3}));
+  expect_error(tip, tip + "\n  - {name: tip, element_at: [0, 0, 0]}",
+               {"deck.yaml:21", "probes[1].name", "used twice"});
+  expect_error(tip, "  - {name: tip, at: [0, 0, 0], element_at: [0, 0, 0]}",
+               {"deck.yaml:20", "probes[0]", "one of them"});
+  expect_error(tip, "  - {name: tip}", {"deck.yaml:20", "probes[0]", "`at`"});
+  expect_error(tip, "  - {name: tip, element_at: [0, 0]}",
+               {"deck.yaml:20", "probes[0].element_at", "three numbers"});
+}
+
 // QA D8: `fix: []` and `components: []` constrained nothing, silently.
 TEST(Deck, EmptyComponentListsAreErrors) {
   expect_error("fix: [z]", "fix: []",

@@ -1071,9 +1071,21 @@ TEST(Keyword, HistoryNodeSetsAndIncludeVariants) {
   EXPECT_TRUE(c.warnings.empty());
   expect_error(with(good, "*END", "*DATABASE_HISTORY_NODE_SET\n         8\n*END"),
                {"*DATABASE_HISTORY_NODE_SET.ID", "node set 8 is not defined"});
-  c = kw(with(good, "*END", "*DATABASE_HISTORY_SOLID\n         1\n*END"));
+  // *DATABASE_HISTORY_SOLID (and _ID): element probes at the elements' centroids.
+  c = kw(with(good, "*END",
+              "*DATABASE_HISTORY_SOLID\n         2         1\n*DATABASE_HISTORY_SOLID_ID\n"
+              "         2the upper brick\n*END"));
+  EXPECT_TRUE(c.warnings.empty()) << c.warnings.at(0);
+  ASSERT_EQ(c.element_probes.size(), 2u); // element 2 once
+  EXPECT_EQ(c.element_probes[0].name, "solid2");
+  EXPECT_EQ(c.element_probes[0].at, (Vec3{0.5, 0.5, 1.5}));
+  EXPECT_EQ(c.element_probes[1].name, "solid1");
+  EXPECT_EQ(c.element_probes[1].at, (Vec3{0.5, 0.5, 0.5}));
+  expect_error(with(good, "*END", "*DATABASE_HISTORY_SOLID\n         3\n*END"),
+               {"*DATABASE_HISTORY_SOLID.ID", "history element 3 is not a solid element"});
+  c = kw(with(good, "*END", "*DATABASE_HISTORY_SHELL\n         1\n*END"));
   ASSERT_EQ(c.warnings.size(), 1u);
-  EXPECT_NE(c.warnings[0].find("*DATABASE_HISTORY_SOLID (1x"), std::string::npos) << c.warnings[0];
+  EXPECT_NE(c.warnings[0].find("*DATABASE_HISTORY_SHELL (1x"), std::string::npos) << c.warnings[0];
   const std::string tr = with(good, "*END", "*INCLUDE_TRANSFORM\npart2.k\n0,0,0\n*END");
   expect_error(tr,
                {fmt::format("model.k:{}: *INCLUDE_TRANSFORM:", line_of(tr, "*INCLUDE_TRANSFORM")),

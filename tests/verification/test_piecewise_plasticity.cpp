@@ -20,11 +20,17 @@
 // dies out by ep = 0.01, past which the two agree to 2e-4 (the inertia of the cube and
 // the half-step between the sampled velocities and positions). Holding the curve's last
 // value instead of extending it misses by 5%.
+//
+// The element probe (`element_at`, history columns gauge.sxx ... gauge.plastic_strain) of
+// the element at the top corner reads the cube's uniform state: szz = F / A and the other
+// stresses 0 within the same 0.5% of sigma (the same ringing), its plastic strain
+// ln(lambda_z) - sigma / E within 1e-4 (the ringing's share of sigma / E is 1e-5).
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <string>
 
 #include <fmt/format.h>
@@ -66,13 +72,16 @@ boundary_conditions:
   - {{set: cube.zmax, velocity: [0, 0, {}], components: [z], curve: [[0, 0], [{}, 1]]}}
 probes:
   - {{name: corner, at: [{}, {}, {}]}}
+  - {{name: gauge, element_at: [{}, {}, {}]}}
 )",
-                     t_end, E, rate_law, L, L, L, v_top, t_ramp, L, L, L);
+                     t_end, E, rate_law, L, L, L, v_top, t_ramp, L, L, L, 0.75 * L, 0.75 * L,
+                     0.75 * L);
 }
 
 struct Worst {
   double error = 0, ep_end = 0, rate = 0;
   int checked = 0;
+  double gauge_stress = 0, gauge_lateral = 0, gauge_strain = 0; // largest differences
 };
 
 // Runs the cube; the largest |sigma - R sigma_y(ep)| / sigma past ep = 0.002.
@@ -94,6 +103,14 @@ Worst pull(const std::string& rate_law, double C, double p) {
         ((d[0] - dm) * (d[0] - dm) + (d[1] - dm) * (d[1] - dm) + (d[2] - dm) * (d[2] - dm)));
     const double factor = C > 0 ? 1 + std::pow(rate / C, 1 / p) : 1.0;
     w.error = std::max(w.error, std::abs(sigma - factor * sigma_y(ep)) / sigma);
+    // The element probe (the element at the top corner): its own stress and plastic
+    // strain, the same state as the cube's (uniform).
+    const double* g = s.element_probes.data();
+    w.gauge_stress = std::max(w.gauge_stress, std::abs(g[2] - sigma) / sigma);
+    w.gauge_lateral =
+        std::max({w.gauge_lateral, std::abs(g[0]) / sigma, std::abs(g[1]) / sigma,
+                  std::abs(g[3]) / sigma, std::abs(g[4]) / sigma, std::abs(g[5]) / sigma});
+    w.gauge_strain = std::max(w.gauge_strain, std::abs(g[6] - ep));
     w.ep_end = ep;
     w.rate = rate;
     ++w.checked;
@@ -106,10 +123,14 @@ TEST(PiecewisePlasticity, UniaxialStressFollowsTheCurve) {
   EXPECT_GT(w.checked, 500);
   EXPECT_GT(w.ep_end, 0.15); // past the curve's last point, on its extension
   EXPECT_LT(w.error, 0.005) << "true stress off the hardening curve by " << w.error;
+  EXPECT_LT(w.gauge_stress, 0.005) << "element probe's szz off F / A by " << w.gauge_stress;
+  EXPECT_LT(w.gauge_lateral, 0.005) << "element probe's other stresses " << w.gauge_lateral;
+  EXPECT_LT(w.gauge_strain, 1e-4) << "element probe's plastic strain off by " << w.gauge_strain;
   if (Comm::world().rank() == 0)
     std::printf("tabulated hardening: worst |sigma - sigma_y(ep)| / sigma %.2e over %d samples "
-                "to ep %.3f\n",
-                w.error, w.checked, w.ep_end);
+                "to ep %.3f; element probe: szz %.2e, other stresses %.2e (of sigma), plastic "
+                "strain %.2e\n",
+                w.error, w.checked, w.ep_end, w.gauge_stress, w.gauge_lateral, w.gauge_strain);
 }
 
 TEST(PiecewisePlasticity, CowperSymondsRaisesTheFlowStress) {

@@ -180,6 +180,8 @@ struct RigidWallConfig {
   SourceLocation where;
 };
 
+// A probe: the node or particle nearest a point (`probes`), or the element whose centroid
+// at t = 0 is nearest it (`element_probes`, deck key `element_at`).
 struct ProbeConfig {
   std::string name;
   Vec3 at;
@@ -221,6 +223,8 @@ struct Config {
   std::vector<InitialCondition> initial_conditions;
   std::vector<BoundaryCondition> boundary_conditions;
   std::vector<ProbeConfig> probes;
+  std::vector<ProbeConfig> element_probes; // history columns after the probes'
+
   std::vector<ContactConfig> contact; // at most one
   std::vector<RigidWallConfig> rigid_walls;
   std::vector<BodyLoad> body_loads; // summed

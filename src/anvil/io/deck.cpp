@@ -994,8 +994,13 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
   if (top.has("probes")) {
     std::set<std::string> names;
     for (const auto& n : top.child("probes").items()) {
-      n.check_keys({"name", "at"});
-      ProbeConfig p{n.required("name").str(), n.required("at").vec3(), n.where()};
+      n.check_keys({"name", "at", "element_at"});
+      const bool element = n.has("element_at");
+      if (element == n.has("at"))
+        n.fail("a probe needs a point: `at` (the nearest node or particle) or `element_at` (the "
+               "element whose centroid is nearest), one of them");
+      ProbeConfig p{n.required("name").str(), n.required(element ? "element_at" : "at").vec3(),
+                    n.where()};
       // The name heads history.csv columns (NAME.ux): no commas, quotes or blanks.
       const auto plain = [](char ch) {
         return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
@@ -1006,7 +1011,7 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
             "probe name '{}' must be a plain name: letters, digits, '_', '.' and '-'", p.name));
       if (!names.insert(p.name).second)
         n.child("name").fail(fmt::format("probe name '{}' is used twice", p.name));
-      c.probes.push_back(p);
+      (element ? c.element_probes : c.probes).push_back(p);
     }
   }
 

@@ -802,14 +802,17 @@ private:
     if (n == "DATABASE_HISTORY_NODE") return history_nodes(b, false);
     if (n == "DATABASE_HISTORY_NODE_SET") return history_nodes(b, true);
     if (n == "DATABASE_HISTORY_NODE_ID") return history_nodes_id(b);
+    if (n == "DATABASE_HISTORY_SOLID") return history_solids(b, false);
+    if (n == "DATABASE_HISTORY_SOLID_ID") return history_solids(b, true);
     if (n == "TITLE") {
       Cursor c(b);
       title_ = text_card(c.next());
       return;
     }
     // Output and performance controls that change nothing anvil computes. Other
-    // *DATABASE_HISTORY_... keywords ask for output anvil does not write (element or
-    // local-system histories): listed as ignored, so that their absence is no surprise.
+    // *DATABASE_HISTORY_... keywords ask for output anvil does not write (shell, beam or
+    // local-system histories, sets of solids): listed as ignored, so that their absence
+    // is no surprise.
     if ((starts_with(n, "DATABASE_") && !starts_with(n, "DATABASE_HISTORY_")) ||
         n == "CONTROL_ENERGY" || n == "CONTROL_OUTPUT" || n == "CONTROL_CPU" ||
         n == "CONTROL_PARALLEL" || starts_with(n, "CONTROL_MPP_") || n == "COMMENT")
@@ -2394,6 +2397,24 @@ private:
     }
   }
 
+  // *DATABASE_HISTORY_SOLID (element ids, any number per card) or _ID (one element per
+  // card, its ID and a HEADING, not used).
+  void history_solids(const Block& b, bool with_heading) {
+    Cursor c(b);
+    while (auto l = c.next_record()) {
+      if (with_heading) {
+        const Card card(b, *l, {10, 70}, Card::Extra::keep);
+        if (const auto id = card.id(0, "ID"); id != 0)
+          history_solids_.push_back({id, false, where_of(*l), "*" + b.name});
+        continue;
+      }
+      const Card card(b, *l, {10, 10, 10, 10, 10, 10, 10, 10}, Card::Extra::keep);
+      for (int k = 0; k < card.size(); ++k)
+        if (const auto id = card.id(k, fmt::format("ID{}", k + 1)); id != 0)
+          history_solids_.push_back({id, false, where_of(*l), "*" + b.name});
+    }
+  }
+
   // ---- assembly ---------------------------------------------------------------------------
 
   std::int64_t node_position(std::int64_t nid, const Where& at, const std::string& key,
@@ -2560,6 +2581,7 @@ private:
     std::string keyword;
   };
   std::vector<HistoryNode> history_nodes_;
+  std::vector<HistoryNode> history_solids_; // elements (`set` unused)
   std::vector<std::string> warnings_;
   std::map<std::string, Unsupported> unsupported_;
 };
@@ -2999,6 +3021,39 @@ Config KeywordReader::config(const std::string& deck_file) {
                                      "to no solid element and get no probe",
                                      h.at.str(), unused.size(), unused.size() == 1 ? "" : "s", h.id,
                                      unused.front(), unused.size() > 1 ? ", ..." : ""));
+  }
+
+  // Element probes: *DATABASE_HISTORY_SOLID (and _ID), at the element's centroid (the
+  // mean of its corners). anvil's element probe takes the element whose centroid is
+  // nearest a point, so elements that share a centroid (coincident ones) are warned of.
+  if (!history_solids_.empty()) {
+    auto centroid = [&](const RawElement& e) {
+      Vec3 x{0, 0, 0};
+      for (const auto n : e.nodes) x = x + nodes_[static_cast<std::size_t>(node_index_.at(n))];
+      return x * 0.125;
+    };
+    std::map<std::array<double, 3>, std::vector<std::int64_t>> at_centroid;
+    for (const auto& e : elements_) {
+      const Vec3 x = centroid(e);
+      at_centroid[{x.x, x.y, x.z}].push_back(e.eid);
+    }
+    std::set<std::int64_t> probed;
+    for (const auto& h : history_solids_) {
+      const auto it = element_index_.find(h.id);
+      if (it == element_index_.end())
+        throw InputError(h.at.loc(h.keyword + ".ID"),
+                         fmt::format("history element {} is not a solid element "
+                                     "(*ELEMENT_SOLID)",
+                                     h.id));
+      if (!probed.insert(h.id).second) continue;
+      const Vec3 x = centroid(elements_[it->second]);
+      const auto& same = at_centroid.at({x.x, x.y, x.z});
+      if (same.size() > 1)
+        warnings.push_back(fmt::format("{}: history element {} shares its centroid with "
+                                       "element {}: the probe may follow that one",
+                                       h.at.str(), h.id, same.front() == h.id ? same[1] : same[0]));
+      c.element_probes.push_back(ProbeConfig{fmt::format("solid{}", h.id), x, h.at.loc(h.keyword)});
+    }
   }
 
   // One warning lists every keyword anvil ignored.

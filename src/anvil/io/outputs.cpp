@@ -220,6 +220,9 @@ std::string Outputs::history_header() const {
   for (const auto& p : c.probes)
     for (const char* f : {"ux", "uy", "uz", "vx", "vy", "vz"})
       h += fmt::format(",{}.{}", p.name, f);
+  for (const auto& p : c.element_probes)
+    for (const char* f : {"sxx", "syy", "szz", "sxy", "syz", "szx", "plastic_strain"})
+      h += fmt::format(",{}.{}", p.name, f);
   for (std::size_t w = 0; w < c.rigid_walls.size(); ++w) h += fmt::format(",wall{}.force", w);
   for (std::size_t b = 0; b < c.boundary_conditions.size(); ++b)
     for (const char* f : {"fx", "fy", "fz"}) h += fmt::format(",bc{}.{}", b, f);
@@ -376,6 +379,7 @@ void Outputs::write_history_row(const Sample& s) {
       "{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", s.time, s.cycle, s.dt,
       s.kinetic, s.internal, s.hourglass, s.contact, s.external_work, s.total());
   for (double v : s.probes) row += fmt::format(",{:.17g}", v);
+  for (double v : s.element_probes) row += fmt::format(",{:.17g}", v);
   for (double v : s.wall_force) row += fmt::format(",{:.17g}", v);
   for (double v : s.reaction) row += fmt::format(",{:.17g}", v);
   std::fprintf(history_, "%s\n", row.c_str());

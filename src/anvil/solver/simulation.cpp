@@ -189,6 +189,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
   apply_boundary_conditions(mesh);
   setup_loads(mesh);
   locate_probes(mesh);
+  locate_element_probes();
 
   // The initial sample (t = 0): kinetic energy of the initial velocities, probes at rest
   // position with their initial velocity.
@@ -284,17 +285,19 @@ void Simulation::warn_of_setup(const Mesh& mesh) {
           config_.contact[0].where.str(), inside));
   }
   if (contact_) warn_of_initial_overlap(mesh);
-  for (const auto& probe : config_.probes) {
-    const double margin = 0.01 * size;
-    bool outside = false;
-    for (int i = 0; i < 3; ++i)
-      outside |= probe.at[i] < lo[i] - margin || probe.at[i] > hi[i] + margin;
-    if (outside)
-      warnings_.push_back(fmt::format("{}: probe {} at [{:g}, {:g}, {:g}] lies outside the model "
-                                      "(its bounding box); it follows the nearest node or particle",
-                                      probe.where.str(), probe.name, probe.at.x, probe.at.y,
-                                      probe.at.z));
-  }
+  for (const auto* probes : {&config_.probes, &config_.element_probes})
+    for (const auto& probe : *probes) {
+      const double margin = 0.01 * size;
+      bool outside = false;
+      for (int i = 0; i < 3; ++i)
+        outside |= probe.at[i] < lo[i] - margin || probe.at[i] > hi[i] + margin;
+      if (outside)
+        warnings_.push_back(fmt::format(
+            "{}: probe {} at [{:g}, {:g}, {:g}] lies outside the model (its bounding box); it "
+            "follows the nearest {}",
+            probe.where.str(), probe.name, probe.at.x, probe.at.y, probe.at.z,
+            probes == &config_.probes ? "node or particle" : "element"));
+    }
   // A spin given to particles of a solid with the plain SPH gradient: the plain gradient
   // does not reproduce a rigid rotation where a kernel is cut by the free surface, so
   // the spin turns into spurious strain and the body stops turning (QA round 14: a ball
@@ -633,6 +636,49 @@ void Simulation::locate_probes(const Mesh& mesh) {
     else if (node_hit[p].index >= 0 && node_hit[p].id == winner[p])
       probe_node_[p] = node_hit[p].index;
   }
+}
+
+// Each element probe's element: the one whose centroid (the mean of its corners at t = 0)
+// is nearest the probe's point, the lowest global element id on a tie; found as the node
+// probes are (each rank's nearest, then the nearest distance and the lowest id at it over
+// all ranks). Collective.
+void Simulation::locate_element_probes() {
+  const std::size_t np = config_.element_probes.size();
+  element_probe_.assign(np, {-1, -1});
+  if (np == 0) return;
+  std::array<std::vector<double>, 3> c;
+  std::vector<std::int64_t> gid;
+  std::vector<std::array<int, 2>> at;
+  for (std::size_t bi = 0; bi < blocks_.size(); ++bi) {
+    const HexBlock& b = blocks_[bi];
+    for (int e = 0; e < b.size(); ++e) {
+      for (int i = 0; i < 3; ++i) {
+        double sum = 0;
+        for (int a = 0; a < 8; ++a) sum += nodes_.x[i][static_cast<std::size_t>(b.conn[a][e])];
+        c[i].push_back(sum / 8);
+      }
+      gid.push_back(b.gid[static_cast<std::size_t>(e)]);
+      at.push_back({static_cast<int>(bi), e});
+    }
+  }
+  std::vector<int> all(gid.size());
+  for (std::size_t k = 0; k < all.size(); ++k) all[k] = static_cast<int>(k);
+  const NearestGrid grid(c[0].data(), c[1].data(), c[2].data(), gid.data(), all);
+  std::vector<NearestGrid::Hit> hit(np);
+  std::vector<double> r2(np);
+  for (std::size_t p = 0; p < np; ++p) {
+    hit[p] = grid.nearest(config_.element_probes[p].at);
+    r2[p] = hit[p].r2;
+  }
+  comm_.min(std::span<double>(r2));
+  constexpr std::int64_t none = std::numeric_limits<std::int64_t>::max();
+  std::vector<std::int64_t> winner(np);
+  for (std::size_t p = 0; p < np; ++p)
+    winner[p] = hit[p].index >= 0 && hit[p].r2 == r2[p] ? hit[p].id : none;
+  comm_.min(std::span<std::int64_t>(winner));
+  for (std::size_t p = 0; p < np; ++p)
+    if (hit[p].index >= 0 && hit[p].id == winner[p])
+      element_probe_[p] = at[static_cast<std::size_t>(hit[p].index)];
 }
 
 // Every rank's eroded elements to the contact surfaces (collective; on the cycles where
@@ -1110,12 +1156,26 @@ Sample Simulation::sample() const {
   s.internal = local[1];
   s.hourglass = local[2];
   s.external_work = local[3];
-  s.probes = probe_local_;
-  comm_.sum(std::span<double>(s.probes));
-  // A probe's value is its rank's; the other ranks add +0. On one rank a -0 (a curve that
-  // scaled a negative value to 0) stayed -0, on several it became +0 (QA round 23): the
-  // same value, other bits. Adding +0 makes every zero +0.
-  for (double& v : s.probes) v += 0.0;
+  // The probes and the element probes in one sum: each value is its rank's, the other
+  // ranks add +0. (On one rank a -0, from a curve that scaled a negative value to 0,
+  // stayed -0, on several it became +0, QA round 23: the same value, other bits. Adding +0
+  // makes every zero +0.) An element probe reads its element's state at t(n), which the
+  // last fe_forces() computed.
+  std::vector<double> values = probe_local_;
+  const std::size_t node_values = values.size();
+  values.resize(node_values + 7 * element_probe_.size(), 0.0);
+  for (std::size_t p = 0; p < element_probe_.size(); ++p) {
+    const auto [bi, e] = element_probe_[p];
+    if (bi < 0) continue;
+    const HexBlock& b = blocks_[static_cast<std::size_t>(bi)];
+    double* out = values.data() + node_values + 7 * p;
+    for (int k = 0; k < 6; ++k) out[k] = b.stress[k][static_cast<std::size_t>(e)];
+    out[6] = b.plastic_strain.empty() ? 0.0 : b.plastic_strain[static_cast<std::size_t>(e)];
+  }
+  comm_.sum(std::span<double>(values));
+  for (double& v : values) v += 0.0;
+  s.probes.assign(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(node_values));
+  s.element_probes.assign(values.begin() + static_cast<std::ptrdiff_t>(node_values), values.end());
   // The walls' forces: every rank's hits, summed in ascending key (DESIGN.md section 3).
   s.wall_force.assign(config_.rigid_walls.size(), 0.0);
   if (!s.wall_force.empty()) {

@@ -67,7 +67,10 @@ struct Sample {
   double dt = 0;
   double kinetic = 0, internal = 0, hourglass = 0, contact = 0, external_work = 0;
   double total() const { return kinetic + internal + hourglass + contact; }
-  std::vector<double> probes;     // per probe: ux, uy, uz, vx, vy, vz
+  std::vector<double> probes; // per probe: ux, uy, uz, vx, vy, vz
+  // per element probe: its element's stress sxx, syy, szz, sxy, syz, szx (Pa; a thick
+  // shell's through-thickness mean) and equivalent plastic strain (0 without plasticity)
+  std::vector<double> element_probes;
   std::vector<double> wall_force; // per rigid wall: normal force, N
   std::vector<double> reaction;   // per boundary condition: fx, fy, fz on its nodes, N
 };
@@ -182,6 +185,7 @@ private:
   void add_load_work(double dt_v, ImpulseWork& work) const;
   std::array<double, 3> body_acceleration(double t) const;
   void locate_probes(const Mesh& mesh);
+  void locate_element_probes();
   double owned_kinetic_energy() const;
   // Particles: selection (mask over own particles), conditions, their part of predict,
   // contact and update (sph_coupling.cpp).
@@ -306,6 +310,8 @@ private:
   // probed particle (-1: the probe is on a node).
   std::vector<int> probe_node_;
   std::vector<std::int64_t> probe_particle_;
+  // Element probes: (block, element) on the rank that holds the element, (-1, -1) elsewhere.
+  std::vector<std::array<int, 2>> element_probe_;
 
   // SPH (null without particles): the particle decomposition, the velocities v(n-1/2)
   // of its own particles in the current step, the particle sets in contact and the
