@@ -120,7 +120,18 @@ TEST(Deck, PiecewiseLinearPlasticity) {
   expect_error(from, head + "cowper_symonds_C: 40}",
                {"deck.yaml:5", "materials.copper.yield_stress", "or hardening_curve"});
   expect_error(from, head + "yield_stress: 4.0e8, cowper_symonds_C: 40}",
-               {"deck.yaml:5", "materials.copper.cowper_symonds_p", "both C and p"});
+               {"deck.yaml:5", "materials.copper.cowper_symonds_p", "its exponent p"});
+  // C = 0 is no rate effect whatever p says (as LS-DYNA reads SRC = 0; QA round 27).
+  std::string no_rate = good;
+  no_rate.replace(no_rate.find(from), from.size(),
+                  head + "yield_stress: 4.0e8, cowper_symonds_C: 0, cowper_symonds_p: 5}");
+  EXPECT_EQ(test::deck(no_rate).materials[0].params.at("cowper_symonds_C"), 0);
+  // A point at fault is named (QA round 27: strains 1e-320 apart made an infinite slope,
+  // the yield stress NaN, and the material silently elastic).
+  expect_error(from, head + "hardening_curve: [[0, 4.0e8], [1.0e-320, 5.0e8], [1, 6.0e8]]}",
+               {"deck.yaml:6", "materials.copper.hardening_curve[1]", "not a finite number"});
+  expect_error(from, head + "hardening_curve: [[0, 4.0e8], [0.1, 4.5e8], [0.2, 4.4e8]]}",
+               {"deck.yaml:6", "materials.copper.hardening_curve[2]", "softening"});
   expect_error(from, head + "yield_stress: 4.0e8, hardening_curv: []}",
                {"deck.yaml:6", "unknown parameter", "hardening_curve"});
 }

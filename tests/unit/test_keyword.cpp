@@ -407,11 +407,27 @@ copper
   expect_error(with(good, elastic, with(points, "      0.05", "       0.0")),
                {"*MAT_024.EPS2", "must increase"});
   expect_error(with(good, elastic, with(points, "     3.5E8", "     2.5E8")),
-               {"*MAT_024.ES1", "softening"});
+               {"*MAT_024.ES2", "softening"}); // the point's own field
+  expect_error(with(good, elastic, with(lcss, "                 0.1 ", "              1.-320 ")),
+               {"*MAT_PIECEWISE_LINEAR_PLASTICITY_TITLE.LCSS", "not a finite number"});
+  expect_error(with(good, elastic,
+                    with(lcss, "         5\n\n", "         7\n\n") + "*DEFINE_TABLE\n         7\n"),
+               {"*MAT_PIECEWISE_LINEAR_PLASTICITY_TITLE.LCSS", "does not read tables"});
   expect_error(with(good, elastic, "*MAT_024\n1,8930.0,117.0E+9,0.35\n\n\n\n"),
                {"*MAT_024.SIGY", "LCSS, or EPS and ES"});
   expect_error(with(good, elastic, "*MAT_003\n1,8930.0,117.0E+9,0.35,0.4E+9,1.0E+8,1.0\n40.0\n"),
                {"*MAT_003.SRP", "must be positive"});
+  // SIGY and ETAN beside EPS/ES, EPS without ES: warnings (QA round 27: silent).
+  c = kw(with(good, elastic, with(points, "      0.35\n", "      0.35     2.0E8     1.0E8\n")));
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("SIGY and ETAN are not used"), std::string::npos) << c.warnings[0];
+  c = kw(with(good, elastic, "*MAT_024\n1,8930.0,117.0E+9,0.35,0.4E+9,1.0E+8\n\n0.0,0.05,0.2\n\n"));
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("every ES is blank"), std::string::npos) << c.warnings[0];
+  // MAT_003 with SRC = 0 and SRP > 0: no rate effect (LS-DYNA: "if zero, rate effects are
+  // not considered").
+  c = kw(with(good, elastic, "*MAT_003\n1,8930.0,117.0E+9,0.35,0.4E+9,1.0E+8,1.0\n0.0,5.0\n"));
+  EXPECT_EQ(c.materials.at(0).model, "j2_plasticity");
   // VP = 1 (viscoplastic), FAIL, TDEL: warnings.
   c = kw(with(good, elastic,
               "*MAT_024\n1,8930.0,117.0E+9,0.35,0.4E+9,1.0E+8,0.3,1.0E-9\n40.0,5.0,,,1\n\n\n"));

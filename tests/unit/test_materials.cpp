@@ -256,7 +256,10 @@ TEST(Materials, PiecewiseLinearChecksItsParameters) {
   EXPECT_EQ(check(plp_params(), {{"hardening_curve", ParamTable{{0}, {0}}}}).key,
             "hardening_curve");
   EXPECT_EQ(check(plp_params(40, 0), curve).key, "cowper_symonds_p");
-  EXPECT_EQ(check(plp_params(0, 5), curve).key, "cowper_symonds_C");
+  EXPECT_TRUE(check(plp_params(0, 5), curve).why.empty()); // C = 0: no rate effect
+  const auto steep =
+      check(plp_params(), {{"hardening_curve", ParamTable{{0, 1e-320, 1}, {4e8, 5e8, 6e8}}}});
+  EXPECT_EQ(steep.point, 1) << steep.why;
   EXPECT_TRUE(check(plp_params(40, 5), curve).why.empty());
 }
 

@@ -363,8 +363,14 @@ MaterialConfig parse_material(const std::string& name, const Node& n) {
   fill_defaults(info->params, m.params, m.where, "", model);
   if (info->check)
     if (const ParamProblem problem = info->check(m.params, m.tables); !problem.why.empty()) {
-      // At the key's own line when the deck gives it, else at the material's.
-      if (n.has(problem.key)) n.child(problem.key).fail(problem.why);
+      // At the table's point, or the key's own line, when the deck gives it; else at the
+      // material's.
+      if (n.has(problem.key)) {
+        const Node key = n.child(problem.key);
+        if (problem.point >= 0 && static_cast<std::size_t>(problem.point) < key.items().size())
+          key.items()[static_cast<std::size_t>(problem.point)].fail(problem.why);
+        key.fail(problem.why);
+      }
       throw InputError({m.where.file, m.where.line, m.where.key + "." + problem.key}, problem.why);
     }
   if (m.params.count("youngs_modulus"))

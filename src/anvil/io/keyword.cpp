@@ -1255,9 +1255,19 @@ private:
                                       "stress; SIGY, ETAN and EPS/ES are not used",
                                       m.at.str(), mid, m.lcss));
     } else if (tabulated) {
+      if (sigy != 0 || etan != 0)
+        m.notes.push_back(fmt::format("{}: material {}: the points EPS/ES give the yield stress; "
+                                      "SIGY and ETAN are not used",
+                                      m.at.str(), mid));
       m.tables["hardening_curve"] = std::move(points);
       m.field_of["hardening_curve"] = where_of(l4).loc("*" + b.name + ".ES1");
+      m.field_of["hardening_curve[]"] = where_of(l4).loc("*" + b.name + ".ES");
     } else {
+      if (std::any_of(points.x.begin(), points.x.end(), [](double x) { return x != 0; }))
+        m.notes.push_back(fmt::format("{}: material {}: EPS gives plastic strains but every ES "
+                                      "is blank: the points are not used, SIGY and ETAN give "
+                                      "the yield stress",
+                                      m.at.str(), mid));
       if (!(sigy > 0))
         c1.fail("SIGY", "the yield stress SIGY must be positive (or give LCSS, or EPS and ES)");
       if (!(etan >= 0 && etan < E))
@@ -2070,13 +2080,24 @@ private:
     }
   }
 
+  // Whether a *DEFINE_CURVE gives curve `lcid`.
+  bool curve_defined(std::int64_t lcid) {
+    index_curves();
+    return curves_.count(lcid) > 0 || curve_index_.count(lcid) > 0;
+  }
+
+  // The index of the *DEFINE_CURVE blocks by LCID, made at the first call.
+  void index_curves() {
+    if (curve_index_.empty())
+      for (const Block* b : curve_blocks_) curve_index_.emplace(curve_id(*b), b);
+  }
+
   // Curve `lcid`, read from the *DEFINE_CURVE that defines it (an index of the curves by
   // LCID, made at the first call); an error at `at` when none does, at the second when two
   // do.
   const CurveCard& curve(std::int64_t lcid, const SourceLocation& at) {
     if (const auto it = curves_.find(lcid); it != curves_.end()) return it->second;
-    if (curve_index_.empty())
-      for (const Block* b : curve_blocks_) curve_index_.emplace(curve_id(*b), b);
+    index_curves();
     const auto [first, last] = curve_index_.equal_range(lcid);
     if (first == last)
       throw InputError(at, fmt::format("curve {} is not defined (*DEFINE_CURVE)", lcid));
@@ -2612,7 +2633,13 @@ void complete_material(MaterialConfig& m,
   if (info->check)
     if (const ParamProblem problem = info->check(m.params, m.tables); !problem.why.empty()) {
       const auto field = field_of.find(problem.key);
-      throw InputError(field != field_of.end() ? field->second : m.where, problem.why);
+      SourceLocation at = field != field_of.end() ? field->second : m.where;
+      // A table read from numbered fields (ES1, ES2, ...): the point's own field.
+      if (const auto points = field_of.find(problem.key + "[]");
+          problem.point >= 0 && points != field_of.end())
+        at = {points->second.file, points->second.line,
+              points->second.key + std::to_string(problem.point + 1)};
+      throw InputError(at, problem.why);
     }
   if (m.params.count("youngs_modulus"))
     if (const std::string why = elastic_wave_problem(m.params); !why.empty())
@@ -2756,6 +2783,12 @@ Config KeywordReader::config(const std::string& deck_file) {
       if (mc.lcss > 0) {
         // The hardening curve: plastic strain against yield stress (the curve's abscissae
         // and values, its scale factors and offsets applied).
+        if (!curve_defined(mc.lcss) && unsupported_.count("DEFINE_TABLE"))
+          throw InputError(mc.field_of.at("hardening_curve"),
+                           fmt::format("curve {} is not defined (*DEFINE_CURVE); if it is a "
+                                       "*DEFINE_TABLE (curves per strain rate), anvil does not "
+                                       "read tables: give one curve, and C and P for the rate",
+                                       mc.lcss));
         const CurveCard& cc = curve(mc.lcss, mc.field_of.at("hardening_curve"));
         m.tables["hardening_curve"] = {cc.curve.t, cc.curve.value};
       }

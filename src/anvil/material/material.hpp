@@ -59,6 +59,7 @@ using TableValues = std::map<std::string, ParamTable, std::less<>>;
 // cross-parameter rules), and under which key: empty `why` when nothing is.
 struct ParamProblem {
   std::string key, why;
+  int point = -1; // a table's point at fault (its index), or -1
 };
 
 // Isotropic elastic constants shared by every solid model.

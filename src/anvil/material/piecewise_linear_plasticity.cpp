@@ -53,21 +53,33 @@ ParamProblem PiecewiseLinearPlasticity::check(const ParamValues& p, const TableV
                           "not {}",
                           c.x.empty() ? 0.0 : c.x.front())};
     for (std::size_t i = 0; i < c.y.size(); ++i) {
-      if (!(c.y[i] > 0))
+      const int at = static_cast<int>(i);
+      if (!(c.y[i] > 0) || !std::isfinite(c.y[i]))
         return {"hardening_curve",
-                fmt::format("yield stress {} at plastic strain {} must be > 0", c.y[i], c.x[i])};
+                fmt::format("yield stress {} at plastic strain {} must be a finite number > 0",
+                            c.y[i], c.x[i]),
+                at};
       if (i > 0 && c.y[i] < c.y[i - 1])
         return {"hardening_curve",
                 fmt::format("the yield stress falls from {} to {} at plastic strain {}: "
                             "softening curves are not supported (the radial return needs a "
                             "yield stress that does not fall)",
-                            c.y[i - 1], c.y[i], c.x[i])};
+                            c.y[i - 1], c.y[i], c.x[i]),
+                at};
+      // The slope of the segment to this point (QA round 27: strains 1e-320 apart made it
+      // infinite, the yield stress at 0 became inf * 0 = NaN, and nothing ever yielded).
+      if (i > 0 && !std::isfinite((c.y[i] - c.y[i - 1]) / (c.x[i] - c.x[i - 1])))
+        return {"hardening_curve",
+                fmt::format("the slope from plastic strain {} to {} is not a finite number: "
+                            "the points are too close or the stresses too large",
+                            c.x[i - 1], c.x[i]),
+                at};
     }
   }
-  const double C = p.at("cowper_symonds_C"), pe = p.at("cowper_symonds_p");
-  if ((C > 0) != (pe > 0))
-    return {C > 0 ? "cowper_symonds_p" : "cowper_symonds_C",
-            "the Cowper-Symonds law needs both C and p (> 0), or neither"};
+  // C = 0: no rate effect, whatever p says (LS-DYNA's SRC, C: "if zero, rate effects are
+  // not considered"); C > 0 needs its exponent.
+  if (p.at("cowper_symonds_C") > 0 && !(p.at("cowper_symonds_p") > 0))
+    return {"cowper_symonds_p", "the Cowper-Symonds law needs its exponent p (> 0) with C > 0"};
   return {};
 }
 
