@@ -360,6 +360,16 @@ TEST(Deck, ElementProbes) {
                {"deck.yaml:20", "probes[0].element_at", "three numbers"});
 }
 
+TEST(Deck, PartEnergiesFlag) {
+  const std::string out = "output: {fields_every: 1.0e-5,";
+  std::string text = good;
+  EXPECT_FALSE(test::deck(text).part_energies);
+  text.replace(text.find(out), out.size(), "output: {part_energies: true, fields_every: 1.0e-5,");
+  EXPECT_TRUE(test::deck(text).part_energies);
+  expect_error(out, "output: {part_energies: yes, fields_every: 1.0e-5,",
+               {"deck.yaml:21", "output.part_energies", "expected true or false"});
+}
+
 // QA D8: `fix: []` and `components: []` constrained nothing, silently.
 TEST(Deck, EmptyComponentListsAreErrors) {
   expect_error("fix: [z]", "fix: []",

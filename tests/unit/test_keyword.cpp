@@ -94,6 +94,7 @@ TEST(Keyword, ReadsADeck) {
   EXPECT_EQ(c.time_step_scale, 0.8);
   EXPECT_EQ(c.fields_every, 1e-5);
   EXPECT_EQ(c.history_every, 5e-7); // the smaller of GLSTAT and NODOUT
+  EXPECT_FALSE(c.part_energies);
   ASSERT_EQ(c.materials.size(), 1u);
   EXPECT_EQ(c.materials[0].name, "mat1");
   EXPECT_EQ(c.materials[0].model, "elastic");
@@ -125,6 +126,10 @@ TEST(Keyword, ReadsADeck) {
     for (int a = 0; a < 8; ++a) x[a] = m.nodes[h[a]];
     EXPECT_NEAR(hex_volume(x), 1.0, 1e-12); // LS-DYNA's node order is anvil's
   }
+  // *DATABASE_MATSUM: the parts' energies in history.csv, its DT among the intervals.
+  const Config ms = kw(with(good, "*END", "*DATABASE_MATSUM\n   2.0E-07\n*END"));
+  EXPECT_TRUE(ms.part_energies);
+  EXPECT_EQ(ms.history_every, 2e-7);
 }
 
 // Free format reads every field of a list card (a set's ids); any other card with more

@@ -215,6 +215,7 @@ struct Config {
   double checkpoint_every = 0;           // 0: checkpoints only when stopped by a signal
   double history_every = 0;              // 0: every cycle
   OutputFormat output_format = OutputFormat::vtu;
+  bool part_energies = false; // history.csv columns of each part's energies (LS-DYNA's matsum)
   std::vector<MaterialConfig> materials;
   std::vector<PartConfig> parts;
   std::vector<ParticleSetConfig> particles;

@@ -148,6 +148,12 @@ public:
     return out;
   }
 
+  // `true` or `false`.
+  bool flag() const {
+    const std::string v = str();
+    if (v != "true" && v != "false") fail("expected true or false");
+    return v == "true";
+  }
   std::string str() const {
     if (!n_.IsScalar()) fail("expected a single value");
     if (!is_utf8(n_.Scalar())) fail("not valid UTF-8 text (save the deck as UTF-8)");
@@ -510,9 +516,7 @@ PartConfig parse_part(const std::string& name, const Node& n, const std::string&
     er.check_keys({"plastic_strain", "inverted"});
     if (er.has("plastic_strain")) p.erosion.plastic_strain = er.child("plastic_strain").positive();
     if (er.has("inverted")) {
-      const std::string v = er.child("inverted").str();
-      if (v != "true" && v != "false") er.child("inverted").fail("expected true or false");
-      p.erosion.inverted = v == "true";
+      p.erosion.inverted = er.child("inverted").flag();
     }
   }
   if (n.has("bulk_viscosity")) {
@@ -622,14 +626,10 @@ ParticleSetConfig parse_particle_set(const std::string& name, const Node& n, int
       a.child("exponent").fail("must be between 1 and 8");
   }
   if (n.has("corrected_gradient")) {
-    const std::string b = n.child("corrected_gradient").str();
-    if (b != "true" && b != "false") n.child("corrected_gradient").fail("expected true or false");
-    p.corrected_gradient = b == "true";
+    p.corrected_gradient = n.child("corrected_gradient").flag();
   }
   if (n.has("summation_density")) {
-    const std::string b = n.child("summation_density").str();
-    if (b != "true" && b != "false") n.child("summation_density").fail("expected true or false");
-    p.summation_density = b == "true";
+    p.summation_density = n.child("summation_density").flag();
   }
   return p;
 }
@@ -1155,7 +1155,8 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 
   if (top.has("output")) {
     const Node o = top.child("output");
-    o.check_keys({"fields_every", "history_every", "format"});
+    o.check_keys({"fields_every", "history_every", "format", "part_energies"});
+    if (o.has("part_energies")) c.part_energies = o.child("part_energies").flag();
     if (o.has("fields_every")) c.fields_every = o.child("fields_every").positive();
     if (o.has("history_every")) c.history_every = o.child("history_every").positive();
     if (o.has("format")) {

@@ -799,6 +799,10 @@ private:
     if (n == "CONTROL_BULK_VISCOSITY") return control_bulk_viscosity(b);
     if (n == "DATABASE_BINARY_D3PLOT") return d3plot(b);
     if (n == "DATABASE_GLSTAT" || n == "DATABASE_NODOUT") return history_interval(b);
+    if (n == "DATABASE_MATSUM") {
+      part_energies_ = true; // the parts' energies in history.csv
+      return history_interval(b);
+    }
     if (n == "DATABASE_HISTORY_NODE") return history_nodes(b, false);
     if (n == "DATABASE_HISTORY_NODE_SET") return history_nodes(b, true);
     if (n == "DATABASE_HISTORY_NODE_ID") return history_nodes_id(b);
@@ -2594,6 +2598,7 @@ private:
   std::int64_t control_ihq_ = 0;
   double control_qh_ = 0, control_q1_ = 0, control_q2_ = 0;
   double d3plot_dt_ = 0, history_dt_ = 0;
+  bool part_energies_ = false;
   std::int64_t d3plot_states_ = 0;
   struct HistoryNode {
     std::int64_t id; // a node, or a node set
@@ -3000,6 +3005,7 @@ Config KeywordReader::config(const std::string& deck_file) {
   else
     c.fields_every = d3plot_dt_;
   c.history_every = history_dt_;
+  c.part_energies = part_energies_;
 
   // Probes: *DATABASE_HISTORY_NODE (and _ID, _SET), at the node's position. anvil probes
   // the model's node nearest to a point, the lowest id among coincident ones; a node that

@@ -1183,7 +1183,52 @@ Sample Simulation::sample() const {
     wall_forces(all, dt_avg_, s.wall_force);
   }
   s.reaction = reactions();
+  if (config_.part_energies) {
+    s.part_energies = part_energies();
+    comm_.sum(std::span<double>(s.part_energies));
+  }
   return s;
+}
+
+// Each part's and particle set's share of the kinetic, internal and hourglass energies of
+// this rank. A node's kinetic energy is split among its elements by the mass each gave it
+// (an eighth of the element's: the lumped mass), so the parts' kinetic energies add up to
+// the nodes'; the velocity is the one the total uses (the deck's at t = 0, then the mean
+// of the half-step velocities around t(n)).
+std::vector<double> Simulation::part_energies() const {
+  const std::size_t parts = config_.parts.size();
+  std::vector<double> e(3 * (parts + config_.particles.size()), 0.0);
+  const bool initial = clock_.cycle == 0;
+  auto speed2 = [&](const std::array<std::vector<double>, 3>& v,
+                    const std::array<std::vector<double>, 3>& v_prev, std::size_t n) {
+    double s = 0;
+    for (int i = 0; i < 3; ++i) {
+      const double a = initial ? v[i][n] : 0.5 * (v_prev[i][n] + v[i][n]);
+      s += a * a;
+    }
+    return s;
+  };
+  for (const auto& b : blocks_) {
+    double* out = e.data() + 3 * static_cast<std::size_t>(b.part);
+    for (int el = 0; el < b.size(); ++el) {
+      const auto k = static_cast<std::size_t>(el);
+      double v2 = 0;
+      for (int a = 0; a < 8; ++a)
+        v2 += speed2(nodes_.v, v_prev_, static_cast<std::size_t>(b.conn[a][k]));
+      out[0] += 0.5 * (b.mass[k] / 8) * v2;
+      out[1] += b.internal_energy[k];
+      out[2] += b.hourglass_energy[k];
+    }
+  }
+  if (sph_) {
+    const auto& pt = sph_->particles();
+    for (std::size_t i = 0; i < pt.size(); ++i) {
+      double* out = e.data() + 3 * (parts + static_cast<std::size_t>(pt.set[i]));
+      out[0] += 0.5 * pt.mass[i] * speed2(pt.v, pv_prev_, i);
+      out[1] += pt.mass[i] * pt.energy[i];
+    }
+  }
+  return e;
 }
 
 // Per boundary condition, the force it applies to its nodes and particles over the current

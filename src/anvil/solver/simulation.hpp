@@ -71,6 +71,9 @@ struct Sample {
   // per element probe: its element's stress sxx, syy, szz, sxy, syz, szx (Pa; a thick
   // shell's through-thickness mean) and equivalent plastic strain (0 without plasticity)
   std::vector<double> element_probes;
+  // with `output.part_energies`: per part, then per particle set, its kinetic, internal and
+  // hourglass energy (J; the totals' terms split by where they are)
+  std::vector<double> part_energies;
   std::vector<double> wall_force; // per rigid wall: normal force, N
   std::vector<double> reaction;   // per boundary condition: fx, fy, fz on its nodes, N
 };
@@ -186,6 +189,7 @@ private:
   std::array<double, 3> body_acceleration(double t) const;
   void locate_probes(const Mesh& mesh);
   void locate_element_probes();
+  std::vector<double> part_energies() const; // this rank's share of Sample::part_energies
   double owned_kinetic_energy() const;
   // Particles: selection (mask over own particles), conditions, their part of predict,
   // contact and update (sph_coupling.cpp).
