@@ -360,6 +360,27 @@ TEST(Deck, ElementProbes) {
                {"deck.yaml:20", "probes[0].element_at", "three numbers"});
 }
 
+// johnson_cook's thermal pair: melt_temperature with specific_heat, or neither.
+TEST(Deck, JohnsonCookThermalTermsComeTogether) {
+  const std::string from = "model: j2_plasticity, density: 8930, youngs_modulus: 117.0e9,\n"
+                           "           poissons_ratio: 0.35, yield_stress: 0.4e9, "
+                           "hardening_modulus: 0.1e9}";
+  const std::string jc = "model: johnson_cook, density: 8930, youngs_modulus: 117.0e9,\n"
+                         "           poissons_ratio: 0.35, A: 0.4e9, B: 0.2e9, n: 0.5";
+  std::string text = good;
+  text.replace(text.find(from), from.size(), jc + "}");
+  const Config c = test::deck(text);
+  EXPECT_EQ(c.materials[0].params.at("melt_temperature"), 0);
+  expect_error(from, jc + ", specific_heat: 383}",
+               {"deck.yaml:6", "materials.copper.specific_heat", "give both, or neither"});
+  expect_error(from, jc + ", melt_temperature: 1356}",
+               {"deck.yaml:5", "materials.copper.specific_heat", "required with melt_temperature"});
+  expect_error(from, jc + ", melt_temperature: 200, specific_heat: 383}",
+               {"deck.yaml:6", "materials.copper.melt_temperature", "must exceed"});
+  expect_error(from, jc + ", saturation_stress: -1}",
+               {"deck.yaml:6", "materials.copper.saturation_stress", "impossible"});
+}
+
 TEST(Deck, PartEnergiesFlag) {
   const std::string out = "output: {fields_every: 1.0e-5,";
   std::string text = good;

@@ -442,6 +442,36 @@ copper
   EXPECT_NE(c.warnings[2].find("VP = 1"), std::string::npos) << c.warnings[2];
 }
 
+// *MAT_SIMPLIFIED_JOHNSON_COOK (MAT_098): anvil's johnson_cook without its thermal terms,
+// SIGMAX and SIGSAT its caps (LS-DYNA's 1e28, a blank's default, is no cap).
+TEST(Keyword, SimplifiedJohnsonCook) {
+  const std::string elastic = "*MAT_ELASTIC\n         1    7850.0   2.0E+11       0.3\n";
+  Config c = kw(with(good, elastic,
+                     "*MAT_SIMPLIFIED_JOHNSON_COOK\n         1    7830.0   2.0E+11      0.29\n"
+                     "   7.92E+8   5.10E+8      0.26     0.014              1.2E+9    1.0E28"
+                     "       1.0\n"));
+  const MaterialConfig& m = c.materials.at(0);
+  ASSERT_EQ(m.model, "johnson_cook");
+  EXPECT_EQ(m.params.at("A"), 792e6);
+  EXPECT_EQ(m.params.at("n"), 0.26);
+  EXPECT_EQ(m.params.at("reference_strain_rate"), 1.0);
+  EXPECT_EQ(m.params.at("max_hardening_stress"), 1.2e9);
+  EXPECT_EQ(m.params.at("saturation_stress"), 0); // 1e28: none
+  EXPECT_EQ(m.params.at("melt_temperature"), 0);  // no thermal terms
+  EXPECT_TRUE(c.warnings.empty()) << c.warnings.at(0);
+  // PSFAIL, VP: warnings; EPSO blank: an error (no default in LS-DYNA's manual).
+  c = kw(with(good, elastic,
+              "*MAT_098\n1,7830.0,2.0E+11,0.29,1\n7.92E+8,5.1E+8,0.26,0.014,0.8,,,1.0\n"));
+  ASSERT_EQ(c.warnings.size(), 2u);
+  EXPECT_NE(c.warnings[0].find("VP = 1"), std::string::npos) << c.warnings[0];
+  EXPECT_NE(c.warnings[1].find("PSFAIL"), std::string::npos) << c.warnings[1];
+  expect_error(with(good, elastic, "*MAT_098\n1,7830.0,2.0E+11,0.29\n7.92E+8,5.1E+8,0.26,0.014\n"),
+               {"*MAT_098.EPSO", "must be positive"});
+  expect_error(
+      with(good, elastic, "*MAT_098\n1,7830.0,2.0E+11,0.29\n-1.0,5.1E+8,0.26,0.014,,,,1\n"),
+      {"*MAT_098.A", "must be positive"});
+}
+
 TEST(Keyword, JohnsonCookAndItsEquationOfState) {
   const std::string jc = R"(*MAT_JOHNSON_COOK
 $      mid        ro         g         e        pr

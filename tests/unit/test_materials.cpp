@@ -1,6 +1,8 @@
 // Constitutive models against closed-form answers on simple strain paths.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "anvil/material/johnson_cook.hpp"
@@ -92,7 +94,9 @@ TEST(Materials, JohnsonCookConsistencyAndAdiabaticHeating) {
                       {"room_temperature", 293},
                       {"melt_temperature", 1793},
                       {"specific_heat", 477},
-                      {"taylor_quinney", 0.9}};
+                      {"taylor_quinney", 0.9},
+                      {"max_hardening_stress", 0},
+                      {"saturation_stress", 0}};
   const JohnsonCook jc(p);
   Point pt;
   pt.rho = 7830;
@@ -116,6 +120,61 @@ TEST(Materials, JohnsonCookConsistencyAndAdiabaticHeating) {
   // Thermal softening to zero strength at melt.
   EXPECT_EQ(jc.yield_stress(0.1, 1.0, 1793), 0.0);
   EXPECT_NEAR(jc.yield_stress(0.0, 1.0, 293), 792e6, 1e-6);
+}
+
+// Johnson-Cook without melt_temperature (LS-DYNA's simplified Johnson-Cook, MAT_098):
+// no temperature, no thermal term, so at a fixed rate the flow stress is (A + B ep^n)
+// (1 + C ln(rate / rate0)); max_hardening_stress caps A + B ep^n before the rate factor
+// and saturation_stress caps the result (MAT_098's SIGMAX, SIGSAT). Simple shear at
+// gamma-dot 1000 /s (equivalent rate 577 /s); q = sqrt(3) tau on the capped law at every
+// plastic step, tolerance 1e-10 relative (the Newton solve's convergence, 1e-14 of q, and
+// the shear stress's own round-off).
+TEST(Materials, SimplifiedJohnsonCookAndItsCaps) {
+  ParamValues p{{"density", 7830},
+                {"youngs_modulus", 200e9},
+                {"poissons_ratio", 0.29},
+                {"A", 792e6},
+                {"B", 510e6},
+                {"C", 0.014},
+                {"n", 0.26},
+                {"m", 1},
+                {"reference_strain_rate", 1.0},
+                {"room_temperature", 293},
+                {"melt_temperature", 0},
+                {"specific_heat", 0},
+                {"taylor_quinney", 0.9},
+                {"max_hardening_stress", 0},
+                {"saturation_stress", 0}};
+  const double rate = 1000 / std::sqrt(3.0), R = 1 + 0.014 * std::log(rate);
+  for (const auto [sigmax, sigsat] : {std::array<double, 2>{0, 0}, {1.0e9, 0}, {0, 1.05e9}}) {
+    p["max_hardening_stress"] = sigmax;
+    p["saturation_stress"] = sigsat;
+    const JohnsonCook jc(p);
+    EXPECT_FALSE(jc.has_temperature());
+    auto expected = [&](double ep) {
+      double h = 792e6 + 510e6 * std::pow(ep, 0.26);
+      if (sigmax > 0) h = std::min(h, sigmax);
+      double y = h * R;
+      if (sigsat > 0) y = std::min(y, sigsat);
+      return y;
+    };
+    Point pt;
+    pt.rho = 7830;
+    pt.d[3] = 500.0;
+    int plastic = 0;
+    for (int n = 0; n < 1000; ++n) { // to gamma = 0.1: ep ~ 0.05, past both caps
+      const double ep0 = pt.ep;
+      pt.step(jc, 1e-7);
+      if (pt.ep == ep0) continue;
+      ++plastic;
+      const double q = std::sqrt(3.0) * std::abs(pt.s[3]);
+      ASSERT_NEAR(q, expected(pt.ep), 1e-10 * q)
+          << "step " << n << ", caps " << sigmax << " " << sigsat;
+    }
+    EXPECT_GT(plastic, 200);
+    if (sigmax > 0) EXPECT_NEAR(std::sqrt(3.0) * pt.s[3], sigmax * R, 1e-10 * sigmax * R);
+    if (sigsat > 0) EXPECT_NEAR(std::sqrt(3.0) * pt.s[3], sigsat, 1e-10 * sigsat);
+  }
 }
 
 // piecewise_linear_plasticity (LS-DYNA MAT_024): the hardening curve of the tests below,

@@ -761,6 +761,9 @@ private:
     if (n == "MAT_JOHNSON_COOK" || n == "MAT_015" || n == "MAT_JOHNSON_COOK_TITLE" ||
         n == "MAT_015_TITLE")
       return mat_johnson_cook(b);
+    if (n == "MAT_SIMPLIFIED_JOHNSON_COOK" || n == "MAT_098" ||
+        n == "MAT_SIMPLIFIED_JOHNSON_COOK_TITLE" || n == "MAT_098_TITLE")
+      return mat_simplified_johnson_cook(b);
     if (n == "MAT_PIECEWISE_LINEAR_PLASTICITY" || n == "MAT_024" ||
         n == "MAT_PIECEWISE_LINEAR_PLASTICITY_TITLE" || n == "MAT_024_TITLE")
       return mat_piecewise_linear_plasticity(b);
@@ -1187,15 +1190,58 @@ private:
                                     m.at.str(), mid, vp));
   }
 
-  // FS of MAT_003, FAIL of MAT_024: not mapped to anvil's erosion.
+  // FS of MAT_003, FAIL of MAT_024, PSFAIL of MAT_098: not mapped to anvil's erosion (0,
+  // and LS-DYNA's 1e17 default of PSFAIL, are no failure).
   static void failure_strain_note(const Card& card, int field, const char* name, std::int64_t mid,
                                   MaterialCard& m) {
-    if (card.real(field, name, 0) == 0) return;
+    const double strain = card.real(field, name, 0);
+    if (strain == 0 || strain >= 1e16) return;
     m.notes.push_back(fmt::format("{}: material {}: the failure strain {} is ignored: a keyword "
                                   "deck does not map it to anvil's erosion, so these elements are "
                                   "never deleted (a YAML deck's part key "
                                   "`erosion: {{plastic_strain: ...}}` deletes them)",
                                   m.at.str(), mid, name));
+  }
+
+  // MID, RO, E, PR, VP; A, B, N, C, PSFAIL, SIGMAX, SIGSAT, EPSO (LS-DYNA manual,
+  // *MAT_SIMPLIFIED_JOHNSON_COOK): anvil's johnson_cook without its thermal terms, SIGMAX
+  // and SIGSAT its caps (LS-DYNA's defaults, 1e28, are none).
+  void mat_simplified_johnson_cook(const Block& b) {
+    Cursor c(b);
+    skip_title(b, c);
+    const Line l = c.next();
+    const Card c1(b, l, {10, 10, 10, 10, 10});
+    const std::int64_t mid = material_id(c1);
+    MaterialCard m{b.name, "johnson_cook", {}, {}, where_of(l), {}, 0, {}};
+    elastic_fields(c1, m.params, 1, 2, 3);
+    if (c1.real(4, "VP", 0) != 0)
+      m.notes.push_back(fmt::format("{}: material {}: VP = {} (the viscoplastic rate form) is "
+                                    "replaced by anvil's scaled yield stress (VP = 0)",
+                                    m.at.str(), mid, c1.real(4, "VP", 0)));
+    const Line l2 = c.next();
+    const Card c2(b, l2, {10, 10, 10, 10, 10, 10, 10, 10});
+    const double A = c2.real(0, "A"), B = c2.real(1, "B"), n = c2.real(2, "N"), C = c2.real(3, "C"),
+                 sigmax = c2.real(5, "SIGMAX", 0), sigsat = c2.real(6, "SIGSAT", 0),
+                 epso = c2.real(7, "EPSO", 0);
+    if (!(A > 0)) c2.fail("A", "the yield stress A must be positive");
+    if (B < 0) c2.fail("B", "B must not be negative");
+    if (B > 0 && !(n > 0)) c2.fail("N", "the hardening exponent N must be positive");
+    if (C < 0) c2.fail("C", "C must not be negative");
+    if (!(epso > 0))
+      c2.fail("EPSO", "the quasi-static threshold strain rate EPSO must be positive (in the "
+                      "deck's time unit: 1.0 for 1/s)");
+    if (sigmax < 0) c2.fail("SIGMAX", "SIGMAX must not be negative");
+    if (sigsat < 0) c2.fail("SIGSAT", "SIGSAT must not be negative");
+    m.params["A"] = A;
+    m.params["B"] = B;
+    m.params["n"] = B > 0 ? n : 1;
+    m.params["C"] = C;
+    m.params["reference_strain_rate"] = epso;
+    // LS-DYNA's "no cap" is 1e28 (its default for a blank field).
+    if (sigmax > 0 && sigmax < 1e27) m.params["max_hardening_stress"] = sigmax;
+    if (sigsat > 0 && sigsat < 1e27) m.params["saturation_stress"] = sigsat;
+    failure_strain_note(c2, 4, "PSFAIL", mid, m);
+    add_material(c1, mid, std::move(m));
   }
 
   // MID, RO, E, PR, SIGY, ETAN, FAIL, TDEL; C, P, LCSS, LCSR, VP; EPS1-EPS8; ES1-ES8
@@ -2738,7 +2784,8 @@ Config KeywordReader::config(const std::string& deck_file) {
       throw InputError(p.at.loc("*PART.MID"),
                        fmt::format("part {}: material {} is a *{} (at {}), which anvil does not "
                                    "have (supported: *MAT_ELASTIC, *MAT_PLASTIC_KINEMATIC, "
-                                   "*MAT_PIECEWISE_LINEAR_PLASTICITY, *MAT_JOHNSON_COOK)",
+                                   "*MAT_PIECEWISE_LINEAR_PLASTICITY, *MAT_JOHNSON_COOK, "
+                                   "*MAT_SIMPLIFIED_JOHNSON_COOK)",
                                    p.pid, p.mid, mc.keyword, mc.at.str()));
     std::string mname = fmt::format("mat{}", p.mid);
     ParamValues params = mc.params; // this part's copy: its EOS may complete it

@@ -26,9 +26,18 @@ std::unique_ptr<Material> make(const ParamValues& p, const TableValues& t) {
 }
 
 ParamProblem johnson_cook_check(const ParamValues& p, const TableValues&) {
+  if (p.at("melt_temperature") == 0) {
+    if (p.at("specific_heat") > 0)
+      return {"specific_heat", "specific_heat is used with melt_temperature (the thermal "
+                               "softening and heating): give both, or neither"};
+    return {};
+  }
   if (!(p.at("melt_temperature") > p.at("room_temperature")))
     return {"melt_temperature", fmt::format("melt_temperature {} must exceed room_temperature {}",
                                             p.at("melt_temperature"), p.at("room_temperature"))};
+  if (!(p.at("specific_heat") > 0))
+    return {"specific_heat", "specific_heat is required with melt_temperature (the adiabatic "
+                             "heating)"};
   return {};
 }
 template <class E>
