@@ -304,6 +304,31 @@ TEST(Lattice, LowerDimensionsOnOnePlane) {
   for (const auto& p : sph::generate_lattice(sphere, 2).points) EXPECT_EQ(p.z, 0.0);
 }
 
+// An element probe in a model of particles only: an error at the probe (QA round 28: its
+// columns were zeros, silently).
+TEST(DeckParticles, AnElementProbeNeedsElements) {
+  const Comm world = Comm::world();
+  try {
+    Simulation sim(test::deck(R"(termination: {cycles: 5}
+materials:
+  rubber: {model: elastic, density: 1200, youngs_modulus: 1.0e7, poissons_ratio: 0.4}
+particles:
+  a: {generate: {shape: box, min: [0, 0, 0], max: [0.004, 0.004, 0.004], spacing: 1.0e-3},
+      material: rubber}
+probes:
+  - {name: gauge, element_at: [0.002, 0.002, 0.002]}
+)",
+                              "deck.yaml"),
+                   world);
+    FAIL() << "no error for an element probe without elements";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("deck.yaml:8: probes[0]: element probe gauge needs "
+                                         "elements"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // Two 2-D blocks given different z ranges meet and exchange momentum (they passed
 // through each other, 24 J of kinetic energy unchanged, before).
 TEST(DeckParticles, TwoDimensionalSetsOnDifferentZCollide) {

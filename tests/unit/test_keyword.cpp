@@ -1130,6 +1130,26 @@ TEST(Keyword, HistoryNodeSetsAndIncludeVariants) {
   ASSERT_EQ(c.element_probes.size(), 2u); // element 2 once
   EXPECT_EQ(c.element_probes[0].name, "solid2");
   EXPECT_EQ(c.element_probes[0].at, (Vec3{0.5, 0.5, 1.5}));
+  EXPECT_EQ(c.element_probes[0].element_id, 2); // the element itself, not its centroid's
+  {
+    // The run records each element's own state: the probes' values are the elements'.
+    const Comm world = Comm::world();
+    Config run = c;
+    run.end_cycles = 20;
+    Simulation sim(run, world);
+    while (!sim.finished()) sim.step();
+    const Sample s = sim.sample();
+    for (std::size_t b = 0; b < sim.blocks().size(); ++b)
+      for (int e = 0; e < sim.blocks()[b].size(); ++e) {
+        const std::int64_t id = sim.element_file_id(b, static_cast<std::size_t>(e));
+        const std::size_t p = id == 2 ? 0 : 1;
+        for (int k = 0; k < 6; ++k)
+          EXPECT_EQ(s.element_probes[7 * p + static_cast<std::size_t>(k)],
+                    sim.blocks()[b].stress[k][static_cast<std::size_t>(e)] + 0.0)
+              << "element " << id << " component " << k;
+      }
+    EXPECT_NE(s.element_probes[2], s.element_probes[7 + 2]); // the two bricks differ
+  }
   EXPECT_EQ(c.element_probes[1].name, "solid1");
   EXPECT_EQ(c.element_probes[1].at, (Vec3{0.5, 0.5, 0.5}));
   expect_error(with(good, "*END", "*DATABASE_HISTORY_SOLID\n         3\n*END"),

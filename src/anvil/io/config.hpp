@@ -186,6 +186,9 @@ struct ProbeConfig {
   std::string name;
   Vec3 at;
   SourceLocation where;
+  // An element probe of a keyword deck's *DATABASE_HISTORY_SOLID: the element with this
+  // id (its mesh's), whatever shares its centroid; -1: the nearest to `at`.
+  std::int64_t element_id = -1;
 };
 
 // Which field files a run writes (DESIGN.md section 4, `output.format`).

@@ -801,7 +801,8 @@ private:
     if (n == "CONTROL_HOURGLASS") return control_hourglass(b);
     if (n == "CONTROL_BULK_VISCOSITY") return control_bulk_viscosity(b);
     if (n == "DATABASE_BINARY_D3PLOT") return d3plot(b);
-    if (n == "DATABASE_GLSTAT" || n == "DATABASE_NODOUT") return history_interval(b);
+    if (n == "DATABASE_GLSTAT" || n == "DATABASE_NODOUT" || n == "DATABASE_ELOUT")
+      return history_interval(b);
     if (n == "DATABASE_MATSUM") {
       part_energies_ = true; // the parts' energies in history.csv
       return history_interval(b);
@@ -2263,7 +2264,8 @@ private:
       if (n == f) return 1;
     for (const char* f :
          {"AUTOMATIC_SURFACE_TO_SURFACE", "SURFACE_TO_SURFACE", "ERODING_SURFACE_TO_SURFACE",
-          "AUTOMATIC_NODES_TO_SURFACE", "NODES_TO_SURFACE", "ERODING_NODES_TO_SURFACE"})
+          "AUTOMATIC_NODES_TO_SURFACE", "NODES_TO_SURFACE", "ERODING_NODES_TO_SURFACE",
+          "AUTOMATIC_ONE_WAY_SURFACE_TO_SURFACE", "ONE_WAY_SURFACE_TO_SURFACE"})
       if (n == f) return 2;
     return 0;
   }
@@ -2973,6 +2975,11 @@ Config KeywordReader::config(const std::string& deck_file) {
     // LS-DYNA's penalty stiffness for solid segments is SLSFAC * SFS * K A^2 / V, anvil's
     // penalty_scale * K A^2 / V. Two sides with their own scales (SFS, SFM): the slave's.
     cc.penalty_scale = (slsfac_ > 0 ? slsfac_ : 0.1) * k.sfs;
+    if (!std::isfinite(cc.penalty_scale))
+      throw InputError(k.at.loc("*" + k.keyword + ".SFS"),
+                       fmt::format("the penalty scale SLSFAC x SFS = {} x {} is not a finite "
+                                   "number",
+                                   slsfac_ > 0 ? slsfac_ : 0.1, k.sfs));
     if (k.two_surface && k.sfm != k.sfs)
       warnings.push_back(fmt::format("{}: contact penalty scales SFS = {} and SFM = {}: anvil's "
                                      "contact is symmetric and uses SFS on both sides",
@@ -3109,20 +3116,15 @@ Config KeywordReader::config(const std::string& deck_file) {
                                      unused.front(), unused.size() > 1 ? ", ..." : ""));
   }
 
-  // Element probes: *DATABASE_HISTORY_SOLID (and _ID), at the element's centroid (the
-  // mean of its corners). anvil's element probe takes the element whose centroid is
-  // nearest a point, so elements that share a centroid (coincident ones) are warned of.
+  // Element probes: *DATABASE_HISTORY_SOLID (and _ID), the element by its id (at its
+  // centroid, the mean of its corners, for the outside-the-model check). By the centroid
+  // alone, a coincident element could stand in for it (QA round 28).
   if (!history_solids_.empty()) {
     auto centroid = [&](const RawElement& e) {
       Vec3 x{0, 0, 0};
       for (const auto n : e.nodes) x = x + nodes_[static_cast<std::size_t>(node_index_.at(n))];
       return x * 0.125;
     };
-    std::map<std::array<double, 3>, std::vector<std::int64_t>> at_centroid;
-    for (const auto& e : elements_) {
-      const Vec3 x = centroid(e);
-      at_centroid[{x.x, x.y, x.z}].push_back(e.eid);
-    }
     std::set<std::int64_t> probed;
     for (const auto& h : history_solids_) {
       const auto it = element_index_.find(h.id);
@@ -3132,13 +3134,9 @@ Config KeywordReader::config(const std::string& deck_file) {
                                      "(*ELEMENT_SOLID)",
                                      h.id));
       if (!probed.insert(h.id).second) continue;
-      const Vec3 x = centroid(elements_[it->second]);
-      const auto& same = at_centroid.at({x.x, x.y, x.z});
-      if (same.size() > 1)
-        warnings.push_back(fmt::format("{}: history element {} shares its centroid with "
-                                       "element {}: the probe may follow that one",
-                                       h.at.str(), h.id, same.front() == h.id ? same[1] : same[0]));
-      c.element_probes.push_back(ProbeConfig{fmt::format("solid{}", h.id), x, h.at.loc(h.keyword)});
+      c.element_probes.push_back(ProbeConfig{fmt::format("solid{}", h.id),
+                                             centroid(elements_[it->second]), h.at.loc(h.keyword),
+                                             h.id});
     }
   }
 

@@ -646,6 +646,12 @@ void Simulation::locate_element_probes() {
   const std::size_t np = config_.element_probes.size();
   element_probe_.assign(np, {-1, -1});
   if (np == 0) return;
+  std::int64_t local_elements = 0;
+  for (const auto& b : blocks_) local_elements += b.size();
+  if (comm_.sum(local_elements) == 0)
+    throw InputError(config_.element_probes[0].where,
+                     fmt::format("element probe {} needs elements, and the model has none",
+                                 config_.element_probes[0].name));
   std::array<std::vector<double>, 3> c;
   std::vector<std::int64_t> gid;
   std::vector<std::array<int, 2>> at;
@@ -667,7 +673,18 @@ void Simulation::locate_element_probes() {
   std::vector<NearestGrid::Hit> hit(np);
   std::vector<double> r2(np);
   for (std::size_t p = 0; p < np; ++p) {
-    hit[p] = grid.nearest(config_.element_probes[p].at);
+    const std::int64_t id = config_.element_probes[p].element_id;
+    if (id < 0) {
+      hit[p] = grid.nearest(config_.element_probes[p].at);
+    } else {
+      // The element with the file id (at "distance" 0; the lowest gid if ids repeat).
+      hit[p] = {std::numeric_limits<double>::infinity(), 0, -1};
+      for (std::size_t k = 0; k < at.size(); ++k)
+        if (element_file_id_[static_cast<std::size_t>(at[k][0])]
+                            [static_cast<std::size_t>(at[k][1])] == id &&
+            (hit[p].index < 0 || gid[k] < hit[p].id))
+          hit[p] = {0.0, gid[k], static_cast<int>(k)};
+    }
     r2[p] = hit[p].r2;
   }
   comm_.min(std::span<double>(r2));
