@@ -109,8 +109,9 @@ int check(const std::string& deck, const anvil::Comm& comm) {
   std::printf("nodes       %lld\n", static_cast<long long>(sim.global_nodes()));
   std::printf("elements    %lld\n", static_cast<long long>(sim.global_elements()));
   for (std::size_t i = 0; i < config.parts.size(); ++i)
-    std::printf("  part %-16s material %-16s mass %.6g kg\n", config.parts[i].name.c_str(),
-                config.parts[i].material.c_str(), sim.part_masses()[i]);
+    std::printf("  part %-16s material %-16s mass %.6g kg%s\n", config.parts[i].name.c_str(),
+                config.parts[i].material.c_str(), sim.part_masses()[i],
+                config.parts[i].rigid ? "  rigid body" : "");
   if (const auto* sph = sim.sph()) {
     const auto& off = sph->set_offsets();
     std::printf("particles   %lld\n", static_cast<long long>(sph->global_count()));

@@ -381,6 +381,19 @@ TEST(Deck, JohnsonCookThermalTermsComeTogether) {
                {"deck.yaml:6", "materials.copper.saturation_stress", "impossible"});
 }
 
+// `rigid: true` on a part; what a rigid part cannot have is an error at its key.
+TEST(Deck, RigidParts) {
+  const std::string mat = "    material: copper\n";
+  const std::string hg = "    hourglass: {model: viscous, coefficient: 0.05}\n";
+  std::string text = good;
+  text.replace(text.find(hg), hg.size(), "    rigid: true\n");
+  EXPECT_TRUE(test::deck(text).parts[0].rigid);
+  EXPECT_FALSE(test::deck(good).parts[0].rigid);
+  expect_error(hg, "    rigid: yes\n", {"deck.yaml:11", "parts.bar.rigid", "true or false"});
+  expect_error(mat, mat + "    rigid: true\n",
+               {"deck.yaml:12", "parts.bar.hourglass", "do not deform"});
+}
+
 TEST(Deck, PartEnergiesFlag) {
   const std::string out = "output: {fields_every: 1.0e-5,";
   std::string text = good;

@@ -472,6 +472,23 @@ TEST(Keyword, SimplifiedJohnsonCook) {
       {"*MAT_098.A", "must be positive"});
 }
 
+// *MAT_RIGID: its parts are rigid bodies (RO their mass, E and PR their contact
+// stiffness); constraints of the body are errors.
+TEST(Keyword, RigidMaterial) {
+  const std::string elastic = "*MAT_ELASTIC\n         1    7850.0   2.0E+11       0.3\n";
+  const Config c = kw(with(good, elastic, "*MAT_RIGID\n1,7850.0,2.0E+11,0.3\n\n\n"));
+  EXPECT_EQ(c.materials.at(0).model, "elastic");
+  EXPECT_TRUE(c.parts.at(0).rigid);
+  EXPECT_FALSE(kw(good).parts.at(0).rigid);
+  // (CMO 1 with nothing constrained is no constraint.)
+  EXPECT_TRUE(
+      kw(with(good, elastic, "*MAT_RIGID\n1,7850.0,2.0E+11,0.3\n1.0\n\n")).parts.at(0).rigid);
+  expect_error(with(good, elastic, "*MAT_RIGID\n1,7850.0,2.0E+11,0.3\n1.0,4,7\n\n"),
+               {"*MAT_RIGID.CMO", "not supported"});
+  expect_error(with(good, elastic, "*MAT_RIGID\n1,7850.0,-2.0E+11,0.3\n\n\n"),
+               {"*MAT_RIGID.E", "positive"});
+}
+
 TEST(Keyword, JohnsonCookAndItsEquationOfState) {
   const std::string jc = R"(*MAT_JOHNSON_COOK
 $      mid        ro         g         e        pr
@@ -661,8 +678,8 @@ shell part
          2         2         2
 *SECTION_SHELL
          2
-*MAT_RIGID
-         2    7850.0   2.0E+11       0.3
+*MAT_NULL
+         2    7850.0
 *END)"));
   std::vector<std::string> about_keywords;
   for (const auto& w : c.warnings)
@@ -674,7 +691,7 @@ shell part
   // A curve no prescribed motion names is not read (its card here is not even in LS-DYNA's
   // columns) and changes nothing: not listed.
   EXPECT_EQ(w.find("*DEFINE_CURVE"), std::string::npos) << w;
-  EXPECT_NE(w.find("*MAT_RIGID (1x"), std::string::npos) << w;
+  EXPECT_NE(w.find("*MAT_NULL (1x"), std::string::npos) << w;
   EXPECT_NE(w.find("*SECTION_SHELL (1x"), std::string::npos) << w;
   // The part without solid elements is left out, with a warning of its own.
   EXPECT_EQ(c.parts.size(), 1u);
@@ -730,8 +747,8 @@ TEST(Keyword, ErrorsNameFileLineAndField) {
                {"model.k:36: *BOUNDARY_SPC_SET.NSID", "node set 8 is not defined"});
   expect_error(with(good, "         7         0         1", "         7         5         1"),
                {"*BOUNDARY_SPC_SET.CID"});
-  expect_error(with(good, "*MAT_ELASTIC\n", "*MAT_RIGID\n"),
-               {"*PART.MID", "*MAT_RIGID", "anvil does not have"});
+  expect_error(with(good, "*MAT_ELASTIC\n", "*MAT_NULL\n"),
+               {"*PART.MID", "*MAT_NULL", "anvil does not have"});
   expect_error(with(good, "    7850.0", "     &dens"), {"*MAT_ELASTIC.RO", "parameter"});
   expect_error(with(good, "       1             0.0", "       1\t0.0"), {"*NODE", "tab"});
   expect_error(with(good, "*SECTION_SOLID\n         1", "*SECTION_SOLID\n         2"),

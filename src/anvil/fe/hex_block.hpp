@@ -70,6 +70,7 @@ struct HexBlock {
   BulkViscosity bulk_viscosity;
   Erosion erosion;
   ThickShell thick_shell;
+  bool rigid = false; // a rigid body's elements: no stress, no forces, no step (skipped)
 
   std::vector<std::int64_t> gid;                       // global element ids, ascending
   std::array<std::vector<int>, 8> conn;                // local node index of each corner

@@ -53,6 +53,9 @@ struct PartConfig {
   BulkViscosity bulk_viscosity;
   Erosion erosion;
   ThickShell thick_shell;
+  // A rigid body (LS-DYNA's *MAT_RIGID): its nodes move together, its elements carry no
+  // stress; the material gives its mass (density) and its contact stiffness (E, nu).
+  bool rigid = false;
   SourceLocation where;
 };
 

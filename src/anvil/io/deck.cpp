@@ -471,9 +471,19 @@ PartConfig parse_part(const std::string& name, const Node& n, const std::string&
   PartConfig p;
   p.name = name;
   p.where = n.where();
-  n.check_keys({"mesh", "material", "hourglass", "bulk_viscosity", "erosion", "thick_shell"});
+  n.check_keys(
+      {"mesh", "material", "hourglass", "bulk_viscosity", "erosion", "thick_shell", "rigid"});
   p.mesh = parse_mesh(n.required("mesh"), base_dir);
   p.material = n.required("material").str();
+  if (n.has("rigid")) {
+    p.rigid = n.child("rigid").flag();
+    // What a rigid part cannot have: its elements do not deform.
+    for (const char* key : {"hourglass", "bulk_viscosity", "erosion", "thick_shell"})
+      if (p.rigid && n.has(key))
+        n.child(key).fail(fmt::format("a rigid part's elements do not deform: {} does not "
+                                      "apply",
+                                      key));
+  }
   if (n.has("hourglass")) {
     const Node h = n.child("hourglass");
     h.check_keys({"model", "coefficient"});

@@ -566,12 +566,21 @@ struct MaterialCard {
   std::vector<std::string> notes; // warnings, given only if a part uses the material
   Where at;
   TableValues tables;
+  bool rigid = false; // *MAT_RIGID: its parts are rigid bodies
   // *MAT_PIECEWISE_LINEAR_PLASTICITY's LCSS: the hardening curve, read from its
   // *DEFINE_CURVE when a part uses the material (0: none).
   std::int64_t lcss = 0;
   // The card field each of anvil's parameters came from (for the model's own checks).
   std::map<std::string, SourceLocation, std::less<>> field_of;
 };
+
+MaterialCard material_card(const Block& b, std::string model, const Line& l) {
+  MaterialCard m;
+  m.keyword = b.name;
+  m.model = std::move(model);
+  m.at = where_of(l);
+  return m;
+}
 
 struct EosCard {
   std::string keyword;
@@ -761,6 +770,8 @@ private:
     if (n == "MAT_JOHNSON_COOK" || n == "MAT_015" || n == "MAT_JOHNSON_COOK_TITLE" ||
         n == "MAT_015_TITLE")
       return mat_johnson_cook(b);
+    if (n == "MAT_RIGID" || n == "MAT_020" || n == "MAT_RIGID_TITLE" || n == "MAT_020_TITLE")
+      return mat_rigid(b);
     if (n == "MAT_SIMPLIFIED_JOHNSON_COOK" || n == "MAT_098" ||
         n == "MAT_SIMPLIFIED_JOHNSON_COOK_TITLE" || n == "MAT_098_TITLE")
       return mat_simplified_johnson_cook(b);
@@ -1120,7 +1131,7 @@ private:
     const Line l = c.next();
     const Card card(b, l, {10, 10, 10, 10, 10, 10, 10});
     const std::int64_t mid = material_id(card);
-    MaterialCard m{b.name, "elastic", {}, {}, where_of(l), {}, 0, {}};
+    MaterialCard m = material_card(b, "elastic", l);
     elastic_fields(card, m.params, 1, 2, 3);
     add_material(card, mid, std::move(m));
   }
@@ -1131,7 +1142,7 @@ private:
     const Line l = c.next();
     const Card card(b, l, {10, 10, 10, 10, 10, 10, 10});
     const std::int64_t mid = material_id(card);
-    MaterialCard m{b.name, "j2_plasticity", {}, {}, where_of(l), {}, 0, {}};
+    MaterialCard m = material_card(b, "j2_plasticity", l);
     elastic_fields(card, m.params, 1, 2, 3);
     const double E = m.params["youngs_modulus"];
     const double sigy = card.real(4, "SIGY");
@@ -1204,6 +1215,29 @@ private:
                                   m.at.str(), mid, name));
   }
 
+  // MID, RO, E, PR, N, COUPLE, M, ALIAS; CMO, CON1, CON2; LCO or A1-A6 (LS-DYNA manual,
+  // *MAT_RIGID): the parts that use it are rigid bodies; RO gives their mass, E and PR
+  // their contact stiffness (as in LS-DYNA: realistic values). Constraints of the body
+  // (CMO with CON1, CON2) are not supported: an error rather than a free body.
+  void mat_rigid(const Block& b) {
+    Cursor c(b);
+    skip_title(b, c);
+    const Line l = c.next();
+    const Card c1(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+    const std::int64_t mid = material_id(c1);
+    MaterialCard m = material_card(b, "elastic", l);
+    m.rigid = true;
+    elastic_fields(c1, m.params, 1, 2, 3);
+    const Line l2 = c.next();
+    const Card c2(b, l2, {10, 10, 10});
+    const double cmo = c2.real(0, "CMO", 0);
+    if (cmo != 0 && (c2.real(1, "CON1", 0) != 0 || c2.real(2, "CON2", 0) != 0))
+      c2.fail("CMO", "constraints of a rigid body (CMO with CON1, CON2) are not supported: "
+                     "anvil's rigid bodies move freely");
+    c.next(); // LCO or A1-A6: the constraint directions, unused without constraints
+    add_material(c1, mid, std::move(m));
+  }
+
   // MID, RO, E, PR, VP; A, B, N, C, PSFAIL, SIGMAX, SIGSAT, EPSO (LS-DYNA manual,
   // *MAT_SIMPLIFIED_JOHNSON_COOK): anvil's johnson_cook without its thermal terms, SIGMAX
   // and SIGSAT its caps (LS-DYNA's defaults, 1e28, are none).
@@ -1213,7 +1247,7 @@ private:
     const Line l = c.next();
     const Card c1(b, l, {10, 10, 10, 10, 10});
     const std::int64_t mid = material_id(c1);
-    MaterialCard m{b.name, "johnson_cook", {}, {}, where_of(l), {}, 0, {}};
+    MaterialCard m = material_card(b, "johnson_cook", l);
     elastic_fields(c1, m.params, 1, 2, 3);
     if (c1.real(4, "VP", 0) != 0)
       m.notes.push_back(fmt::format("{}: material {}: VP = {} (the viscoplastic rate form) is "
@@ -1255,7 +1289,7 @@ private:
     const Line l = c.next();
     const Card c1(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
     const std::int64_t mid = material_id(c1);
-    MaterialCard m{b.name, "piecewise_linear_plasticity", {}, {}, where_of(l), {}, 0, {}};
+    MaterialCard m = material_card(b, "piecewise_linear_plasticity", l);
     elastic_fields(c1, m.params, 1, 2, 3);
     const double E = m.params["youngs_modulus"];
     const double sigy = c1.real(4, "SIGY", 0), etan = c1.real(5, "ETAN", 0);
@@ -1336,7 +1370,7 @@ private:
     const Line l = c.next();
     const Card c1(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
     const std::int64_t mid = material_id(c1);
-    MaterialCard m{b.name, "johnson_cook", {}, {}, where_of(l), {}, 0, {}};
+    MaterialCard m = material_card(b, "johnson_cook", l);
     const double ro = c1.real(1, "RO"), G = c1.real(2, "G"), E = c1.real(3, "E"),
                  pr = c1.real(4, "PR");
     if (!(ro > 0)) c1.fail("RO", "the density RO must be positive");
@@ -1424,8 +1458,7 @@ private:
       } catch (const InputError&) {
         mid = 0;
       }
-      if (mid > 0)
-        materials_.emplace(mid, MaterialCard{b.name, "", {}, {}, where_of(l), {}, 0, {}});
+      if (mid > 0) materials_.emplace(mid, material_card(b, "", l));
     }
     c.skip_rest(); // the keyword is listed as ignored, whatever its cards
     unsupported(b);
@@ -2787,7 +2820,7 @@ Config KeywordReader::config(const std::string& deck_file) {
                        fmt::format("part {}: material {} is a *{} (at {}), which anvil does not "
                                    "have (supported: *MAT_ELASTIC, *MAT_PLASTIC_KINEMATIC, "
                                    "*MAT_PIECEWISE_LINEAR_PLASTICITY, *MAT_JOHNSON_COOK, "
-                                   "*MAT_SIMPLIFIED_JOHNSON_COOK)",
+                                   "*MAT_SIMPLIFIED_JOHNSON_COOK, *MAT_RIGID)",
                                    p.pid, p.mid, mc.keyword, mc.at.str()));
     std::string mname = fmt::format("mat{}", p.mid);
     ParamValues params = mc.params; // this part's copy: its EOS may complete it
@@ -2860,6 +2893,7 @@ Config KeywordReader::config(const std::string& deck_file) {
       c.materials.push_back(std::move(m));
     }
     pc.material = mname;
+    pc.rigid = mc.rigid;
 
     // Hourglass and bulk viscosity: the part's *HOURGLASS, else the *CONTROL_ cards, else
     // LS-DYNA's defaults (which are anvil's: viscous 0.1, Q1 1.5, Q2 0.06).

@@ -69,6 +69,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     hb.bulk_viscosity = part.bulk_viscosity;
     hb.erosion = part.erosion;
     hb.thick_shell = part.thick_shell;
+    hb.rigid = part.rigid;
     const int bad = hb.init(lb.gid, lb.conn, xs, lb.corner_base);
     // Every rank must throw, not only the one holding the element.
     const std::int64_t none = std::numeric_limits<std::int64_t>::max();
@@ -187,6 +188,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
   // the constraint, so that the energy balance starts from the energy the deck gave.
   const double ke_given = comm_.sum(owned_kinetic_energy() + particle_kinetic_energy());
   apply_boundary_conditions(mesh);
+  setup_rigid_bodies(mesh);
   setup_loads(mesh);
   locate_probes(mesh);
   locate_element_probes();
@@ -758,7 +760,7 @@ void Simulation::fe_forces() {
     // blocks in order); the corner slots it stores are those of the exchanged nodes.
     workspace_.begin_nodal_forces(static_cast<int>(fe_.node_gid.size()));
     for (auto& b : blocks_)
-      if (b.size() > 0) hex_forces(b, view, clock_.dt_prev, corners, workspace_, r);
+      if (b.size() > 0 && !b.rigid) hex_forces(b, view, clock_.dt_prev, corners, workspace_, r);
     double* const f[3] = {nodes_.f[0].data(), nodes_.f[1].data(), nodes_.f[2].data()};
     workspace_.end_nodal_forces(f);
     eroded_ += r.eroded;
@@ -881,6 +883,23 @@ void Simulation::predict() {
   const auto g_now = body_acceleration(clock_.time);
   const double g[3] = {g_now[0], g_now[1], g_now[2]};
   for (int i = 0; i < 3; ++i) gravity_[i] = g[i];
+  // The rigid bodies' nodes: prescribed by their bodies' motion (constrained in every
+  // component); the reactions' impulses, the rigid bodies' internal forces, sum to zero.
+  if (!rigid_gids_.empty()) {
+    move_rigid_bodies(false);
+    for (const auto& rn : rigid_nodes_) {
+      const auto n = static_cast<std::size_t>(rn.local);
+      const Vec3 x{nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]};
+      const Vec3 v = rigid_motion_[static_cast<std::size_t>(rn.body)].point_velocity(x);
+      for (int i = 0; i < 3; ++i) {
+        v_bc_[i][n] = v[i];
+        if (!rn.owned) continue;
+        const double v_old = nodes_.v[i][n];
+        const double v_forces = v_old + dt_avg * nodes_.f[i][n] / nodes_.mass[n];
+        constraint_work.add(nodes_.mass[n] * (v[i] - v_forces), v_old, v[i]);
+      }
+    }
+  }
   for (int n : constrained_nodes_) {
     for (int i = 0; i < 3; ++i) {
       if (!(constrained_[n] & (1u << i))) continue;
@@ -1034,7 +1053,8 @@ void Simulation::correct() {
     double ke_change = 0; // of 1/2 m |v(n)|^2, v(n) = (v(n-1/2) + v(n+1/2)) / 2
     auto impulse = [&](std::size_t n) {
       if (cf[0][n] == 0.0 && cf[1][n] == 0.0 && cf[2][n] == 0.0)
-        return; // most nodes: no pair acts on them
+        return;                                           // most nodes: no pair acts on them
+      if (!rigid_node_.empty() && rigid_node_[n]) return; // their bodies take it, below
       const double inv_m = dt_avg_ / nodes_.mass[n];
       for (int i = 0; i < 3; ++i) {
         const double f = cf[i][n];
@@ -1072,6 +1092,28 @@ void Simulation::correct() {
       for (; n < nn; ++n) impulse(n);
     } else {
       for (const int l : fn) impulse(static_cast<std::size_t>(l));
+    }
+    if (!rigid_gids_.empty()) {
+      // The rigid bodies move again with the contact forces on their nodes: each node's
+      // change of velocity is its contact impulse plus the body's internal one (external
+      // work, as the constraints' are; it sums to zero over a body).
+      move_rigid_bodies(true);
+      for (const auto& rn : rigid_nodes_) {
+        const auto n = static_cast<std::size_t>(rn.local);
+        const Vec3 x{nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]};
+        const Vec3 v = rigid_motion_[static_cast<std::size_t>(rn.body)].point_velocity(x);
+        for (int i = 0; i < 3; ++i) {
+          const double before = 0.5 * (v_prev_[i][n] + nodes_.v[i][n]);
+          const double after = 0.5 * (v_prev_[i][n] + v[i]);
+          if (rn.owned) {
+            const double f = cf[i][n];
+            work_c += f * dt_avg_ * after;
+            ke_change += 0.5 * nodes_.mass[n] * (after * after - before * before);
+            reaction += (nodes_.mass[n] * (v[i] - nodes_.v[i][n]) - f * dt_avg_) * after;
+          }
+          nodes_.v[i][n] = v[i];
+        }
+      }
     }
     double work = work_c; // (the same sum)
     if (sph_) correct_particles(work, ke_change, reaction);
@@ -1450,7 +1492,7 @@ double Simulation::stable_time_step() {
   HexResult r;
   // With dt_prev = 0 the kernel changes no state: rotation by the identity, no increment.
   for (auto& b : blocks_)
-    if (b.size() > 0) hex_forces(b, view, 0.0, corners, workspace_, r);
+    if (b.size() > 0 && !b.rigid) hex_forces(b, view, 0.0, corners, workspace_, r);
   return comm_.min(r.dt_stable);
 }
 

@@ -13,6 +13,7 @@
 #include "anvil/contact/rigid_wall.hpp"
 #include "anvil/core/timer.hpp"
 #include "anvil/fe/hex_block.hpp"
+#include "anvil/fe/rigid_body.hpp"
 #include "anvil/io/config.hpp"
 #include "anvil/mesh/mesh.hpp"
 #include "anvil/parallel/comm.hpp"
@@ -183,6 +184,8 @@ private:
   // before the corner exchange, the loads' nodal forces added after it; their work over the
   // step before (predict).
   void setup_loads(const Mesh& mesh);
+  void setup_rigid_bodies(const Mesh& mesh);
+  void move_rigid_bodies(bool with_contact);
   void press_faces();
   void add_loads();
   void add_load_work(double dt_v, ImpulseWork& work) const;
@@ -314,6 +317,28 @@ private:
   // probed particle (-1: the probe is on a node).
   std::vector<int> probe_node_;
   std::vector<std::int64_t> probe_particle_;
+  // Rigid bodies (parts with `rigid`, solver/rigid.cpp): per body, its nodes' global ids in
+  // ascending order (every rank knows them: the global mesh's) and where its points start
+  // in rigid_points_; this rank's nodes of rigid bodies (rigid_node_: 1 per such local
+  // node); the buffers of the cycle's gather, and each body's motion over the step.
+  struct RigidNode {
+    int body, slot, local;
+    bool owned;
+  };
+  struct RigidRecord {
+    std::int64_t at; // body offset + slot
+    RigidPoint p;
+  };
+  std::vector<std::vector<std::int64_t>> rigid_gids_;
+  std::vector<std::size_t> rigid_offset_;
+  std::vector<RigidNode> rigid_nodes_;
+  std::vector<std::uint8_t> rigid_node_;
+  std::vector<RigidRecord> rigid_send_, rigid_recv_;
+  std::vector<std::int64_t> rigid_bytes_;
+  std::vector<RigidPoint> rigid_points_;
+  std::vector<Vec3> rigid_scratch_;
+  std::vector<RigidMotion> rigid_motion_;
+
   // Element probes: (block, element) on the rank that holds the element, (-1, -1) elsewhere.
   std::vector<std::array<int, 2>> element_probe_;
 

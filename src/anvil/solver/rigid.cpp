@@ -1,0 +1,117 @@
+// Rigid bodies (a part with `rigid: true`, LS-DYNA's *MAT_RIGID): the nodes of a rigid part
+// move as one body. Each cycle every rank gathers the body's points (mass, position,
+// velocity v(n - 1/2), force) from their owners, places them in the body's node order and
+// computes the body's motion (fe/rigid_body.hpp), so every rank moves every body the same
+// way on any number of ranks. The nodes are constrained in every component, their
+// velocities prescribed by the motion: first from the forces of t(n) (predict, for the
+// contact search), then again with the contact forces (correct).
+#include <algorithm>
+#include <span>
+
+#include <fmt/format.h>
+
+#include "anvil/core/error.hpp"
+#include "anvil/solver/model.hpp"
+#include "anvil/solver/simulation.hpp"
+
+namespace anvil {
+
+void Simulation::setup_rigid_bodies(const Mesh& mesh) {
+  const std::size_t nn = fe_.node_gid.size();
+  rigid_gids_.clear();
+  std::vector<std::size_t> part_of_body;
+  for (std::size_t b = 0; b < config_.parts.size(); ++b) {
+    if (!config_.parts[b].rigid) continue;
+    std::vector<std::int64_t> gids;
+    for (const auto& h : mesh.blocks[b].elements) gids.insert(gids.end(), h.begin(), h.end());
+    std::sort(gids.begin(), gids.end());
+    gids.erase(std::unique(gids.begin(), gids.end()), gids.end());
+    // Two rigid parts that share a node would be one body: anvil keeps bodies apart.
+    for (std::size_t o = 0; o < rigid_gids_.size(); ++o) {
+      std::vector<std::int64_t> common;
+      std::set_intersection(gids.begin(), gids.end(), rigid_gids_[o].begin(), rigid_gids_[o].end(),
+                            std::back_inserter(common));
+      if (!common.empty())
+        throw InputError(config_.parts[b].where,
+                         fmt::format("rigid parts {} and {} share {} node{}: each rigid part is "
+                                     "a body of its own (merge them into one part, or keep "
+                                     "their nodes apart)",
+                                     config_.parts[part_of_body[o]].name, config_.parts[b].name,
+                                     common.size(), common.size() == 1 ? "" : "s"));
+    }
+    rigid_gids_.push_back(std::move(gids));
+    part_of_body.push_back(b);
+  }
+  if (rigid_gids_.empty()) return;
+  if (rigid_gids_.size() == config_.parts.size() && config_.particles.empty())
+    throw InputError(config_.parts[0].where,
+                     "every part is rigid: anvil needs a deformable part or particles (their "
+                     "stable time step sets the step)");
+  // A condition on a rigid body's node would fight the body's motion.
+  for (const auto& bc : config_.boundary_conditions) {
+    const auto ids = selected_nodes(mesh, bc.nodes);
+    for (std::size_t o = 0; o < rigid_gids_.size(); ++o)
+      for (const std::int64_t id : ids)
+        if (std::binary_search(rigid_gids_[o].begin(), rigid_gids_[o].end(), id))
+          throw InputError(bc.where,
+                           fmt::format("this condition holds nodes of the rigid part {}: "
+                                       "anvil's rigid bodies move freely (constraining or "
+                                       "driving them is not supported yet; drive a deformable "
+                                       "part instead)",
+                                       config_.parts[part_of_body[o]].name));
+  }
+  rigid_offset_.assign(rigid_gids_.size() + 1, 0);
+  std::size_t largest = 0;
+  for (std::size_t o = 0; o < rigid_gids_.size(); ++o) {
+    rigid_offset_[o + 1] = rigid_offset_[o] + rigid_gids_[o].size();
+    largest = std::max(largest, rigid_gids_[o].size());
+  }
+  rigid_points_.assign(rigid_offset_.back(), RigidPoint{});
+  rigid_scratch_.assign(2 * largest, Vec3{0, 0, 0});
+  rigid_motion_.assign(rigid_gids_.size(), RigidMotion{});
+  rigid_node_.assign(nn, 0);
+  rigid_nodes_.clear();
+  for (std::size_t n = 0; n < nn; ++n)
+    for (std::size_t o = 0; o < rigid_gids_.size(); ++o) {
+      const auto& g = rigid_gids_[o];
+      const auto it = std::lower_bound(g.begin(), g.end(), fe_.node_gid[n]);
+      if (it == g.end() || *it != fe_.node_gid[n]) continue;
+      rigid_nodes_.push_back({static_cast<int>(o), static_cast<int>(it - g.begin()),
+                              static_cast<int>(n), fe_.node_owned[n] != 0});
+      rigid_node_[n] = 1;
+      constrained_[n] = 7; // every component follows the body
+    }
+  rigid_send_.reserve(rigid_nodes_.size());
+  rigid_recv_.reserve(rigid_points_.size());
+}
+
+// The bodies' motion over the step, from every rank's owned points in each body's node
+// order (collective). Without contact (predict): the forces of t(n), v(n - 1/2) in
+// nodes_.v. With contact (correct): the contact forces added, v(n - 1/2) in v_prev_.
+void Simulation::move_rigid_bodies(bool with_contact) {
+  rigid_send_.clear();
+  for (const auto& rn : rigid_nodes_) {
+    if (!rn.owned) continue;
+    const auto n = static_cast<std::size_t>(rn.local);
+    RigidRecord r;
+    r.at = static_cast<std::int64_t>(rigid_offset_[static_cast<std::size_t>(rn.body)]) + rn.slot;
+    r.p.m = nodes_.mass[n];
+    for (int i = 0; i < 3; ++i) {
+      r.p.x[i] = nodes_.x[i][n];
+      r.p.v[i] = with_contact ? v_prev_[i][n] : nodes_.v[i][n];
+      r.p.f[i] = nodes_.f[i][n] + (with_contact ? contact_force_[i][n] : 0.0);
+    }
+    rigid_send_.push_back(r);
+  }
+  comm_.allgatherv(std::span<const RigidRecord>(rigid_send_), rigid_recv_, rigid_bytes_);
+  for (const auto& r : rigid_recv_) rigid_points_[static_cast<std::size_t>(r.at)] = r.p;
+  const Vec3 g{gravity_[0], gravity_[1], gravity_[2]};
+  for (std::size_t o = 0; o < rigid_gids_.size(); ++o) {
+    const std::span<const RigidPoint> pts(rigid_points_.data() + rigid_offset_[o],
+                                          rigid_gids_[o].size());
+    rigid_motion_[o] = rigid_motion(pts, std::span<Vec3>(rigid_scratch_.data(), 2 * pts.size()), g,
+                                    clock_.dt_prev, dt_avg_, clock_.dt);
+  }
+}
+
+} // namespace anvil
