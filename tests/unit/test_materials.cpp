@@ -146,7 +146,9 @@ TEST(Materials, SimplifiedJohnsonCookAndItsCaps) {
                 {"max_hardening_stress", 0},
                 {"saturation_stress", 0}};
   const double rate = 1000 / std::sqrt(3.0), R = 1 + 0.014 * std::log(rate);
-  for (const auto [sigmax, sigsat] : {std::array<double, 2>{0, 0}, {1.0e9, 0}, {0, 1.05e9}}) {
+  for (const auto& caps : {std::array<double, 2>{0, 0}, {1.0e9, 0}, {0, 1.05e9}}) {
+    // (Named copies: clang before 16 cannot capture a structured binding in a lambda.)
+    const double sigmax = caps[0], sigsat = caps[1];
     p["max_hardening_stress"] = sigmax;
     p["saturation_stress"] = sigsat;
     const JohnsonCook jc(p);
