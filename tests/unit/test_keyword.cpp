@@ -487,6 +487,13 @@ TEST(Keyword, RigidMaterial) {
                {"*MAT_RIGID.CMO", "not supported"});
   expect_error(with(good, elastic, "*MAT_RIGID\n1,7850.0,-2.0E+11,0.3\n\n\n"),
                {"*MAT_RIGID.E", "positive"});
+  // Keywords that drive, load or shape rigid bodies would run another model if ignored
+  // (QA round 29: a driven body ran free): errors at the keyword.
+  for (const char* k :
+       {"*BOUNDARY_PRESCRIBED_MOTION_RIGID", "*INITIAL_VELOCITY_RIGID_BODY", "*LOAD_RIGID_BODY",
+        "*PART_INERTIA", "*CONSTRAINED_RIGID_BODIES", "*CONSTRAINED_EXTRA_NODES_SET"})
+    expect_error(with(good, "*END", std::string(k) + "\n         1\n*END"),
+                 {std::string(k) + ":", "not supported"});
 }
 
 TEST(Keyword, JohnsonCookAndItsEquationOfState) {

@@ -9,8 +9,8 @@
 // The step's rotation is the Cayley transform of omega dt, an exact rotation whose
 // increment is omega x (r(n) + r(n + 1)) / 2, so that the angular momentum read back from
 // the points the next step is I(n + 1/2) omega: exactly what was set, for the inertia at
-// the mid-step that the step's omega solves for (five fixed-point iterations, each
-// shrinking the error by about omega dt / 2). The points
+// the mid-step that the step's omega solves for (fixed-point iterations until omega
+// settles, each shrinking the error by about omega dt / 2). The points
 // keep their distances to round-off, and a free body keeps its momentum and angular
 // momentum.
 #pragma once
@@ -34,6 +34,9 @@ struct RigidMotion {
   Vec3 omega;    // angular velocity over the step
   double dt = 0;
   double mass = 0;
+  // Whether omega settled (it cannot when the body would turn by about a radian or more
+  // in the step: the caller stops the run rather than lose the spin).
+  bool converged = true;
   // v(n + 1/2) of the point at x(n): it lands on centre + dt velocity + R (x - centre),
   // R the step's rotation. (R - I) r is formed as s (a x r + a x (a x r)), a = omega dt / 2,
   // s = 2 / (1 + a.a), not as R r - r: a small rotation would lose its digits to r.
@@ -41,9 +44,8 @@ struct RigidMotion {
 };
 
 // The motion from t(n) to t(n) + dt of the body whose points are `p`, under their forces
-// and the body acceleration g (dt_avg: the interval the velocity advances over). `scratch`
-// holds 2 p.size() vectors (the caller's, so that the cycle allocates nothing).
-RigidMotion rigid_motion(std::span<const RigidPoint> p, std::span<Vec3> scratch, const Vec3& g,
-                         double dt_prev, double dt_avg, double dt);
+// and the body acceleration g (dt_avg: the interval the velocity advances over).
+RigidMotion rigid_motion(std::span<const RigidPoint> p, const Vec3& g, double dt_prev,
+                         double dt_avg, double dt);
 
 } // namespace anvil

@@ -770,6 +770,17 @@ private:
     if (n == "MAT_JOHNSON_COOK" || n == "MAT_015" || n == "MAT_JOHNSON_COOK_TITLE" ||
         n == "MAT_015_TITLE")
       return mat_johnson_cook(b);
+    // Keywords that drive, load or shape rigid bodies: ignoring them would run another
+    // model (QA round 29: a driven body ran free), so they are errors.
+    for (const char* k :
+         {"BOUNDARY_PRESCRIBED_MOTION_RIGID", "INITIAL_VELOCITY_RIGID_BODY", "LOAD_RIGID_BODY",
+          "PART_INERTIA", "CONSTRAINED_RIGID_BODIES", "CONSTRAINED_EXTRA_NODES"})
+      if (starts_with(n, k))
+        throw InputError(where_of(b.head).loc("*" + b.name),
+                         fmt::format("*{} is not supported: anvil's rigid bodies (*MAT_RIGID) "
+                                     "move freely under contact, loads and gravity, with the "
+                                     "mass and inertia of their elements' nodes",
+                                     b.name));
     if (n == "MAT_RIGID" || n == "MAT_020" || n == "MAT_RIGID_TITLE" || n == "MAT_020_TITLE")
       return mat_rigid(b);
     if (n == "MAT_SIMPLIFIED_JOHNSON_COOK" || n == "MAT_098" ||

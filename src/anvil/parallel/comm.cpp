@@ -202,7 +202,10 @@ void Comm::allgather_bytes(const void* send, std::size_t bytes, void* recv) cons
 }
 void Comm::allgatherv_bytes(const void* send, std::size_t bytes, void* recv,
                             std::span<const std::int64_t> recv_bytes) const {
-  std::vector<int> counts(static_cast<std::size_t>(size_)), displ(counts.size());
+  std::vector<int>& counts = gather_counts_;
+  std::vector<int>& displ = gather_displ_;
+  counts.resize(static_cast<std::size_t>(size_));
+  displ.resize(counts.size());
   std::int64_t offset = 0;
   for (std::size_t q = 0; q < counts.size(); ++q) {
     counts[q] = to_int(static_cast<std::size_t>(recv_bytes[q]), "allgatherv");

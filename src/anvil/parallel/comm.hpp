@@ -179,6 +179,10 @@ private:
   bool owned_ = false;
   int rank_ = 0;
   int size_ = 1;
+  // allgatherv's counts and displacements in MPI's int, kept so that a call allocates
+  // nothing once they have their size (QA round 29: the rigid bodies' gather of every
+  // cycle allocated twice per call).
+  mutable std::vector<int> gather_counts_, gather_displ_;
 };
 
 } // namespace anvil

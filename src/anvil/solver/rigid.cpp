@@ -60,14 +60,17 @@ void Simulation::setup_rigid_bodies(const Mesh& mesh) {
                                        "part instead)",
                                        config_.parts[part_of_body[o]].name));
   }
+  if (!config_.rigid_walls.empty())
+    warnings_.push_back(fmt::format(
+        "{}: rigid walls do not act on rigid parts ({} here): a rigid body passes through a "
+        "wall; give the wall as a rigid part in contact instead (docs/contact.md, \"Rigid "
+        "bodies\")",
+        config_.rigid_walls[0].where.str(), config_.parts[part_of_body[0]].name));
   rigid_offset_.assign(rigid_gids_.size() + 1, 0);
-  std::size_t largest = 0;
-  for (std::size_t o = 0; o < rigid_gids_.size(); ++o) {
+  for (std::size_t o = 0; o < rigid_gids_.size(); ++o)
     rigid_offset_[o + 1] = rigid_offset_[o] + rigid_gids_[o].size();
-    largest = std::max(largest, rigid_gids_[o].size());
-  }
+  rigid_part_ = std::move(part_of_body);
   rigid_points_.assign(rigid_offset_.back(), RigidPoint{});
-  rigid_scratch_.assign(2 * largest, Vec3{0, 0, 0});
   rigid_motion_.assign(rigid_gids_.size(), RigidMotion{});
   rigid_node_.assign(nn, 0);
   rigid_nodes_.clear();
@@ -109,8 +112,13 @@ void Simulation::move_rigid_bodies(bool with_contact) {
   for (std::size_t o = 0; o < rigid_gids_.size(); ++o) {
     const std::span<const RigidPoint> pts(rigid_points_.data() + rigid_offset_[o],
                                           rigid_gids_[o].size());
-    rigid_motion_[o] = rigid_motion(pts, std::span<Vec3>(rigid_scratch_.data(), 2 * pts.size()), g,
-                                    clock_.dt_prev, dt_avg_, clock_.dt);
+    rigid_motion_[o] = rigid_motion(pts, g, clock_.dt_prev, dt_avg_, clock_.dt);
+    // (Every rank computes the same motion: every rank stops.)
+    if (!rigid_motion_[o].converged)
+      throw PhysicsError(fmt::format("rigid part {}", config_.parts[rigid_part_[o]].name),
+                         clock_.time,
+                         "it spins too fast for the time step (by about a radian or more a "
+                         "step): its angular velocity does not settle; lower time_step.scale");
   }
 }
 

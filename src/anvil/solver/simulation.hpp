@@ -331,12 +331,12 @@ private:
   };
   std::vector<std::vector<std::int64_t>> rigid_gids_;
   std::vector<std::size_t> rigid_offset_;
+  std::vector<std::size_t> rigid_part_; // the part of each body
   std::vector<RigidNode> rigid_nodes_;
   std::vector<std::uint8_t> rigid_node_;
   std::vector<RigidRecord> rigid_send_, rigid_recv_;
   std::vector<std::int64_t> rigid_bytes_;
   std::vector<RigidPoint> rigid_points_;
-  std::vector<Vec3> rigid_scratch_;
   std::vector<RigidMotion> rigid_motion_;
 
   // Element probes: (block, element) on the rank that holds the element, (-1, -1) elsewhere.
