@@ -186,6 +186,7 @@ private:
   void setup_loads(const Mesh& mesh);
   void setup_rigid_bodies(const Mesh& mesh);
   void move_rigid_bodies(bool with_contact);
+  void warn_of_thin_rigid_parts(const std::vector<std::size_t>& parts);
   void press_faces();
   void add_loads();
   void add_load_work(double dt_v, ImpulseWork& work) const;
