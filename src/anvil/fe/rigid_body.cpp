@@ -1,6 +1,5 @@
 #include "anvil/fe/rigid_body.hpp"
 
-#include <array>
 #include <cmath>
 
 namespace anvil {
@@ -92,19 +91,15 @@ RigidMotion rigid_motion(std::span<const RigidPoint> p, const Vec3& g, double dt
   // pass over the points per iteration. From I(n), fixed-point iterations until omega
   // settles (each shrinks its error by about omega dt / 2; they cannot settle when the
   // body turns by a radian or more in a step: `converged` then says so).
-  auto inertia_of = [&](const Mat3& S) {
-    Mat3 I;
+  // I = tr(S) 1 - S for the second moment S of the offsets.
+  auto inertia_of = [](const Mat3& S, Mat3& I) {
     const double tr = S[0][0] + S[1][1] + S[2][2];
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) I[i][j] = (i == j ? tr : 0.0) - S[i][j];
-    return std::to_array(
-        {I[0][0], I[0][1], I[0][2], I[1][0], I[1][1], I[1][2], I[2][0], I[2][1], I[2][2]});
   };
-  auto solve_flat = [&](const std::array<double, 9>& f) {
-    const Mat3 I = {{f[0], f[1], f[2]}, {f[3], f[4], f[5]}, {f[6], f[7], f[8]}};
-    return solve(I, L);
-  };
-  Vec3 omega = solve_flat(inertia_of(J));
+  Mat3 I;
+  inertia_of(J, I);
+  Vec3 omega = solve(I, L);
   out.converged = false;
   for (int it = 0; it < 100; ++it) {
     const Vec3 a = 0.5 * dt * omega;
@@ -123,7 +118,8 @@ RigidMotion rigid_motion(std::span<const RigidPoint> p, const Vec3& g, double dt
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j)
         for (int k = 0; k < 3; ++k) S[i][j] += QJ[i][k] * Q[j][k];
-    const Vec3 next = solve_flat(inertia_of(S));
+    inertia_of(S, I);
+    const Vec3 next = solve(I, L);
     const double change = norm(next - omega);
     omega = next;
     if (change <= 1e-14 * norm(omega)) {

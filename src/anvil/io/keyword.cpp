@@ -1156,18 +1156,9 @@ private:
     MaterialCard m = material_card(b, "j2_plasticity", l);
     elastic_fields(card, m.params, 1, 2, 3);
     const double E = m.params["youngs_modulus"];
-    const double sigy = card.real(4, "SIGY");
-    const double etan = card.real(5, "ETAN");
+    bilinear_hardening(card, E, "", m);
     const double beta = card.real(6, "BETA");
-    if (!(sigy > 0)) card.fail("SIGY", "the yield stress SIGY must be positive");
-    if (!(etan >= 0 && etan < E))
-      card.fail("ETAN",
-                fmt::format("the tangent modulus ETAN = {} must be in [0, E = {})", etan, E));
     if (!(beta >= 0 && beta <= 1)) card.fail("BETA", "BETA must be between 0 and 1");
-    m.params["yield_stress"] = sigy;
-    // Linear hardening in the uniaxial curve (slope ETAN) is plastic hardening modulus
-    // H = E ETAN / (E - ETAN) in terms of plastic strain.
-    m.params["hardening_modulus"] = etan * E / (E - etan);
     if (beta < 1)
       m.notes.push_back(fmt::format(
           "{}: material {}: BETA = {} asks for {} hardening; anvil hardens "
@@ -1181,6 +1172,36 @@ private:
     rate_form(card2, 3, mid, m);
     failure_strain_note(card2, 2, "FS", mid, m);
     add_material(card, mid, std::move(m));
+  }
+
+  // SIGY and ETAN (fields 4 and 5) of *MAT_PLASTIC_KINEMATIC and *MAT_PIECEWISE_LINEAR_
+  // PLASTICITY into m: the yield stress and, for linear hardening in the uniaxial curve
+  // (slope ETAN), the plastic hardening modulus H = E ETAN / (E - ETAN) in terms of
+  // plastic strain. `or_else` ends the SIGY message (the card's other ways to give it).
+  static void bilinear_hardening(const Card& card, double E, std::string_view or_else,
+                                 MaterialCard& m) {
+    const double sigy = card.real(4, "SIGY", 0), etan = card.real(5, "ETAN", 0);
+    if (!(sigy > 0))
+      card.fail("SIGY", fmt::format("the yield stress SIGY must be positive{}", or_else));
+    if (!(etan >= 0 && etan < E))
+      card.fail("ETAN",
+                fmt::format("the tangent modulus ETAN = {} must be in [0, E = {})", etan, E));
+    m.params["yield_stress"] = sigy;
+    m.params["hardening_modulus"] = etan * E / (E - etan);
+  }
+
+  // A, B, N, C (fields 0-3 of a Johnson-Cook card's second card) into m: the strength law
+  // (A + B ep^n) (1 + C ln rate*) of *MAT_JOHNSON_COOK and *MAT_SIMPLIFIED_JOHNSON_COOK.
+  static void johnson_cook_strength(const Card& c2, MaterialCard& m) {
+    const double A = c2.real(0, "A"), B = c2.real(1, "B"), n = c2.real(2, "N"), C = c2.real(3, "C");
+    if (!(A > 0)) c2.fail("A", "the yield stress A must be positive");
+    if (B < 0) c2.fail("B", "B must not be negative");
+    if (B > 0 && !(n > 0)) c2.fail("N", "the hardening exponent N must be positive");
+    if (C < 0) c2.fail("C", "C must not be negative");
+    m.params["A"] = A;
+    m.params["B"] = B;
+    m.params["n"] = B > 0 ? n : 1; // no hardening: the exponent does not matter
+    m.params["C"] = C;
   }
 
   // The Cowper-Symonds constants C and P of a material card into m; true when they turn
@@ -1266,22 +1287,14 @@ private:
                                     m.at.str(), mid, c1.real(4, "VP", 0)));
     const Line l2 = c.next();
     const Card c2(b, l2, {10, 10, 10, 10, 10, 10, 10, 10});
-    const double A = c2.real(0, "A"), B = c2.real(1, "B"), n = c2.real(2, "N"), C = c2.real(3, "C"),
-                 sigmax = c2.real(5, "SIGMAX", 0), sigsat = c2.real(6, "SIGSAT", 0),
+    johnson_cook_strength(c2, m);
+    const double sigmax = c2.real(5, "SIGMAX", 0), sigsat = c2.real(6, "SIGSAT", 0),
                  epso = c2.real(7, "EPSO", 0);
-    if (!(A > 0)) c2.fail("A", "the yield stress A must be positive");
-    if (B < 0) c2.fail("B", "B must not be negative");
-    if (B > 0 && !(n > 0)) c2.fail("N", "the hardening exponent N must be positive");
-    if (C < 0) c2.fail("C", "C must not be negative");
     if (!(epso > 0))
       c2.fail("EPSO", "the quasi-static threshold strain rate EPSO must be positive (in the "
                       "deck's time unit: 1.0 for 1/s)");
     if (sigmax < 0) c2.fail("SIGMAX", "SIGMAX must not be negative");
     if (sigsat < 0) c2.fail("SIGSAT", "SIGSAT must not be negative");
-    m.params["A"] = A;
-    m.params["B"] = B;
-    m.params["n"] = B > 0 ? n : 1;
-    m.params["C"] = C;
     m.params["reference_strain_rate"] = epso;
     // LS-DYNA's "no cap" is 1e28 (its default for a blank field).
     if (sigmax > 0 && sigmax < 1e27) m.params["max_hardening_stress"] = sigmax;
@@ -1364,13 +1377,7 @@ private:
                                       "is blank: the points are not used, SIGY and ETAN give "
                                       "the yield stress",
                                       m.at.str(), mid));
-      if (!(sigy > 0))
-        c1.fail("SIGY", "the yield stress SIGY must be positive (or give LCSS, or EPS and ES)");
-      if (!(etan >= 0 && etan < E))
-        c1.fail("ETAN",
-                fmt::format("the tangent modulus ETAN = {} must be in [0, E = {})", etan, E));
-      m.params["yield_stress"] = sigy;
-      m.params["hardening_modulus"] = etan * E / (E - etan); // as *MAT_PLASTIC_KINEMATIC
+      bilinear_hardening(c1, E, " (or give LCSS, or EPS and ES)", m);
     }
     add_material(c1, mid, std::move(m));
   }
@@ -1416,23 +1423,15 @@ private:
                                     m.at.str(), mid));
     const Line l2 = c.next();
     const Card c2(b, l2, {10, 10, 10, 10, 10, 10, 10, 10});
-    const double A = c2.real(0, "A"), B = c2.real(1, "B"), n = c2.real(2, "N"), C = c2.real(3, "C"),
-                 M = c2.real(4, "M"), TM = c2.real(5, "TM"), TR = c2.real(6, "TR"),
+    johnson_cook_strength(c2, m);
+    const double M = c2.real(4, "M"), TM = c2.real(5, "TM"), TR = c2.real(6, "TR"),
                  EPSO = c2.real(7, "EPSO");
-    if (!(A > 0)) c2.fail("A", "the yield stress A must be positive");
-    if (B < 0) c2.fail("B", "B must not be negative");
-    if (B > 0 && !(n > 0)) c2.fail("N", "the hardening exponent N must be positive");
-    if (C < 0) c2.fail("C", "C must not be negative");
     if (!(M > 0))
       c2.fail("M", "the thermal softening exponent M must be positive (anvil's johnson_cook "
                    "always softens; give M and TM)");
     if (!(TR > 0)) c2.fail("TR", "the room temperature TR must be positive (kelvin)");
     if (!(TM > TR)) c2.fail("TM", "the melt temperature TM must exceed the room temperature TR");
     if (!(EPSO > 0)) c2.fail("EPSO", "the reference strain rate EPSO must be positive");
-    m.params["A"] = A;
-    m.params["B"] = B;
-    m.params["n"] = B > 0 ? n : 1; // no hardening: the exponent does not matter
-    m.params["C"] = C;
     m.params["m"] = M;
     m.params["melt_temperature"] = TM;
     m.params["room_temperature"] = TR;
