@@ -433,13 +433,60 @@ copper
   // not considered").
   c = kw(with(good, elastic, "*MAT_003\n1,8930.0,117.0E+9,0.35,0.4E+9,1.0E+8,1.0\n0.0,5.0\n"));
   EXPECT_EQ(c.materials.at(0).model, "j2_plasticity");
-  // VP = 1 (viscoplastic), FAIL, TDEL: warnings.
+  // VP = 1 (viscoplastic), TDEL: warnings. FAIL: the part's erosion at that plastic strain.
   c = kw(with(good, elastic,
               "*MAT_024\n1,8930.0,117.0E+9,0.35,0.4E+9,1.0E+8,0.3,1.0E-9\n40.0,5.0,,,1\n\n\n"));
-  ASSERT_EQ(c.warnings.size(), 3u);
-  EXPECT_NE(c.warnings[0].find("FAIL"), std::string::npos) << c.warnings[0];
-  EXPECT_NE(c.warnings[1].find("TDEL"), std::string::npos) << c.warnings[1];
-  EXPECT_NE(c.warnings[2].find("VP = 1"), std::string::npos) << c.warnings[2];
+  ASSERT_EQ(c.warnings.size(), 2u);
+  EXPECT_NE(c.warnings[0].find("TDEL"), std::string::npos) << c.warnings[0];
+  EXPECT_NE(c.warnings[1].find("VP = 1"), std::string::npos) << c.warnings[1];
+  EXPECT_EQ(c.parts.at(0).erosion.plastic_strain, 0.3);
+  EXPECT_FALSE(c.parts.at(0).erosion.inverted);
+}
+
+// *CONTROL_TERMINATION's DTMIN (LS-DYNA manual: the run ends when the step falls below
+// DTMIN times the initial one) is anvil's time_step.minimum_fraction; ENDENG and ENDMAS
+// (stops anvil does not make) are warnings, NOSOL an error.
+TEST(Keyword, TerminationMinimumStep) {
+  EXPECT_EQ(kw(good).time_step_minimum_fraction, 0);
+  Config c = kw(with(good, "   1.0E-04\n", "   1.0E-04         0      0.05\n"));
+  EXPECT_EQ(c.time_step_minimum_fraction, 0.05);
+  EXPECT_EQ(c.end_time, 1e-4);
+  EXPECT_TRUE(c.warnings.empty()) << c.warnings.at(0);
+  expect_error(with(good, "   1.0E-04\n", "   1.0E-04         0       1.0\n"),
+               {"*CONTROL_TERMINATION.DTMIN", "[0, 1)"});
+  expect_error(with(good, "   1.0E-04\n", "1.0E-04,0,-0.1\n"),
+               {"*CONTROL_TERMINATION.DTMIN", "[0, 1)"});
+  c = kw(with(good, "   1.0E-04\n", "1.0E-04,0,0.0,0.1,0.2\n"));
+  ASSERT_EQ(c.warnings.size(), 2u);
+  EXPECT_NE(c.warnings[0].find("ENDENG"), std::string::npos) << c.warnings[0];
+  EXPECT_NE(c.warnings[1].find("ENDMAS"), std::string::npos) << c.warnings[1];
+  expect_error(with(good, "   1.0E-04\n", "1.0E-04,0,0.0,0.0,0.0,1\n"),
+               {"*CONTROL_TERMINATION.NOSOL", "anvil check"});
+}
+
+// The failure strains of the plastic materials (FS of MAT_003, FAIL of MAT_024, PSFAIL of
+// MAT_098; LS-DYNA manual: "effective plastic strain for eroding elements") are anvil's
+// part key erosion.plastic_strain on every part of the material; 0, blank and LS-DYNA's
+// "never" defaults (1e17, 1e20) are no erosion; negative values (user failure
+// subroutines) are errors.
+TEST(Keyword, FailureStrainErodes) {
+  const std::string elastic = "*MAT_ELASTIC\n         1    7850.0   2.0E+11       0.3\n";
+  const std::string mat003 = "*MAT_003\n1,8930.0,117.0E+9,0.35,0.4E+9,1.0E+8,1.0\n0.0,0.0,";
+  Config c = kw(with(good, elastic, mat003 + "0.45\n"));
+  EXPECT_EQ(c.parts.at(0).erosion.plastic_strain, 0.45);
+  EXPECT_TRUE(c.warnings.empty()) << c.warnings.at(0);
+  for (const char* never : {"", "0.0", "1.0E+20", "1.0E+17"}) {
+    c = kw(with(good, elastic, mat003 + never + "\n"));
+    EXPECT_EQ(c.parts.at(0).erosion.plastic_strain, 0) << never;
+    EXPECT_FALSE(c.parts.at(0).erosion.enabled()) << never;
+  }
+  expect_error(with(good, elastic, mat003 + "-1.0\n"), {"*MAT_003.FS", "not supported"});
+  expect_error(with(good, elastic, "*MAT_024\n1,8930.0,117.0E+9,0.35,0.4E+9,1.0E+8,-1.0\n\n\n\n"),
+               {"*MAT_024.FAIL", "not supported"});
+  c = kw(with(good, elastic,
+              "*MAT_098\n1,7830.0,2.0E+11,0.29\n7.92E+8,5.1E+8,0.26,0.014,0.8,,,1.0\n"));
+  EXPECT_EQ(c.parts.at(0).erosion.plastic_strain, 0.8);
+  EXPECT_TRUE(c.warnings.empty()) << c.warnings.at(0);
 }
 
 // *MAT_SIMPLIFIED_JOHNSON_COOK (MAT_098): anvil's johnson_cook without its thermal terms,
@@ -459,12 +506,11 @@ TEST(Keyword, SimplifiedJohnsonCook) {
   EXPECT_EQ(m.params.at("saturation_stress"), 0); // 1e28: none
   EXPECT_EQ(m.params.at("melt_temperature"), 0);  // no thermal terms
   EXPECT_TRUE(c.warnings.empty()) << c.warnings.at(0);
-  // PSFAIL, VP: warnings; EPSO blank: an error (no default in LS-DYNA's manual).
-  c = kw(with(good, elastic,
-              "*MAT_098\n1,7830.0,2.0E+11,0.29,1\n7.92E+8,5.1E+8,0.26,0.014,0.8,,,1.0\n"));
-  ASSERT_EQ(c.warnings.size(), 2u);
+  // VP: a warning; EPSO blank: an error (no default in LS-DYNA's manual).
+  c = kw(
+      with(good, elastic, "*MAT_098\n1,7830.0,2.0E+11,0.29,1\n7.92E+8,5.1E+8,0.26,0.014,,,,1.0\n"));
+  ASSERT_EQ(c.warnings.size(), 1u);
   EXPECT_NE(c.warnings[0].find("VP = 1"), std::string::npos) << c.warnings[0];
-  EXPECT_NE(c.warnings[1].find("PSFAIL"), std::string::npos) << c.warnings[1];
   expect_error(with(good, elastic, "*MAT_098\n1,7830.0,2.0E+11,0.29\n7.92E+8,5.1E+8,0.26,0.014\n"),
                {"*MAT_098.EPSO", "must be positive"});
   expect_error(
@@ -1212,15 +1258,14 @@ TEST(Keyword, AProbeOnANodeNoElementUsesIsAnError) {
   EXPECT_NE(c.warnings[0].find("node 777"), std::string::npos) << c.warnings[0];
 }
 
-// Message nits (QA round 5, item 7): the failure warnings do not deny anvil's erosion
-// (deck.md documents it); a blank EID is called blank; a UTF-8 byte-order mark is skipped;
+// Message nits (QA round 5, item 7): FS is no longer a warning but the part's erosion
+// (Keyword.FailureStrainErodes); a blank EID is called blank; a UTF-8 byte-order mark is skipped;
 // a D3PLOT LCDT curve and a repeated control keyword are warned of (keyword.md says why).
 TEST(Keyword, MessageNits) {
   const Config pk = kw(with(good, "*MAT_ELASTIC\n         1    7850.0   2.0E+11       0.3\n",
                             "*MAT_003\n1,8930.0,117.0E+9,0.35,0.4E+9,1.0E+8,1.0\n0,0,0.8\n"));
-  ASSERT_EQ(pk.warnings.size(), 1u);
-  EXPECT_EQ(pk.warnings[0].find("does not erode"), std::string::npos) << pk.warnings[0];
-  EXPECT_NE(pk.warnings[0].find("erosion"), std::string::npos) << pk.warnings[0];
+  EXPECT_TRUE(pk.warnings.empty()) << pk.warnings.at(0);
+  EXPECT_EQ(pk.parts.at(0).erosion.plastic_strain, 0.8);
   expect_error(
       with(good, "       1       1       1       2", "                 1       1       1       2"),
       {"model.k:30: *ELEMENT_SOLID.EID", "EID is blank", "I10=Y"});

@@ -17,8 +17,12 @@
 //   and the hardening modulus the keyword reader derives, the two runs are the same bits.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <span>
 
 #include <fmt/format.h>
 
@@ -134,10 +138,11 @@ TEST(KeywordTaylorBar, RunsLikeTheYamlDeck) {
   EXPECT_LT(test::relative_error(a.kinetic, b.kinetic), 2e-8);
 }
 
-TEST(KeywordTaylorBar, SameMeshAndMaterialGiveTheSameBits) {
-  const Comm world = Comm::world();
-  const Config k = read_input(decks() + "taylor_bar.k");
-  const std::string yaml = fmt::format(R"(title: Taylor bar, copper, 227 m/s
+// The YAML deck of the keyword deck k with the keyword file's own mesh; `part_extra` is
+// added to the part's keys.
+Config same_mesh_yaml(const Config& k, const std::string& part_extra = "") {
+  const std::string yaml =
+      fmt::format(R"(title: Taylor bar, copper, 227 m/s
 termination: {{time: 8.0e-5}}
 time_step: {{scale: 0.9}}
 materials:
@@ -147,7 +152,7 @@ parts:
   bar:
     mesh: {{file: {}taylor_bar_mesh.k}}
     material: copper
-    hourglass: {{model: viscous, coefficient: 0.05}}
+    hourglass: {{model: viscous, coefficient: 0.05}}{}
 node_sets:
   impact_face: {{part: bar, box: {{min: [-1, -1, -1.0e-9], max: [1, 1, 1.0e-9]}}}}
 initial_conditions:
@@ -155,8 +160,14 @@ initial_conditions:
 boundary_conditions:
   - {{set: impact_face, fix: [z]}}
 )",
-                                       k.materials[0].params.at("hardening_modulus"), decks());
-  const Config y = parse_deck(yaml, "same_mesh.yaml");
+                  k.materials[0].params.at("hardening_modulus"), decks(), part_extra);
+  return parse_deck(yaml, "same_mesh.yaml");
+}
+
+TEST(KeywordTaylorBar, SameMeshAndMaterialGiveTheSameBits) {
+  const Comm world = Comm::world();
+  const Config k = read_input(decks() + "taylor_bar.k");
+  const Config y = same_mesh_yaml(k);
   Simulation sk(k, world), sy(y, world);
   run_cycles(sk);
   run_cycles(sy);
@@ -164,6 +175,37 @@ boundary_conditions:
   const Compare c = compare(sk, sy);
   EXPECT_TRUE(c.same_bits) << "max position difference " << c.dx;
   EXPECT_EQ(sk.clock().time, sy.clock().time);
+}
+
+// FS of *MAT_PLASTIC_KINEMATIC (LS-DYNA: "effective plastic strain for eroding elements")
+// is the YAML part key erosion.plastic_strain: with FS = 0.3 the keyword deck erodes the
+// same elements as the YAML deck with `erosion: {plastic_strain: 0.3}`, to the bit. (The
+// impact face passes 0.3 within the 300 cycles: elements must have eroded.)
+TEST(KeywordTaylorBar, FailureStrainErodesLikeTheYamlKey) {
+  const Comm world = Comm::world();
+  std::ifstream in(decks() + "taylor_bar.k");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string fs_card = "       0.0       0.0       0.0       0.0\n";
+  const auto at = text.find(fs_card);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, fs_card.size(), "       0.0       0.0       0.3       0.0\n");
+  const Config k = parse_keyword_deck(text, decks() + "taylor_bar_fs.k", decks());
+  ASSERT_EQ(k.parts.at(0).erosion.plastic_strain, 0.3);
+  const Config y = same_mesh_yaml(k, "\n    erosion: {plastic_strain: 0.3}");
+  Simulation sk(k, world), sy(y, world);
+  run_cycles(sk);
+  run_cycles(sy);
+  ASSERT_EQ(sk.clock().cycle, sy.clock().cycle);
+  std::array<std::int64_t, 2> eroded{sk.eroded_local(), sy.eroded_local()};
+  world.sum(std::span<std::int64_t>(eroded));
+  const auto [eroded_k, eroded_y] = eroded;
+  if (world.rank() == 0)
+    std::printf("FS = 0.3: %lld elements eroded in %d cycles (YAML deck: %lld)\n",
+                static_cast<long long>(eroded_k), cycles, static_cast<long long>(eroded_y));
+  EXPECT_GT(eroded_k, 0);
+  EXPECT_EQ(eroded_k, eroded_y);
+  const Compare c = compare(sk, sy);
+  EXPECT_TRUE(c.same_bits) << "max position difference " << c.dx;
 }
 
 } // namespace

@@ -567,6 +567,8 @@ struct MaterialCard {
   Where at;
   TableValues tables;
   bool rigid = false; // *MAT_RIGID: its parts are rigid bodies
+  // FS, FAIL, PSFAIL: the plastic strain at which its parts' elements erode (0: never).
+  double failure_strain = 0;
   // *MAT_PIECEWISE_LINEAR_PLASTICITY's LCSS: the hardening curve, read from its
   // *DEFINE_CURVE when a part uses the material (0: none).
   std::int64_t lcss = 0;
@@ -1170,7 +1172,7 @@ private:
     // Cowper-Symonds: anvil's piecewise_linear_plasticity in its bilinear form.
     if (cowper_symonds(card2, 0, "SRC", 1, "SRP", m)) m.model = "piecewise_linear_plasticity";
     rate_form(card2, 3, mid, m);
-    failure_strain_note(card2, 2, "FS", mid, m);
+    failure_strain(card2, 2, "FS", m);
     add_material(card, mid, std::move(m));
   }
 
@@ -1234,17 +1236,18 @@ private:
                                     m.at.str(), mid, vp));
   }
 
-  // FS of MAT_003, FAIL of MAT_024, PSFAIL of MAT_098: not mapped to anvil's erosion (0,
-  // and LS-DYNA's 1e17 default of PSFAIL, are no failure).
-  static void failure_strain_note(const Card& card, int field, const char* name, std::int64_t mid,
-                                  MaterialCard& m) {
+  // FS of MAT_003, FAIL of MAT_024, PSFAIL of MAT_098: the effective plastic strain at
+  // which an element is deleted, anvil's part key erosion.plastic_strain for every part of
+  // the material (0, blank, and LS-DYNA's "never" defaults 1e17 and 1e20 are no failure).
+  static void failure_strain(const Card& card, int field, const char* name, MaterialCard& m) {
     const double strain = card.real(field, name, 0);
+    if (strain < 0)
+      card.fail(name, fmt::format("{} = {} (a user failure subroutine or LS-DYNA's other "
+                                  "failure forms) is not supported: give the effective plastic "
+                                  "strain at failure, or 0 for none",
+                                  name, strain));
     if (strain == 0 || strain >= 1e16) return;
-    m.notes.push_back(fmt::format("{}: material {}: the failure strain {} is ignored: a keyword "
-                                  "deck does not map it to anvil's erosion, so these elements are "
-                                  "never deleted (a YAML deck's part key "
-                                  "`erosion: {{plastic_strain: ...}}` deletes them)",
-                                  m.at.str(), mid, name));
+    m.failure_strain = strain;
   }
 
   // MID, RO, E, PR, N, COUPLE, M, ALIAS; CMO, CON1, CON2; LCO or A1-A6 (LS-DYNA manual,
@@ -1299,7 +1302,7 @@ private:
     // LS-DYNA's "no cap" is 1e28 (its default for a blank field).
     if (sigmax > 0 && sigmax < 1e27) m.params["max_hardening_stress"] = sigmax;
     if (sigsat > 0 && sigsat < 1e27) m.params["saturation_stress"] = sigsat;
-    failure_strain_note(c2, 4, "PSFAIL", mid, m);
+    failure_strain(c2, 4, "PSFAIL", m);
     add_material(c1, mid, std::move(m));
   }
 
@@ -1317,7 +1320,7 @@ private:
     elastic_fields(c1, m.params, 1, 2, 3);
     const double E = m.params["youngs_modulus"];
     const double sigy = c1.real(4, "SIGY", 0), etan = c1.real(5, "ETAN", 0);
-    failure_strain_note(c1, 6, "FAIL", mid, m);
+    failure_strain(c1, 6, "FAIL", m);
     if (c1.real(7, "TDEL", 0) != 0)
       m.notes.push_back(fmt::format("{}: material {}: TDEL (the time step below which elements "
                                     "are deleted) is ignored",
@@ -1448,10 +1451,10 @@ private:
     failure = failure || c4.real(0, "D5") != 0 || c4.real(2, "EROD") != 0;
     if (failure)
       m.notes.push_back(fmt::format("{}: material {}: spall (PC, SPALL) and damage (D1-D5, "
-                                    "EROD) are ignored: anvil's johnson_cook has no damage, and "
-                                    "a keyword deck does not set anvil's erosion (a YAML deck's "
-                                    "part key `erosion: {{plastic_strain: ...}}` deletes elements "
-                                    "at a plastic strain)",
+                                    "EROD) are ignored: anvil's johnson_cook has no damage, so "
+                                    "these elements are never deleted (anvil erodes at a plastic "
+                                    "strain: the FAIL of *MAT_024 or a YAML deck's part key "
+                                    "`erosion: {{plastic_strain: ...}}`)",
                                     m.at.str(), mid));
     add_material(c1, mid, std::move(m));
   }
@@ -2418,6 +2421,22 @@ private:
     endcyc_ = card.integer(1, "ENDCYC", 0);
     if (endtim_ < 0) card.fail("ENDTIM", "ENDTIM must not be negative");
     if (endcyc_ < 0) card.fail("ENDCYC", "ENDCYC must not be negative");
+    // DTMIN: the run stops when the step falls below DTMIN times the initial one (anvil's
+    // time_step.minimum_fraction; LS-DYNA writes a restart dump there, anvil a checkpoint).
+    dtmin_ = card.real(2, "DTMIN", 0);
+    if (!(dtmin_ >= 0 && dtmin_ < 1))
+      card.fail("DTMIN", "DTMIN must be in [0, 1): a fraction of the initial time step");
+    if (card.real(3, "ENDENG", 0) != 0)
+      warnings_.push_back(fmt::format("{}: ENDENG (stop at a change of the total energy) is "
+                                      "ignored: the run goes on to ENDTIM or ENDCYC",
+                                      where_of(l).str()));
+    if (card.real(4, "ENDMAS", 0) != 0)
+      warnings_.push_back(fmt::format("{}: ENDMAS (stop at a mass increase of mass scaling) is "
+                                      "ignored: anvil does not scale masses",
+                                      where_of(l).str()));
+    if (card.integer(5, "NOSOL", 0) != 0)
+      card.fail("NOSOL", "NOSOL (a run that reads the deck and writes no solution) is not "
+                         "supported: use `anvil check`");
     termination_at_ = where_of(l);
     have_termination_ = true;
   }
@@ -2686,6 +2705,7 @@ private:
   double endtim_ = 0;
   std::int64_t endcyc_ = 0;
   double tssfac_ = 0.9;
+  double dtmin_ = 0; // *CONTROL_TERMINATION DTMIN
   std::int64_t control_ihq_ = 0;
   double control_qh_ = 0, control_q1_ = 0, control_q2_ = 0;
   double d3plot_dt_ = 0, history_dt_ = 0;
@@ -2756,6 +2776,7 @@ Config KeywordReader::config(const std::string& deck_file) {
   if (endtim_ > 0) c.end_time = endtim_;
   if (endcyc_ > 0) c.end_cycles = endcyc_;
   c.time_step_scale = tssfac_;
+  c.time_step_minimum_fraction = dtmin_;
 
   // Parts with solid elements; the others (shells, beams, ...) are left out.
   std::map<std::int64_t, std::size_t> solids;
@@ -2904,6 +2925,7 @@ Config KeywordReader::config(const std::string& deck_file) {
     }
     pc.material = mname;
     pc.rigid = mc.rigid;
+    pc.erosion.plastic_strain = mc.failure_strain;
 
     // Hourglass and bulk viscosity: the part's *HOURGLASS, else the *CONTROL_ cards, else
     // LS-DYNA's defaults (which are anvil's: viscous 0.1, Q1 1.5, Q2 0.06).
