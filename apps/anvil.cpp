@@ -108,10 +108,27 @@ int check(const std::string& deck, const anvil::Comm& comm) {
   std::printf("ranks       %d\n", comm.size());
   std::printf("nodes       %lld\n", static_cast<long long>(sim.global_nodes()));
   std::printf("elements    %lld\n", static_cast<long long>(sim.global_elements()));
-  for (std::size_t i = 0; i < config.parts.size(); ++i)
-    std::printf("  part %-16s material %-16s mass %.6g kg%s\n", config.parts[i].name.c_str(),
+  for (std::size_t i = 0; i < config.parts.size(); ++i) {
+    const double added = sim.part_added_masses()[i];
+    std::printf("  part %-16s material %-16s mass %.6g kg%s%s\n", config.parts[i].name.c_str(),
                 config.parts[i].material.c_str(), sim.part_masses()[i],
+                added > 0 ? fmt::format(" + {:.6g} kg mass scaling ({:.3g}%)", added,
+                                        100 * added / sim.part_masses()[i])
+                                .c_str()
+                          : "",
                 config.parts[i].rigid ? "  rigid body" : "");
+  }
+  if (config.mass_scaling_step > 0) {
+    double added = 0, mass = 0;
+    for (std::size_t i = 0; i < config.parts.size(); ++i) {
+      added += sim.part_added_masses()[i];
+      mass += sim.part_masses()[i];
+    }
+    std::printf("mass scaling step %g s: %lld elements scaled, %.6g kg added (%.3g%% of the "
+                "elements' mass)\n",
+                config.mass_scaling_step, static_cast<long long>(sim.mass_scaled_elements()), added,
+                100 * added / mass);
+  }
   if (const auto* sph = sim.sph()) {
     const auto& off = sph->set_offsets();
     std::printf("particles   %lld\n", static_cast<long long>(sph->global_count()));

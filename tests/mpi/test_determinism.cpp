@@ -214,6 +214,23 @@ TEST(Determinism, SameBitsOnAnyRankCount) {
   EXPECT_GT(max_ep, 0.01);
 }
 
+// Mass scaling (time_step.mass_scaling) to a step that scales about half the elements of
+// the FE deck: each element's factor comes from its own step at rest, the nodes' masses
+// are gathered in global element order, so the run keeps its bits.
+TEST(Determinism, MassScalingSameBitsOnAnyRankCount) {
+  Config config =
+      test::deck(std::string("time_step: {mass_scaling: {step: 1.0e-7}}\n") + deck_text);
+  double max_ep = 0;
+  const std::int64_t differing = compare_with_serial(config, &max_ep);
+  EXPECT_EQ(differing, 0) << "values differing from the 1-rank run on " << Comm::world().size()
+                          << " ranks";
+  if (Comm::world().rank() == 0) EXPECT_GT(max_ep, 0.01);
+  const Comm self = Comm::self();
+  Simulation sim(config, self);
+  EXPECT_GT(sim.mass_scaled_elements(), 0);
+  EXPECT_LT(sim.mass_scaled_elements(), sim.global_elements());
+}
+
 // Eroding contact (examples/eroding_penetration.yaml to 12 us): elements erode on every
 // rank's part of the target and the faces they covered join the contact surfaces
 // (ContactPhase::set_eroded); the same bits as on one rank, exactly.

@@ -163,6 +163,15 @@ TEST(Deck, ImpossibleValues) {
                {"deck.yaml:6", "poissons_ratio", "< 0.5"});
   expect_error("radius: 3.2e-3", "radius: 0", {"deck.yaml:9", "radius", "positive"});
   expect_error("scale: 0.9", "scale: 1.5", {"deck.yaml:3", "time_step.scale"});
+  // Mass scaling: a positive step, and only `step`.
+  expect_error("scale: 0.9", "scale: 0.9, mass_scaling: {step: -1.0e-7}",
+               {"deck.yaml:3", "time_step.mass_scaling.step", "positive"});
+  expect_error("scale: 0.9", "scale: 0.9, mass_scaling: {}",
+               {"deck.yaml:3", "time_step.mass_scaling", "give `step`"});
+  expect_error("scale: 0.9", "scale: 0.9, mass_scaling: {step: 1.0e-7, every_cycle: true}",
+               {"deck.yaml:3", "time_step.mass_scaling.every_cycle", "unknown key"});
+  expect_error("scale: 0.9", "scale: 0.9, mass_scaling: 1.0e-7",
+               {"deck.yaml:3", "time_step.mass_scaling"});
   // (QA round 22: accepted, and the run ended before its first step with status 0.)
   expect_error("termination: {time: 8.0e-5}", "termination: {time: 8.0e-5, cycles: 0}",
                {"deck.yaml:2", "termination.cycles", "at least 1"});

@@ -464,6 +464,26 @@ TEST(Keyword, TerminationMinimumStep) {
                {"*CONTROL_TERMINATION.NOSOL", "anvil check"});
 }
 
+// *CONTROL_TIMESTEP's DT2MS < 0 (LS-DYNA manual: "TSSFAC*|DT2MS| is the minimum time step
+// size permitted and mass scaling is done if and only if it is necessary") is anvil's
+// time_step.mass_scaling.step; anvil scales at t = 0 only, LS-DYNA's MS1ST = 1, so
+// MS1ST = 0 (its default) warns. DT2MS > 0 is ignored with a warning.
+TEST(Keyword, MassScaling) {
+  const std::string card = "       0.0       0.8\n";
+  EXPECT_EQ(kw(good).mass_scaling_step, 0);
+  Config c = kw(with(good, card, "       0.0       0.8       0.0       0.0  -1.0E-07\n"));
+  EXPECT_DOUBLE_EQ(c.mass_scaling_step, 0.8e-7);
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("MS1ST = 1"), std::string::npos) << c.warnings[0];
+  c = kw(with(good, card, "0.0,0.8,0,0.0,-1.0E-07,0,0,1\n"));
+  EXPECT_DOUBLE_EQ(c.mass_scaling_step, 0.8e-7);
+  EXPECT_TRUE(c.warnings.empty()) << c.warnings.at(0);
+  c = kw(with(good, card, "0.0,0.8,0,0.0,1.0E-07\n"));
+  EXPECT_EQ(c.mass_scaling_step, 0);
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("DT2MS > 0"), std::string::npos) << c.warnings[0];
+}
+
 // The failure strains of the plastic materials (FS of MAT_003, FAIL of MAT_024, PSFAIL of
 // MAT_098; LS-DYNA manual: "effective plastic strain for eroding elements") are anvil's
 // part key erosion.plastic_strain on every part of the material; 0, blank and LS-DYNA's

@@ -376,6 +376,8 @@ int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array
   corner_rows.assign(p / width, 1);
   volume.assign(p, 0.0);
   alive.assign(p, 1.0);
+  mass_scale.clear();
+  wave_scale.clear();
   hex_volumes(*this, x, volume);
   const double rho = material->elastic().density;
   mass.assign(p, 0.0);
@@ -485,6 +487,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
     for (int k = 0; k < 6; ++k) ps[p][k] = b.point_stress[p][k].data();
   const bool has_ep = !b.plastic_strain.empty(), has_T = !b.temperature.empty();
   const bool erode_ep = b.erosion.plastic_strain > 0 && has_ep;
+  const bool scaled = !b.wave_scale.empty(); // mass scaling
   // Nodal assembly (HexWorkspace::begin_nodal_forces), or null.
   double* const sums = work.assembled_nodes_ >= 0 ? work.sums_.data() : nullptr;
   const std::uint8_t* rows = b.corner_rows.data();
@@ -661,9 +664,12 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         for (auto& x : row) x *= 1.0 / 12.0;
       const vdouble vol = vol12 * (1.0 / 12.0);
       const vdouble inv = 1.0 / vol;
-      const vdouble mass = simd::load(&b.mass[e]);
+      const vdouble mass =
+          scaled ? simd::load(&b.mass[e]) * simd::load(&b.mass_scale[e]) : simd::load(&b.mass[e]);
       const vdouble rho = mass * inv;
-      const vdouble c = simd::load(scratch(s_wave_speed) + l);
+      const vdouble c = scaled
+                            ? simd::load(scratch(s_wave_speed) + l) * simd::load(&b.wave_scale[e])
+                            : simd::load(scratch(s_wave_speed) + l);
       vdouble d[6], s[6];
       _Pragma("GCC unroll 12") for (int k = 0; k < 6; ++k) d[k] = simd::load(scratch(s_d0 + k) + l);
       // Thick shell: the element's stress is the points' average, formed here with their
@@ -886,7 +892,8 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         const vdouble hh = (hhd[0] + hhd[1]) + hhd[2];
         const vdouble cheap = hex8::hourglass_damping_bound_frobenius(bb, hh);
         dte = step(cheap);
-        if (stdx::any_of(dte <= best_dt)) {
+        // (Every element's own step, where the caller asks for each: formed everywhere.)
+        if (result.element_dt || stdx::any_of(dte <= best_dt)) {
           vdouble Bc[3][8];
           _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a)
               _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) Bc[i][a] =
@@ -930,6 +937,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       // With nodal assembly, the rows go to the corner slots only where the block asks for
       // them (corner_rows) and otherwise to the stage scratch, for the assembly after the
       // bookkeeping (which may erode an element).
+      if (result.element_dt) simd::store(dte, result.element_dt + e);
       vdouble check = dte;
       const bool slots = !sums || rows[e / W] != 0;
       _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) {

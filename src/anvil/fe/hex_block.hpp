@@ -72,9 +72,15 @@ struct HexBlock {
   ThickShell thick_shell;
   bool rigid = false; // a rigid body's elements: no stress, no forces, no step (skipped)
 
-  std::vector<std::int64_t> gid;                       // global element ids, ascending
-  std::array<std::vector<int>, 8> conn;                // local node index of each corner
-  std::vector<double> mass;                            // kg
+  std::vector<std::int64_t> gid;        // global element ids, ascending
+  std::array<std::vector<int>, 8> conn; // local node index of each corner
+  std::vector<double> mass;             // kg
+  // Mass scaling (docs/deck.md, time_step.mass_scaling): empty, or per element the
+  // factor f that the nodes' share of the element's mass and its inertia in the kernel
+  // (bulk viscosity, hourglass damping, stable step) take, as from a density f times its
+  // material's, and 1 / sqrt f, which scales its material's wave speed there. `mass` and
+  // the density the material sees stay physical.
+  std::vector<double> mass_scale, wave_scale;
   std::vector<double> volume;                          // current volume, m^3
   std::vector<double> alive;                           // 1, or 0 once eroded
   std::int64_t eroded = 0;                             // elements with alive 0
@@ -102,6 +108,10 @@ struct HexBlock {
                                          // all; see HexWorkspace::begin_nodal_forces)
 
   int size() const { return static_cast<int>(gid.size()); }
+  // Element e's mass with mass scaling's (what its nodes carry), kg.
+  double scaled_mass(std::size_t e) const {
+    return mass_scale.empty() ? mass[e] : mass[e] * mass_scale[e];
+  }
 
   // Sets the elements (ascending global ids and their corners as local node indices)
   // and the corner slot base, sizes and zeroes the state (padded to whole vectors), and
@@ -148,6 +158,9 @@ struct HexResult {
                                    // centre Jacobian, or -1
   std::int64_t nonfinite_gid = -1; // first element with a non-finite force or stress, or -1
   std::int64_t eroded = 0;         // elements eroded in this call
+  // Optional out (set up, not the cycle): each element's stable step, written at
+  // element_dt[e] for e in [0, padded size) of every block the call covers (eroded: 1e300).
+  double* element_dt = nullptr;
 };
 
 class HexWorkspace;

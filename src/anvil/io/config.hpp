@@ -217,9 +217,12 @@ struct Config {
   std::int64_t end_cycles = std::numeric_limits<std::int64_t>::max();
   double time_step_scale = 0.9;
   double time_step_minimum_fraction = 0; // stop when dt < this * initial dt (0: never)
-  double fields_every = 0;               // 0: first and last only
-  double checkpoint_every = 0;           // 0: checkpoints only when stopped by a signal
-  double history_every = 0;              // 0: every cycle
+  // Mass scaling at t = 0 (0: none): elements whose step would be below this get the mass
+  // that raises it to this (LS-DYNA's DT2MS < 0 with MS1ST = 1: TSSFAC |DT2MS|), s.
+  double mass_scaling_step = 0;
+  double fields_every = 0;     // 0: first and last only
+  double checkpoint_every = 0; // 0: checkpoints only when stopped by a signal
+  double history_every = 0;    // 0: every cycle
   OutputFormat output_format = OutputFormat::vtu;
   bool part_energies = false; // history.csv columns of each part's energies (LS-DYNA's matsum)
   std::vector<MaterialConfig> materials;

@@ -786,7 +786,13 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 
   if (top.has("time_step")) {
     const Node ts = top.child("time_step");
-    ts.check_keys({"scale", "minimum_fraction"});
+    ts.check_keys({"scale", "minimum_fraction", "mass_scaling"});
+    if (ts.has("mass_scaling")) {
+      const Node ms = ts.child("mass_scaling");
+      ms.check_keys({"step"});
+      if (!ms.has("step")) ms.fail("give `step`: the smallest time step the run takes, s");
+      c.mass_scaling_step = ms.child("step").positive();
+    }
     if (ts.has("minimum_fraction")) {
       c.time_step_minimum_fraction = ts.child("minimum_fraction").number();
       if (!(c.time_step_minimum_fraction >= 0 && c.time_step_minimum_fraction < 1))

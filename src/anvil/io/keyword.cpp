@@ -2432,7 +2432,8 @@ private:
                                       where_of(l).str()));
     if (card.real(4, "ENDMAS", 0) != 0)
       warnings_.push_back(fmt::format("{}: ENDMAS (stop at a mass increase of mass scaling) is "
-                                      "ignored: anvil does not scale masses",
+                                      "ignored: anvil adds mass once, at t = 0, and reports it "
+                                      "(`anvil check`, summary.json)",
                                       where_of(l).str()));
     if (card.integer(5, "NOSOL", 0) != 0)
       card.fail("NOSOL", "NOSOL (a run that reads the deck and writes no solution) is not "
@@ -2451,10 +2452,27 @@ private:
         card.fail("TSSFAC", "TSSFAC must be in (0, 1]: a fraction of the stable time step");
       tssfac_ = tssfac;
     }
-    if (card.real(4, "DT2MS") != 0)
-      warnings_.push_back(fmt::format("{}: DT2MS (mass scaling) is ignored: anvil takes the "
-                                      "stable time step of the unscaled mass",
+    // DT2MS < 0: mass scaling, anvil's time_step.mass_scaling with the step TSSFAC |DT2MS|,
+    // scaled once at t = 0 (LS-DYNA's MS1ST = 1; its default rescales every cycle).
+    // DT2MS > 0 (mass added to and taken from every element): not supported.
+    const double dt2ms = card.real(4, "DT2MS", 0);
+    mass_scaling_dt2ms_ = 0;
+    if (!std::isfinite(dt2ms)) card.fail("DT2MS", "DT2MS must be a finite number");
+    if (dt2ms > 0)
+      warnings_.push_back(fmt::format("{}: DT2MS > 0 (mass added to and taken from every "
+                                      "element) is ignored: anvil takes the stable time step of "
+                                      "the unscaled mass (DT2MS < 0, mass added where needed, "
+                                      "is supported)",
                                       where_of(l).str()));
+    if (dt2ms < 0) {
+      mass_scaling_dt2ms_ = -dt2ms;
+      if (card.integer(7, "MS1ST", 0) == 0)
+        warnings_.push_back(fmt::format(
+            "{}: DT2MS < 0: anvil adds the mass once, at t = 0, to the elements at rest in their "
+            "initial shape (LS-DYNA's MS1ST = 1); LS-DYNA's default (MS1ST = 0) adds mass every "
+            "cycle, so that crushed elements keep the step TSSFAC |DT2MS|: here their step falls",
+            where_of(l).str()));
+    }
     if (card.integer(5, "LCTM", 0) != 0)
       warnings_.push_back(
           fmt::format("{}: LCTM (a time step limit curve) is ignored", where_of(l).str()));
@@ -2705,7 +2723,8 @@ private:
   double endtim_ = 0;
   std::int64_t endcyc_ = 0;
   double tssfac_ = 0.9;
-  double dtmin_ = 0; // *CONTROL_TERMINATION DTMIN
+  double dtmin_ = 0;              // *CONTROL_TERMINATION DTMIN
+  double mass_scaling_dt2ms_ = 0; // |DT2MS| of *CONTROL_TIMESTEP when DT2MS < 0
   std::int64_t control_ihq_ = 0;
   double control_qh_ = 0, control_q1_ = 0, control_q2_ = 0;
   double d3plot_dt_ = 0, history_dt_ = 0;
@@ -2777,6 +2796,7 @@ Config KeywordReader::config(const std::string& deck_file) {
   if (endcyc_ > 0) c.end_cycles = endcyc_;
   c.time_step_scale = tssfac_;
   c.time_step_minimum_fraction = dtmin_;
+  c.mass_scaling_step = tssfac_ * mass_scaling_dt2ms_;
 
   // Parts with solid elements; the others (shells, beams, ...) are left out.
   std::map<std::int64_t, std::size_t> solids;

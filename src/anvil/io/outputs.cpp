@@ -671,6 +671,18 @@ void Outputs::write_summary(int status, const std::string& message) {
   for (std::size_t i = 0; i < sim_.config().parts.size(); ++i)
     masses[sim_.config().parts[i].name] = sim_.part_masses()[i];
   j["part_mass"] = masses;
+  if (sim_.config().mass_scaling_step > 0) {
+    json added = json::object();
+    double total = 0;
+    for (std::size_t i = 0; i < sim_.config().parts.size(); ++i) {
+      added[sim_.config().parts[i].name] = sim_.part_added_masses()[i];
+      total += sim_.part_added_masses()[i];
+    }
+    j["mass_scaling"] = {{"step", sim_.config().mass_scaling_step},
+                         {"elements", sim_.mass_scaled_elements()},
+                         {"added_mass", total},
+                         {"part_added_mass", added}};
+  }
   write_file_atomic(opt_.directory + "/summary.json", json_text(j, 2) + "\n");
 }
 

@@ -89,12 +89,19 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
                                    "the node order",
                                    id, part.name, v));
     }
-    for (int e = 0; e < hb.size(); ++e)
-      for (int a = 0; a < 8; ++a)
-        corner_mass[lb.slot(static_cast<std::size_t>(e), a)] = hb.mass[e] / 8;
     hb.corner_rows = lb.exchanged_vectors; // the other nodes are summed in the kernel
     blocks_.push_back(std::move(hb));
   }
+  part_mass_.assign(config_.parts.size(), 0.0);
+  for (const auto& b : blocks_)
+    for (int e = 0; e < b.size(); ++e) part_mass_[b.part] += b.mass[e];
+  comm_.sum(std::span<double>(part_mass_));
+  scale_masses();
+  for (std::size_t b = 0; b < blocks_.size(); ++b)
+    for (int e = 0; e < blocks_[b].size(); ++e)
+      for (int a = 0; a < 8; ++a)
+        corner_mass[fe_.blocks[b].slot(static_cast<std::size_t>(e), a)] =
+            blocks_[b].scaled_mass(static_cast<std::size_t>(e)) / 8;
   corner_exchange_->exchange({corner_mass.data()});
   gather_corners(fe_, {corner_mass.data()}, {nodes_.mass.data()});
   std::fill(corner_mass.begin(), corner_mass.end(), 0.0);
@@ -135,11 +142,6 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
       for (const auto id : ids) top = std::max(top, id);
     max_file_id_ = comm_.max(top);
   }
-
-  part_mass_.assign(config_.parts.size(), 0.0);
-  for (const auto& b : blocks_)
-    for (int e = 0; e < b.size(); ++e) part_mass_[b.part] += b.mass[e];
-  comm_.sum(std::span<double>(part_mass_));
 
   if (!config_.contact.empty()) {
     contact_ = std::make_unique<ContactPhase>(config_.contact[0], mesh, fe_, blocks_, comm_,
@@ -1274,7 +1276,7 @@ std::vector<double> Simulation::part_energies() const {
       double v2 = 0;
       for (int a = 0; a < 8; ++a)
         v2 += speed2(nodes_.v, v_prev_, static_cast<std::size_t>(b.conn[a][k]));
-      out[0] += 0.5 * (b.mass[k] / 8) * v2;
+      out[0] += 0.5 * (b.scaled_mass(k) / 8) * v2;
       out[1] += b.internal_energy[k];
       out[2] += b.hourglass_energy[k];
     }
@@ -1478,6 +1480,57 @@ void Simulation::restore(const Checkpoint& c) {
     }
   }
   if (sph_) restore_particles(c, from);
+}
+
+void Simulation::scale_masses() {
+  part_added_mass_.assign(config_.parts.size(), 0.0);
+  mass_scaled_elements_ = 0;
+  if (!(config_.mass_scaling_step > 0)) return;
+  // The step each element would set, at rest in its initial shape (the kernel with
+  // dt_prev = 0 changes no state), against the element step that gives the wanted one.
+  const double target = config_.mass_scaling_step / config_.time_step_scale;
+  const NodalView view{{nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()},
+                       {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()}};
+  const CornerView corners{
+      {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()}};
+  std::vector<double> dte;
+  for (auto& b : blocks_) {
+    if (b.size() == 0 || b.rigid) continue;
+    dte.assign(b.mass.size(), 1e300);
+    HexResult r;
+    r.element_dt = dte.data();
+    hex_forces(b, view, 0.0, corners, workspace_, r);
+    // The inertia of a density f times higher, and its wave speed (1 / sqrt f): the
+    // element's step scales with sqrt f, so f = (target / step)^2 raises it to the
+    // target. Padding lanes repeat the last element, as HexBlock::init made them.
+    b.mass_scale.assign(b.mass.size(), 1.0);
+    b.wave_scale.assign(b.mass.size(), 1.0);
+    const auto n = static_cast<std::size_t>(b.size());
+    for (std::size_t e = 0; e < b.mass.size(); ++e) {
+      const std::size_t k = std::min(e, n - 1);
+      if (!(dte[k] < target)) continue;
+      const double f = (target / dte[k]) * (target / dte[k]);
+      const double added = b.mass[e] * (f - 1);
+      b.mass_scale[e] = f;
+      b.wave_scale[e] = 1 / std::sqrt(f);
+      if (e < n) {
+        part_added_mass_[static_cast<std::size_t>(b.part)] += added;
+        ++mass_scaled_elements_;
+      }
+    }
+  }
+  for (auto& c : corner_force_) std::fill(c.begin(), c.end(), 0.0);
+  comm_.sum(std::span<double>(part_added_mass_));
+  comm_.sum(std::span<std::int64_t>(&mass_scaled_elements_, 1));
+  // LS-DYNA's users keep the added mass of a part under a few per cent (its effect on a
+  // dynamic run is F = m a's): say where it is more.
+  for (std::size_t p = 0; p < part_added_mass_.size(); ++p)
+    if (part_added_mass_[p] > 0.05 * part_mass_[p])
+      warnings_.push_back(fmt::format(
+          "{}: mass scaling adds {:.3g} kg to part {}, {:.1f}% of its {:.6g} kg, to reach the "
+          "step {:g} s: the dynamics of this part are those of a heavier one",
+          config_.deck_file, part_added_mass_[p], config_.parts[p].name,
+          100 * part_added_mass_[p] / part_mass_[p], part_mass_[p], config_.mass_scaling_step));
 }
 
 void Simulation::decompose_now() {

@@ -150,7 +150,12 @@ public:
   std::int64_t max_file_id() const { return max_file_id_; }
   // Of the initial particles (ids, sets, masses, reference positions; 0 without any).
   std::uint64_t particle_fingerprint() const { return particle_fingerprint_; }
+  // Each part's mass from its material's density (without mass scaling's), kg.
   const std::vector<double>& part_masses() const { return part_mass_; }
+  // Mass scaling (time_step.mass_scaling): the mass it added to each part, kg, and the
+  // elements it scaled (over all ranks; zeros without it).
+  const std::vector<double>& part_added_masses() const { return part_added_mass_; }
+  std::int64_t mass_scaled_elements() const { return mass_scaled_elements_; }
   // Global element id -> part name (for messages).
   std::string describe_element(std::int64_t gid) const;
   // Per external load, the faces it presses or the nodes it pushes, over all ranks
@@ -169,6 +174,9 @@ private:
   void detect_contacts();
   void correct();
   void share_eroded(bool exposing = true);
+  // Mass scaling at t = 0: raises each element's mass so that its stable step at rest in
+  // its initial shape is at least config_.mass_scaling_step / scale (collective).
+  void scale_masses();
   void warn_of_setup(const Mesh& mesh);
   void apply_walls();             // the rigid walls' part of correct()
   void sample_probe_velocities(); // at the end of correct()
@@ -382,6 +390,8 @@ private:
   std::int64_t max_file_id_ = 0;                           // of both, over all ranks
   std::vector<std::int64_t> block_offsets_;
   std::vector<double> part_mass_;
+  std::vector<double> part_added_mass_;
+  std::int64_t mass_scaled_elements_ = 0;
 };
 
 } // namespace anvil
