@@ -163,6 +163,10 @@ TEST(Deck, ImpossibleValues) {
                {"deck.yaml:6", "poissons_ratio", "< 0.5"});
   expect_error("radius: 3.2e-3", "radius: 0", {"deck.yaml:9", "radius", "positive"});
   expect_error("scale: 0.9", "scale: 1.5", {"deck.yaml:3", "time_step.scale"});
+  // An angular velocity's centre: a point, or mass_center.
+  expect_error("velocity: [0, 0, -227.0]}",
+               "velocity: [0, 0, -227.0], angular_velocity: [0, 0, 1], center: middle}",
+               {"initial_conditions", "center", "mass_center"});
   // Mass scaling: a positive step, and only `step`.
   expect_error("scale: 0.9", "scale: 0.9, mass_scaling: {step: -1.0e-7}",
                {"deck.yaml:3", "time_step.mass_scaling.step", "positive"});

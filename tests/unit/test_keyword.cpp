@@ -555,11 +555,35 @@ TEST(Keyword, RigidMaterial) {
                {"*MAT_RIGID.E", "positive"});
   // Keywords that drive, load or shape rigid bodies would run another model if ignored
   // (QA round 29: a driven body ran free): errors at the keyword.
-  for (const char* k :
-       {"*BOUNDARY_PRESCRIBED_MOTION_RIGID", "*INITIAL_VELOCITY_RIGID_BODY", "*LOAD_RIGID_BODY",
-        "*PART_INERTIA", "*CONSTRAINED_RIGID_BODIES", "*CONSTRAINED_EXTRA_NODES_SET"})
+  for (const char* k : {"*BOUNDARY_PRESCRIBED_MOTION_RIGID", "*LOAD_RIGID_BODY", "*PART_INERTIA",
+                        "*CONSTRAINED_RIGID_BODIES", "*CONSTRAINED_EXTRA_NODES_SET"})
     expect_error(with(good, "*END", std::string(k) + "\n         1\n*END"),
                  {std::string(k) + ":", "not supported"});
+}
+
+// *INITIAL_VELOCITY_RIGID_BODY (LS-DYNA manual: "the initial translational and rotational
+// velocities at the center of gravity for a rigid body"): an initial condition on the part
+// about its centre of mass; a deformable part and LCID are errors.
+TEST(Keyword, InitialVelocityOfARigidBody) {
+  const std::string elastic = "*MAT_ELASTIC\n         1    7850.0   2.0E+11       0.3\n";
+  const std::string rigid = "*MAT_RIGID\n1,7850.0,2.0E+11,0.3\n\n\n";
+  const Config c = kw(with(with(good, elastic, rigid), "*END",
+                           "*INITIAL_VELOCITY_RIGID_BODY\n1,1.0,2.0,3.0,10.0,20.0,30.0\n*END"));
+  ASSERT_EQ(c.initial_conditions.size(), 2u); // the *INITIAL_VELOCITY_GENERATION's, then this
+  const InitialCondition& ic = c.initial_conditions.back();
+  EXPECT_EQ(ic.nodes.part, "part1");
+  EXPECT_TRUE(ic.about_mass_center);
+  EXPECT_EQ(ic.velocity, (Vec3{1, 2, 3}));
+  EXPECT_EQ(ic.angular_velocity, (Vec3{10, 20, 30}));
+  EXPECT_FALSE(c.initial_conditions.front().about_mass_center);
+  expect_error(with(good, "*END", "*INITIAL_VELOCITY_RIGID_BODY\n1,1.0,2.0,3.0\n*END"),
+               {"*INITIAL_VELOCITY_RIGID_BODY.PID", "not rigid"});
+  expect_error(with(with(good, elastic, rigid), "*END",
+                    "*INITIAL_VELOCITY_RIGID_BODY\n1,1.0,2.0,3.0,0,0,0,4\n*END"),
+               {"*INITIAL_VELOCITY_RIGID_BODY.LCID", "not supported"});
+  expect_error(
+      with(with(good, elastic, rigid), "*END", "*INITIAL_VELOCITY_RIGID_BODY\n9,1.0,2.0,3.0\n*END"),
+      {"*INITIAL_VELOCITY_RIGID_BODY.PID", "part 9"});
 }
 
 TEST(Keyword, JohnsonCookAndItsEquationOfState) {

@@ -116,6 +116,9 @@ struct InitialCondition {
   Vec3 velocity;
   Vec3 angular_velocity; // rad/s about `center`: v += w x (x - center)
   Vec3 center;
+  // `center: mass_center`: about the centre of mass of the nodes it sets (their lumped
+  // masses; for a rigid part, the body's), found when the model is built.
+  bool about_mass_center = false;
   SourceLocation where;
 };
 

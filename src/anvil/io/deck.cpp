@@ -154,6 +154,7 @@ public:
     if (v != "true" && v != "false") fail("expected true or false");
     return v == "true";
   }
+  bool scalar() const { return n_.IsScalar(); }
   std::string str() const {
     if (!n_.IsScalar()) fail("expected a single value");
     if (!is_utf8(n_.Scalar())) fail("not valid UTF-8 text (save the deck as UTF-8)");
@@ -957,7 +958,15 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
       if (n.has("velocity")) ic.velocity = n.child("velocity").vec3();
       if (n.has("angular_velocity")) {
         ic.angular_velocity = n.child("angular_velocity").vec3();
-        ic.center = n.required("center").vec3();
+        const Node centre = n.required("center");
+        if (centre.scalar()) {
+          if (centre.str() != "mass_center")
+            centre.fail("expected a point [x, y, z] or mass_center (the centre of mass of the "
+                        "nodes it sets)");
+          ic.about_mass_center = true;
+        } else {
+          ic.center = centre.vec3();
+        }
       } else if (n.has("center")) {
         n.child("center").fail("center is only used with angular_velocity");
       }

@@ -675,6 +675,7 @@ struct VelocityGen {
   int styp; // 1 part set, 2 part, 3 node set, 0: all parts (*INITIAL_VELOCITY with NSID 0)
   std::int64_t id;
   Vec3 velocity, angular, center;
+  bool mass_center = false; // *INITIAL_VELOCITY_RIGID_BODY: about the part's centre of mass
   Where at;
   std::string keyword;
 };
@@ -774,9 +775,8 @@ private:
       return mat_johnson_cook(b);
     // Keywords that drive, load or shape rigid bodies: ignoring them would run another
     // model (QA round 29: a driven body ran free), so they are errors.
-    for (const char* k :
-         {"BOUNDARY_PRESCRIBED_MOTION_RIGID", "INITIAL_VELOCITY_RIGID_BODY", "LOAD_RIGID_BODY",
-          "PART_INERTIA", "CONSTRAINED_RIGID_BODIES", "CONSTRAINED_EXTRA_NODES"})
+    for (const char* k : {"BOUNDARY_PRESCRIBED_MOTION_RIGID", "LOAD_RIGID_BODY", "PART_INERTIA",
+                          "CONSTRAINED_RIGID_BODIES", "CONSTRAINED_EXTRA_NODES"})
       if (starts_with(n, k))
         throw InputError(where_of(b.head).loc("*" + b.name),
                          fmt::format("*{} is not supported: anvil's rigid bodies (*MAT_RIGID) "
@@ -817,6 +817,7 @@ private:
     }
     if (n == "INITIAL_VELOCITY_GENERATION") return velocity_generation(b);
     if (n == "INITIAL_VELOCITY") return initial_velocity(b);
+    if (n == "INITIAL_VELOCITY_RIGID_BODY") return initial_velocity_rigid_body(b);
     if (contact_form(n)) return contact(b);
     if (n == "CONTROL_CONTACT") return control_contact(b);
     if (n == "RIGIDWALL_PLANAR" || n == "RIGIDWALL_PLANAR_ID") return rigidwall(b);
@@ -2296,6 +2297,29 @@ private:
     }
   }
 
+  // PID, VX, VY, VZ, VXR, VYR, VZR, LCID (LS-DYNA manual, *INITIAL_VELOCITY_RIGID_BODY):
+  // the translational and rotational velocities of a rigid part at its centre of mass,
+  // anvil's initial condition on the part about `center: mass_center`.
+  void initial_velocity_rigid_body(const Block& b) {
+    Cursor c(b);
+    while (!c.done()) {
+      const Line l = c.next();
+      const Card c1(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+      VelocityGen v{};
+      v.id = c1.integer(0, "PID", 0);
+      if (v.id <= 0) c1.fail("PID", "PID must be a positive part id");
+      v.styp = 2;
+      v.velocity = {c1.real(1, "VX"), c1.real(2, "VY"), c1.real(3, "VZ")};
+      v.angular = {c1.real(4, "VXR"), c1.real(5, "VYR"), c1.real(6, "VZR")};
+      if (c1.integer(7, "LCID", 0) != 0)
+        c1.fail("LCID", "a curve of the rotational velocity (LCID) is not supported");
+      v.mass_center = true;
+      v.at = where_of(l);
+      v.keyword = b.name;
+      velocities_.push_back(v);
+    }
+  }
+
   // The *CONTACT_ forms anvil reads (with or without _ID or _TITLE): 1 a single surface,
   // 2 two surfaces (slave and master sides), 0 none. All become anvil's general contact.
   static int contact_form(std::string_view n) {
@@ -2992,7 +3016,20 @@ Config KeywordReader::config(const std::string& deck_file) {
       targets.push_back(s);
     } else {
       std::vector<std::string> names;
-      if (v.styp == 2) {
+      if (v.mass_center) {
+        // LS-DYNA: "for a rigid body or a nodal rigid body".
+        const std::string field = key + ".PID";
+        if (part_ref(v.id, v.at, field)) names.push_back(part_name(v.id));
+        const auto p = std::find_if(parts_.begin(), parts_.end(),
+                                    [&](const PartCard& q) { return q.pid == v.id; });
+        const auto m = materials_.find(p->mid);
+        if (m == materials_.end() || !m->second.rigid)
+          throw InputError(v.at.loc(field),
+                           fmt::format("part {} is not rigid (*MAT_RIGID): *{} sets the velocity "
+                                       "of a rigid body (give *INITIAL_VELOCITY_GENERATION for "
+                                       "a deformable part)",
+                                       v.id, v.keyword));
+      } else if (v.styp == 2) {
         if (part_ref(v.id, v.at, key + ".ID")) names.push_back(part_name(v.id));
       } else if (v.styp == 1) {
         names = part_set(v.id, v.at, key + ".ID", kept);
@@ -3012,6 +3049,7 @@ Config KeywordReader::config(const std::string& deck_file) {
       ic.velocity = v.velocity;
       ic.angular_velocity = v.angular;
       ic.center = v.center;
+      ic.about_mass_center = v.mass_center;
       ic.where = v.at.loc(key);
       c.initial_conditions.push_back(ic);
     }

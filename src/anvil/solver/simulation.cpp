@@ -462,14 +462,38 @@ void Simulation::warn_if_outside_model(const std::vector<std::int64_t>& ids,
                                     ids.size() == 1 ? "s" : ""));
 }
 
+// The centre of mass of the nodes with global ids `ids` (sorted), from their lumped masses,
+// summed in global id order so that every rank count finds the same bits (collective).
+Vec3 Simulation::mass_center(std::span<const std::int64_t> ids) const {
+  struct Point {
+    std::int64_t gid;
+    double m, x[3];
+  };
+  std::vector<Point> mine;
+  for (std::size_t n = 0; n < fe_.node_gid.size(); ++n)
+    if (fe_.node_owned[n] && std::binary_search(ids.begin(), ids.end(), fe_.node_gid[n]))
+      mine.push_back(
+          {fe_.node_gid[n], nodes_.mass[n], {nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]}});
+  std::vector<Point> all = comm_.allgatherv(std::span<const Point>(mine));
+  std::sort(all.begin(), all.end(), [](const Point& a, const Point& b) { return a.gid < b.gid; });
+  double m = 0;
+  Vec3 mx{0, 0, 0};
+  for (const auto& p : all) {
+    m += p.m;
+    mx += p.m * Vec3{p.x[0], p.x[1], p.x[2]};
+  }
+  return m > 0 ? mx * (1 / m) : Vec3{0, 0, 0};
+}
+
 void Simulation::apply_initial_conditions(const Mesh& mesh) {
   const std::size_t nn = fe_.node_gid.size();
   for (const auto& ic : config_.initial_conditions) {
     const auto ids = selected_nodes(mesh, ic.nodes);
     warn_if_outside_model(ids, ic.nodes.where);
+    const Vec3 centre = ic.about_mass_center ? mass_center(ids) : ic.center;
     for (std::size_t n = 0; n < nn; ++n) {
       if (!std::binary_search(ids.begin(), ids.end(), fe_.node_gid[n])) continue;
-      const Vec3 r = Vec3{nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]} - ic.center;
+      const Vec3 r = Vec3{nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]} - centre;
       const Vec3 v = ic.velocity + cross(ic.angular_velocity, r);
       for (int i = 0; i < 3; ++i) nodes_.v[i][n] = v[i];
     }

@@ -177,6 +177,7 @@ private:
   // Mass scaling at t = 0: raises each element's mass so that its stable step at rest in
   // its initial shape is at least config_.mass_scaling_step / scale (collective).
   void scale_masses();
+  Vec3 mass_center(std::span<const std::int64_t> ids) const;
   void warn_of_setup(const Mesh& mesh);
   void apply_walls();             // the rigid walls' part of correct()
   void sample_probe_velocities(); // at the end of correct()
