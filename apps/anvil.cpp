@@ -55,14 +55,26 @@ std::string describe_selection(const anvil::Selection& s) {
 std::string describe_condition(std::size_t n, const anvil::BoundaryCondition& bc) {
   const std::string where = describe_selection(bc.nodes);
   const auto& on = bc.prescribed ? bc.components : bc.fix;
-  std::string comps;
-  for (int i = 0; i < 3; ++i)
+  const auto& spin_on = bc.prescribed ? bc.spin_components : bc.fix_spin;
+  std::string comps, spins;
+  for (int i = 0; i < 3; ++i) {
     if (on[static_cast<std::size_t>(i)]) comps += "xyz"[i];
-  std::string what = "fix " + comps;
+    // (A rigid body's rotations: `fix: all` names them for nodes too, which have none.)
+    if (spin_on[static_cast<std::size_t>(i)] && (bc.rotations || bc.prescribed))
+      spins += fmt::format(" r{}", "xyz"[i]);
+  }
+  const bool all = !bc.prescribed && comps == "xyz" && bc.fix_spin[0] && bc.fix_spin[1] &&
+                   bc.fix_spin[2] && !bc.rotations;
+  std::string what = all ? "fix all" : "fix " + comps + spins;
   if (bc.prescribed) {
     const bool moved = bc.motion == anvil::BoundaryCondition::Motion::displacement;
-    what = fmt::format("{} {} [{:g}, {:g}, {:g}]", moved ? "displacement" : "velocity", comps,
-                       bc.value.x, bc.value.y, bc.value.z);
+    what.clear();
+    if (!comps.empty())
+      what = fmt::format("{} {} [{:g}, {:g}, {:g}]", moved ? "displacement" : "velocity", comps,
+                         bc.value.x, bc.value.y, bc.value.z);
+    if (!spins.empty())
+      what += fmt::format("{}angular velocity{} [{:g}, {:g}, {:g}] rad/s", what.empty() ? "" : ", ",
+                          spins, bc.spin.x, bc.spin.y, bc.spin.z);
     if (bc.curve)
       what += fmt::format(" x curve of {}",
                           count_of(static_cast<std::int64_t>(bc.curve->t.size()), "point"));
@@ -165,6 +177,12 @@ int check(const std::string& deck, const anvil::Comm& comm) {
   }
   std::printf("stable dt   %.6g s (element kernel at t = 0), step %.6g s with scale %g\n", dt,
               dt * config.time_step_scale, config.time_step_scale);
+  if (config.mass_scaling_step > 0 &&
+      dt * config.time_step_scale < config.mass_scaling_step * (1 - 1e-9))
+    std::printf("            below the mass-scaling step %g s: elements that the initial "
+                "velocities compress (bulk viscosity) take a smaller one, as mass scaling "
+                "looks at the elements at rest\n",
+                config.mass_scaling_step);
   if (std::isfinite(config.end_time))
     std::printf("end time    %.6g s, about %.0f cycles at the initial step\n", config.end_time,
                 std::ceil(config.end_time / (dt * config.time_step_scale)));

@@ -231,6 +231,37 @@ TEST(Determinism, MassScalingSameBitsOnAnyRankCount) {
   EXPECT_LT(sim.mass_scaled_elements(), sim.global_elements());
 }
 
+// A rigid punch held in x, y and its rotations and driven down in z into a plastic block,
+// in contact: every rank moves the held body the same way.
+TEST(Determinism, DrivenRigidPunchSameBitsOnAnyRankCount) {
+  const Config config = test::deck(R"(
+termination: {cycles: 300}
+materials:
+  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+  aluminium: {model: j2_plasticity, density: 2700, youngs_modulus: 70.0e9, poissons_ratio: 0.33,
+              yield_stress: 1.0e8, hardening_modulus: 1.0e8}
+parts:
+  punch:
+    mesh: {generate: box, min: [0.004, 0.002, 0.0101], max: [0.008, 0.008, 0.014], divisions: [2, 3, 2]}
+    material: steel
+    rigid: true
+  block:
+    mesh: {generate: box, min: [0, 0, 0], max: [0.012, 0.01, 0.01], divisions: [12, 10, 6]}
+    material: aluminium
+contact:
+  - {type: general}
+boundary_conditions:
+  - {set: block.zmin, fix: all}
+  - {part: punch, fix: all}
+  - {part: punch, velocity: [0, 0, -40.0], components: [z]}
+)");
+  double max_ep = 0;
+  const std::int64_t differing = compare_with_serial(config, &max_ep);
+  EXPECT_EQ(differing, 0) << "values differing from the 1-rank run on " << Comm::world().size()
+                          << " ranks";
+  if (Comm::world().rank() == 0) EXPECT_GT(max_ep, 1e-3); // the punch has dented the block
+}
+
 // Eroding contact (examples/eroding_penetration.yaml to 12 us): elements erode on every
 // rank's part of the target and the faces they covered join the contact surfaces
 // (ContactPhase::set_eroded); the same bits as on one rank, exactly.

@@ -506,15 +506,57 @@ TEST(Deck, Gravity) {
 // QA round 24: a prescribed value on a component `components` leaves out was dropped (a
 // driver along x held only in z stood still in x); a component listed twice, or a word
 // for the list, is refused.
+// Conditions on a whole part (`part:`), and a rigid body's rotations: rx, ry, rz in `fix`
+// and `components`, `angular_velocity` (alone or with a velocity, one curve for both).
+TEST(Deck, ConditionsOnAPartAndRotations) {
+  std::string text = good;
+  text.replace(text.find("  - {set: bar.top, velocity: [0, 0, 1.0], components: [z]}"),
+               std::string("  - {set: bar.top, velocity: [0, 0, 1.0], components: [z]}").size(),
+               "  - {part: bar, fix: [x, rz]}\n"
+               "  - {part: bar, velocity: [0, 0, -2.0], angular_velocity: [0, 0, 30.0],\n"
+               "     components: [z, rz], curve: [[0, 1], [1, 1]]}\n"
+               "  - {part: bar, angular_velocity: [1, 2, 3]}");
+  const Config c = test::deck(text);
+  ASSERT_EQ(c.boundary_conditions.size(), 4u);
+  const BoundaryCondition& fix = c.boundary_conditions[1];
+  EXPECT_EQ(fix.nodes.part, std::optional<std::string>("bar"));
+  EXPECT_TRUE(fix.nodes.name.empty());
+  EXPECT_EQ(fix.fix, (std::array<bool, 3>{true, false, false}));
+  EXPECT_EQ(fix.fix_spin, (std::array<bool, 3>{false, false, true}));
+  EXPECT_TRUE(fix.rotations);
+  const BoundaryCondition& both = c.boundary_conditions[2];
+  EXPECT_EQ(both.components, (std::array<bool, 3>{false, false, true}));
+  EXPECT_EQ(both.spin_components, (std::array<bool, 3>{false, false, true}));
+  EXPECT_EQ(both.spin, (Vec3{0, 0, 30.0}));
+  EXPECT_TRUE(both.curve.has_value());
+  const BoundaryCondition& spin = c.boundary_conditions[3];
+  EXPECT_EQ(spin.components, (std::array<bool, 3>{false, false, false}));
+  EXPECT_EQ(spin.spin_components, (std::array<bool, 3>{true, true, true}));
+  // `fix: all` holds the six (a node's three; rotations are not named).
+  EXPECT_FALSE(test::deck(good).boundary_conditions[0].rotations);
+  expect_error("{set: impact_face, fix: [z]}", "{part: bar, set: impact_face, fix: [z]}",
+               {"boundary_conditions[0]", "exactly one of 'part' or 'set'"});
+  expect_error("fix: [z]", "fix: [z, rw]", {"boundary_conditions[0].fix[1]", "got 'rw'"});
+  expect_error("velocity: [0, 0, 1.0], components: [z]",
+               "velocity: [0, 0, 1.0], components: [z, rz]",
+               {"boundary_conditions[1].components", "rz is listed, but no angular_velocity"});
+  expect_error("velocity: [0, 0, 1.0], components: [z]",
+               "angular_velocity: [0, 4.0, 1.0], components: [rz]",
+               {"boundary_conditions[1].angular_velocity", "4 about y"});
+  expect_error("velocity: [0, 0, 1.0], components: [z]",
+               "displacement: [0, 0, 1.0], angular_velocity: [0, 0, 1.0]",
+               {"boundary_conditions[1].angular_velocity", "goes with velocity"});
+}
+
 TEST(Deck, PrescribedValuesOnlyOnTheirComponents) {
   expect_error(
       "velocity: [0, 0, 1.0], components: [z]", "velocity: [5.0, 0, 1.0], components: [z]",
       {"deck.yaml:18", "boundary_conditions[1].velocity", "5 on x, which `components` leaves out"});
   expect_error("components: [z]", "components: [z, z]",
                {"boundary_conditions[1].components[1]", "z is listed twice"});
-  expect_error(
-      "components: [z]", "components: ALL",
-      {"boundary_conditions[1].components", "expected a list of x, y, z, or all, got 'ALL'"});
+  expect_error("components: [z]", "components: ALL",
+               {"boundary_conditions[1].components",
+                "expected a list of x, y, z (rx, ry, rz for a rigid part), or all, got 'ALL'"});
 }
 
 // QA D9: a deck set named like a generated one (bar.top) replaced it without a word.

@@ -482,6 +482,19 @@ TEST(Keyword, MassScaling) {
   EXPECT_EQ(c.mass_scaling_step, 0);
   ASSERT_EQ(c.warnings.size(), 1u);
   EXPECT_NE(c.warnings[0].find("DT2MS > 0"), std::string::npos) << c.warnings[0];
+  expect_error(with(good, card, "0.0,0.8,0,0.0,-1.0E-07,0,0,2\n"),
+               {"*CONTROL_TIMESTEP.MS1ST", "0 or 1"});
+  // A repeated *CONTROL_TIMESTEP replaces the earlier whole (QA round 30: the earlier
+  // TSSFAC stayed under a blank one, and its notes were given).
+  c = kw(with(good, "*END", "*CONTROL_TIMESTEP\n0.0,,0,0.0,-1.0E-07,0,0,1\n*END"));
+  EXPECT_EQ(c.time_step_scale, 0.9);
+  EXPECT_DOUBLE_EQ(c.mass_scaling_step, 0.9e-7);
+  c = kw(with(with(good, card, "0.0,0.5,0,0.0,-1.0E-07\n"), "*END",
+              "*CONTROL_TIMESTEP\n0.0,0.7\n*END"));
+  EXPECT_EQ(c.time_step_scale, 0.7);
+  EXPECT_EQ(c.mass_scaling_step, 0);
+  ASSERT_EQ(c.warnings.size(), 1u); // the repeat's; no MS1ST note of the card it replaced
+  EXPECT_NE(c.warnings[0].find("repeats"), std::string::npos) << c.warnings[0];
 }
 
 // The failure strains of the plastic materials (FS of MAT_003, FAIL of MAT_024, PSFAIL of
@@ -549,14 +562,55 @@ TEST(Keyword, RigidMaterial) {
   // (CMO 1 with nothing constrained is no constraint.)
   EXPECT_TRUE(
       kw(with(good, elastic, "*MAT_RIGID\n1,7850.0,2.0E+11,0.3\n1.0\n\n")).parts.at(0).rigid);
-  expect_error(with(good, elastic, "*MAT_RIGID\n1,7850.0,2.0E+11,0.3\n1.0,4,7\n\n"),
+  // CMO = 1: CON1 4 (x and y), CON2 7 (all rotations) hold the body: a `fix` on the part,
+  // before the deck's other conditions.
+  const Config held = kw(with(good, elastic, "*MAT_RIGID\n1,7850.0,2.0E+11,0.3\n1.0,4,7\n\n"));
+  ASSERT_EQ(held.boundary_conditions.size(), 2u);
+  const BoundaryCondition& hb = held.boundary_conditions.front();
+  EXPECT_EQ(hb.nodes.part, std::optional<std::string>("part1"));
+  EXPECT_TRUE(hb.nodes.name.empty());
+  EXPECT_EQ(hb.fix, (std::array<bool, 3>{true, true, false}));
+  EXPECT_EQ(hb.fix_spin, (std::array<bool, 3>{true, true, true}));
+  expect_error(with(good, elastic, "*MAT_RIGID\n1,7850.0,2.0E+11,0.3\n-1.0,4,7\n\n"),
                {"*MAT_RIGID.CMO", "not supported"});
+  expect_error(with(good, elastic, "*MAT_RIGID\n1,7850.0,2.0E+11,0.3\n1.0,8\n\n"),
+               {"*MAT_RIGID.CON1", "0-7"});
+  // CON1, CON2 with CMO = 0: a warning (nothing held).
+  const Config unheld = kw(with(good, elastic, "*MAT_RIGID\n1,7850.0,2.0E+11,0.3\n0.0,4,7\n\n"));
+  EXPECT_EQ(unheld.boundary_conditions.size(), 1u);
+  ASSERT_EQ(unheld.warnings.size(), 1u);
+  EXPECT_NE(unheld.warnings[0].find("CMO = 0"), std::string::npos) << unheld.warnings[0];
+  // *BOUNDARY_PRESCRIBED_MOTION_RIGID: the body's centre (DOF 1-3) or spin (5-7) by a curve.
+  const std::string curve = "*DEFINE_CURVE\n9\n0.0,1.0\n1.0,1.0\n";
+  const Config driven =
+      kw(with(with(good, elastic, "*MAT_RIGID\n1,7850.0,2.0E+11,0.3\n\n\n"), "*END",
+              curve + "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n1,3,0,9,-2.5\n1,7,0,9,30.0\n*END"));
+  ASSERT_EQ(driven.boundary_conditions.size(), 3u);
+  const BoundaryCondition& dz = driven.boundary_conditions[1];
+  EXPECT_EQ(dz.nodes.part, std::optional<std::string>("part1"));
+  EXPECT_TRUE(dz.prescribed);
+  EXPECT_EQ(dz.components, (std::array<bool, 3>{false, false, true}));
+  EXPECT_EQ(dz.value, (Vec3{0, 0, -2.5}));
+  const BoundaryCondition& wz = driven.boundary_conditions[2];
+  EXPECT_EQ(wz.spin_components, (std::array<bool, 3>{false, false, true}));
+  EXPECT_EQ(wz.spin, (Vec3{0, 0, 30.0}));
+  EXPECT_EQ(wz.components, (std::array<bool, 3>{false, false, false}));
+  const std::string rigid = with(good, elastic, "*MAT_RIGID\n1,7850.0,2.0E+11,0.3\n\n\n");
+  expect_error(with(rigid, "*END", curve + "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n1,4,0,9\n*END"),
+               {"*BOUNDARY_PRESCRIBED_MOTION_RIGID.DOF", "not supported"});
+  expect_error(with(rigid, "*END", curve + "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n1,5,2,9\n*END"),
+               {"*BOUNDARY_PRESCRIBED_MOTION_RIGID.VAD", "not supported"});
+  expect_error(with(good, "*END", curve + "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n1,3,0,9\n*END"),
+               {"*BOUNDARY_PRESCRIBED_MOTION_RIGID.PID", "not rigid"});
+  expect_error(with(rigid, "*END", curve + "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n4,3,0,9\n*END"),
+               {"*BOUNDARY_PRESCRIBED_MOTION_RIGID.PID", "part 4 is not defined"});
   expect_error(with(good, elastic, "*MAT_RIGID\n1,7850.0,-2.0E+11,0.3\n\n\n"),
                {"*MAT_RIGID.E", "positive"});
   // Keywords that drive, load or shape rigid bodies would run another model if ignored
   // (QA round 29: a driven body ran free): errors at the keyword.
-  for (const char* k : {"*BOUNDARY_PRESCRIBED_MOTION_RIGID", "*LOAD_RIGID_BODY", "*PART_INERTIA",
-                        "*CONSTRAINED_RIGID_BODIES", "*CONSTRAINED_EXTRA_NODES_SET"})
+  for (const char* k :
+       {"*BOUNDARY_PRESCRIBED_MOTION_RIGID_LOCAL", "*LOAD_RIGID_BODY", "*PART_INERTIA",
+        "*CONSTRAINED_RIGID_BODIES", "*CONSTRAINED_EXTRA_NODES_SET"})
     expect_error(with(good, "*END", std::string(k) + "\n         1\n*END"),
                  {std::string(k) + ":", "not supported"});
 }

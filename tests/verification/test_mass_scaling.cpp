@@ -22,6 +22,7 @@
 
 #include <fmt/format.h>
 
+#include "anvil/io/checkpoint.hpp"
 #include "anvil/parallel/comm.hpp"
 #include "anvil/solver/simulation.hpp"
 #include "test_support.hpp"
@@ -184,6 +185,55 @@ TEST(MassScaling, OnlyElementsBelowTheStepGainMass) {
                 "(reference %.6e), balance error after 20 cycles %.2e\n",
                 dt_thin, dt, static_cast<long long>(sim.mass_scaled_elements()),
                 sim.part_added_masses()[0], added_ref, balance);
+}
+
+// A restart keeps the masses of the run that wrote the checkpoint: a deck without its mass
+// scaling, or with another step, is an input error (QA round 30: it ran on with other
+// masses and the old velocities, the energy balance off by 16%); the same deck restores.
+// A step so large that the masses overflow is an input error too (was a non-finite force
+// at t = 0, exit 3).
+TEST(MassScaling, RestartKeepsTheMassesAndOverflowIsAnInputError) {
+  const Comm world = Comm::world();
+  const Config config = test::deck(two_blocks);
+  Simulation sim(config, world);
+  for (int i = 0; i < 5; ++i) sim.step();
+  // (capture() gathers on rank 0; every rank reads the file back.)
+  const std::string path = fmt::format("/tmp/anvil_test_mass_scaling_np{}.anvil", world.size());
+  const Checkpoint captured = capture(sim, OutputState{});
+  if (world.rank() == 0) write_checkpoint(path, captured);
+  world.barrier();
+  const Checkpoint c = read_checkpoint(path);
+  world.barrier();
+  if (world.rank() == 0) std::remove(path.c_str());
+  {
+    Simulation same(config, world);
+    EXPECT_NO_THROW(same.restore(c));
+    EXPECT_EQ(same.clock().cycle, 5);
+  }
+  for (const double step : {0.0, 5.0e-8}) {
+    Config other = config;
+    other.mass_scaling_step = step;
+    Simulation sim2(other, world);
+    try {
+      sim2.restore(c);
+      ADD_FAILURE() << "no error for a restart with the step " << step;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("the masses would change under the run"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  std::string huge = two_blocks;
+  huge.replace(huge.find("step: 4.0e-8"), 12, "step: 1.0e300");
+  try {
+    Simulation sim3(test::deck(huge, "deck.yaml"), world);
+    ADD_FAILURE() << "no error for a step of 1e300 s";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("deck.yaml:3: time_step.mass_scaling.step"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("beyond any number"), std::string::npos) << e.what();
+  }
 }
 
 } // namespace

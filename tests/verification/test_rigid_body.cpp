@@ -20,6 +20,14 @@
 //    relative.
 // 2. The same run on one rank and on all: every probe value the same bits (DESIGN.md
 //    section 3: each rank gathers the body's points in one order and moves it the same way).
+// 4. A rigid plate driven into an elastic column (a keyword deck: the plate's element
+//    shares the column's base nodes; *MAT_RIGID CMO = 1 holds its x, y and rotations,
+//    *BOUNDARY_PRESCRIBED_MOTION_RIGID drives z at V). Reference: 1-D wave theory (Graff
+//    1975, section 1.1), as test_wave_1d: the base moving at V sends the stress -rho c V up
+//    the column, and the driver holds the plate against it with rho c V A. Before the wave
+//    returns (2L/c), the driver's mean force (history bcN.fz) within 1% of rho c V A, the
+//    mean axial stress behind the front within 1% of -rho c V, and the plate's velocity V
+//    exactly, its x, y and spin 0 exactly.
 // 3. An initial velocity about the body's centre of mass (`center: mass_center`, LS-DYNA's
 //    *INITIAL_VELOCITY_RIGID_BODY): at t = 0 a free rigid box's centre moves at V and its
 //    angular momentum is I omega about the centre; it keeps both for 200 steps (a free
@@ -209,6 +217,14 @@ parts:
                "deck.yaml:14: boundary_conditions[0]: this condition holds nodes of the rigid "
                "part a");
   expect_error(base + "    rigid: true\n", "every part is rigid");
+  // Rotations hold a rigid body only; a body is held whole (its part), not by a box of it.
+  expect_error(base + "boundary_conditions:\n  - {set: b.zmin, fix: [z, rx]}\n",
+               "rotations (rx, ry, rz, angular_velocity) are a rigid body's");
+  expect_error(base + "boundary_conditions:\n  - {part: b, angular_velocity: [0, 0, 1.0]}\n",
+               "rotations (rx, ry, rz, angular_velocity) are a rigid body's");
+  expect_error(base + "boundary_conditions:\n  - {set: {part: a, box: {min: [-1, -1, -1], "
+                      "max: [1, 1, 1]}}, fix: all}\n",
+               "a rigid body is held or driven whole (`part: a`");
   // Two rigid parts that share nodes (a keyword deck's two bricks, parts 1 and 2 of
   // *MAT_RIGID, and a third, deformable brick apart).
   std::string k = R"(*KEYWORD
@@ -363,6 +379,97 @@ initial_conditions:
                 norm(v1 - V) / norm(V), norm(L1 - L0) / norm(L0));
   EXPECT_LT(norm(v1 - V), 1e-12 * norm(V));
   EXPECT_LT(norm(L1 - L0), 1e-12 * norm(L0));
+}
+
+// 4. The driven plate: the keyword deck of a column of N cubes of side h on a rigid plate.
+std::string driven_column_deck(int N, double h, double V, double end) {
+  std::string k = fmt::format(R"(*KEYWORD
+*CONTROL_TERMINATION
+{:>10.4E}
+*PART
+column
+         1         1         1
+plate
+         2         1         2
+*SECTION_SOLID
+         1         1
+*MAT_ELASTIC
+1,7850.0,2.0E+11,0.3
+*MAT_RIGID
+2,7850.0,2.0E+11,0.3
+1.0,4.0,7.0
+
+*DEFINE_CURVE
+         9
+                 0.0                 1.0
+                 1.0                 1.0
+*BOUNDARY_PRESCRIBED_MOTION_RIGID
+2,3,0,9,{}
+*NODE
+)",
+                              end, V);
+  // Layer k of the column at z = k h (ids 4k + 1..4k + 4); the plate's lower face at -h.
+  const double xy[4][2] = {{0, 0}, {h, 0}, {h, h}, {0, h}};
+  for (int layer = -1; layer <= N; ++layer)
+    for (int a = 0; a < 4; ++a)
+      k += fmt::format("{},{},{},{}\n", layer < 0 ? 1001 + a : 4 * layer + a + 1, xy[a][0],
+                       xy[a][1], layer * h);
+  k += "*ELEMENT_SOLID\n";
+  for (int e = 0; e < N; ++e)
+    k += fmt::format("{},1,{},{},{},{},{},{},{},{}\n", e + 1, 4 * e + 1, 4 * e + 2, 4 * e + 3,
+                     4 * e + 4, 4 * e + 5, 4 * e + 6, 4 * e + 7, 4 * e + 8);
+  k += fmt::format("{},2,1001,1002,1003,1004,1,2,3,4\n", N + 1);
+  // The column's nodes above the base held laterally (uniaxial strain).
+  k += "*SET_NODE_LIST_GENERATE\n1\n";
+  k += fmt::format("5,{}\n", 4 * N + 4);
+  k += "*BOUNDARY_SPC_SET\n1,0,1,1,0\n*END\n";
+  return k;
+}
+
+TEST(RigidBody, DrivenPlateSendsTheOneDimensionalWave) {
+  const Comm world = Comm::world();
+  const int N = 100;
+  const double h = 0.0005, V = 2.0, length = N * h;
+  const double c = c_wave, t_end = 1.6 * length / c;
+  Config config = parse_keyword_deck(driven_column_deck(N, h, V, t_end), "column.k", ".");
+  ASSERT_EQ(config.boundary_conditions.size(), 3u); // the plate's hold, its drive, the sides
+  Simulation sim(config, world);
+  double force = 0, count = 0;
+  bool exact = true;
+  while (!sim.finished()) {
+    sim.step();
+    const Sample s = sim.sample();
+    const RigidMotion& m = sim.rigid_motions().at(0);
+    exact = exact && m.velocity == Vec3{0, 0, V} && m.omega == Vec3{0, 0, 0};
+    if (s.time > 0.3 * length / c && s.time < 0.9 * length / c) {
+      force += s.reaction.at(3 * 1 + 2); // bc1: the drive, z
+      count += 1;
+    }
+  }
+  force /= count;
+  // Mean axial stress of the lower quarter (behind the front).
+  double sum = 0, n = 0;
+  for (const auto& blk : sim.blocks()) {
+    if (blk.rigid) continue;
+    for (int e = 0; e < blk.size(); ++e) {
+      double z = 0;
+      for (int q = 0; q < 8; ++q) z += sim.nodes().x[2][blk.conn[q][e]] / 8;
+      if (z < 0.25 * length) {
+        sum += blk.stress[2][e];
+        n += 1;
+      }
+    }
+  }
+  const double stress = world.sum(sum) / world.sum(n);
+  const double f_ref = rho * c * V * h * h, s_ref = -rho * c * V;
+  if (world.rank() == 0)
+    std::printf("driven rigid plate: driver force %.5e N (1-D theory %.5e, rel %.2e), stress "
+                "%.5e Pa (theory %.5e, rel %.2e)\n",
+                force, f_ref, test::relative_error(force, f_ref), stress, s_ref,
+                test::relative_error(stress, s_ref));
+  EXPECT_TRUE(exact) << "the plate's held velocity and spin";
+  EXPECT_LT(test::relative_error(force, f_ref), 0.01);
+  EXPECT_LT(test::relative_error(stress, s_ref), 0.01);
 }
 
 } // namespace

@@ -51,7 +51,7 @@ Vec3 RigidMotion::point_velocity(const Vec3& x) const {
 }
 
 RigidMotion rigid_motion(std::span<const RigidPoint> p, const Vec3& g, double dt_prev,
-                         double dt_avg, double dt) {
+                         double dt_avg, double dt, const RigidHold& hold) {
   RigidMotion out;
   out.dt = dt;
   double M = 0;
@@ -85,7 +85,30 @@ RigidMotion rigid_motion(std::span<const RigidPoint> p, const Vec3& g, double dt
   }
   F += M * g;
   out.velocity = v_c + (dt_avg / M) * F;
+  for (int i = 0; i < 3; ++i)
+    if (hold.velocity_held[static_cast<std::size_t>(i)]) {
+      out.held_force[i] = M * (hold.velocity[i] - out.velocity[i]) / dt_avg;
+      out.velocity[i] = hold.velocity[i];
+    }
   L += dt_avg * T;
+  const bool spin_held = hold.spin_held[0] || hold.spin_held[1] || hold.spin_held[2];
+  // With components of omega held: the held rows of I omega = L replaced by
+  // tr(I) omega_i = tr(I) w_i (scaled so that solve() sees rows of one size).
+  auto solve_held = [&](const Mat3& I0, const Vec3& b) {
+    if (!spin_held) return solve(I0, b);
+    const double tr = I0[0][0] + I0[1][1] + I0[2][2];
+    Mat3 A;
+    Vec3 r = b;
+    for (int i = 0; i < 3; ++i) {
+      const bool held = hold.spin_held[static_cast<std::size_t>(i)];
+      for (int j = 0; j < 3; ++j) A[i][j] = held ? (i == j ? tr : 0.0) : I0[i][j];
+      if (held) r[i] = tr * hold.spin[i];
+    }
+    Vec3 w = solve(A, r);
+    for (int i = 0; i < 3; ++i)
+      if (hold.spin_held[static_cast<std::size_t>(i)]) w[i] = hold.spin[i]; // exactly
+    return w;
+  };
   // omega = I(n + 1/2)^-1 L. The mid-step offsets are Q r, Q = I + (s / 2) (A + A^2) (the
   // half of the step's rotation, turn()), so I(n + 1/2) = tr(S) 1 - S with S = Q J Q^T: no
   // pass over the points per iteration. From I(n), fixed-point iterations until omega
@@ -99,9 +122,10 @@ RigidMotion rigid_motion(std::span<const RigidPoint> p, const Vec3& g, double dt
   };
   Mat3 I;
   inertia_of(J, I);
-  Vec3 omega = solve(I, L);
+  Vec3 omega = solve_held(I, L);
   out.converged = false;
-  for (int it = 0; it < 100; ++it) {
+  const bool all_held = hold.spin_held[0] && hold.spin_held[1] && hold.spin_held[2];
+  for (int it = 0; it < 100 && !all_held; ++it) {
     const Vec3 a = 0.5 * dt * omega;
     const double s = 1 / (1 + dot(a, a)); // half of turn()'s 2 / (1 + a.a)
     const double A[3][3] = {{0, -a.z, a.y}, {a.z, 0, -a.x}, {-a.y, a.x, 0}};
@@ -119,7 +143,7 @@ RigidMotion rigid_motion(std::span<const RigidPoint> p, const Vec3& g, double dt
       for (int j = 0; j < 3; ++j)
         for (int k = 0; k < 3; ++k) S[i][j] += QJ[i][k] * Q[j][k];
     inertia_of(S, I);
-    const Vec3 next = solve(I, L);
+    const Vec3 next = solve_held(I, L);
     const double change = norm(next - omega);
     omega = next;
     if (change <= 1e-14 * norm(omega)) {
@@ -131,8 +155,16 @@ RigidMotion rigid_motion(std::span<const RigidPoint> p, const Vec3& g, double dt
   // a = a0 (1 + a^2), a = omega dt / 2, whose smaller root is at most 1); the iteration can
   // also settle on a spurious one at infinity, where the half-turned points collapse onto
   // the axis (QA round 29: 60,000 rad/s at dt 3.6e-5 s became 6e17 rad/s, the spin lost).
+  if (all_held) out.converged = true;
   if (!(norm(omega) * dt <= 2)) out.converged = false;
   out.omega = omega;
+  // The torque the held components take: I(n + 1/2) omega - L, per dt_avg (I of the last
+  // iteration: the one omega solved).
+  if (spin_held)
+    for (int i = 0; i < 3; ++i)
+      if (hold.spin_held[static_cast<std::size_t>(i)])
+        out.held_torque[i] =
+            (I[i][0] * omega[0] + I[i][1] * omega[1] + I[i][2] * omega[2] - L[i]) / dt_avg;
   return out;
 }
 

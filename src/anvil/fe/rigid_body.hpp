@@ -15,6 +15,7 @@
 // momentum.
 #pragma once
 
+#include <array>
 #include <span>
 
 #include "anvil/core/vec3.hpp"
@@ -28,6 +29,14 @@ struct RigidPoint {
   Vec3 f; // at t(n)
 };
 
+// Components of a body's motion that conditions hold (LS-DYNA's *MAT_RIGID CON1, CON2 and
+// *BOUNDARY_PRESCRIBED_MOTION_RIGID): the centre's velocity and the angular velocity over
+// the step, in global axes.
+struct RigidHold {
+  std::array<bool, 3> velocity_held{false, false, false}, spin_held{false, false, false};
+  Vec3 velocity{0, 0, 0}, spin{0, 0, 0}; // the held components' values (m/s, rad/s)
+};
+
 struct RigidMotion {
   Vec3 centre;   // of mass, at t(n)
   Vec3 velocity; // of the centre over the step
@@ -37,6 +46,9 @@ struct RigidMotion {
   // Whether omega settled (it cannot when the body would turn by about a radian or more
   // in the step: the caller stops the run rather than lose the spin).
   bool converged = true;
+  // The force and the torque about the centre the held components take (what the body's
+  // momentum and angular momentum change by beyond the forces', per dt_avg): 0 where free.
+  Vec3 held_force{0, 0, 0}, held_torque{0, 0, 0};
   // v(n + 1/2) of the point at x(n): it lands on centre + dt velocity + R (x - centre),
   // R the step's rotation. (R - I) r is formed as s (a x r + a x (a x r)), a = omega dt / 2,
   // s = 2 / (1 + a.a), not as R r - r: a small rotation would lose its digits to r.
@@ -44,8 +56,10 @@ struct RigidMotion {
 };
 
 // The motion from t(n) to t(n) + dt of the body whose points are `p`, under their forces
-// and the body acceleration g (dt_avg: the interval the velocity advances over).
+// and the body acceleration g (dt_avg: the interval the velocity advances over), with the
+// components `hold` holds set to its values: the free components of the angular velocity
+// then solve the free rows of L = I omega.
 RigidMotion rigid_motion(std::span<const RigidPoint> p, const Vec3& g, double dt_prev,
-                         double dt_avg, double dt);
+                         double dt_avg, double dt, const RigidHold& hold = {});
 
 } // namespace anvil

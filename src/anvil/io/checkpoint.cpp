@@ -195,6 +195,7 @@ Checkpoint capture(const Simulation& sim, const OutputState& outputs) {
   c.model_elements = sim.global_elements();
   c.mesh_fingerprint = sim.mesh_fingerprint();
   c.particle_fingerprint = sim.particle_fingerprint();
+  c.mass_scaling_target = sim.mass_scaling_target();
   double diag[2] = {sim.external_work_local(), sim.contact_energy_local()};
   comm.sum(std::span<double>(diag, 2));
   c.external_work = diag[0];
@@ -314,6 +315,7 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
   h["model_particles"] = c.model_particles;
   h["mesh_fingerprint"] = c.mesh_fingerprint;
   h["particle_fingerprint"] = c.particle_fingerprint;
+  h["mass_scaling_target"] = c.mass_scaling_target;
   h["next_fields"] = c.outputs.next_fields;
   h["next_history"] = c.outputs.next_history;
   h["next_checkpoint"] = c.outputs.next_checkpoint;
@@ -461,6 +463,8 @@ Checkpoint read_checkpoint(const std::string& path) {
     c.model_particles = h.at("model_particles").get<std::int64_t>();
     c.mesh_fingerprint = h.at("mesh_fingerprint").get<std::uint64_t>();
     c.particle_fingerprint = h.at("particle_fingerprint").get<std::uint64_t>();
+    if (h.contains("mass_scaling_target")) // (since mass scaling; same format version)
+      c.mass_scaling_target = h.at("mass_scaling_target").get<double>();
     c.outputs.field_count = h.at("field_count").get<int>();
     c.outputs.pvd = h.at("pvd").get<std::vector<std::pair<double, std::string>>>();
     c.outputs.particle_pvd =

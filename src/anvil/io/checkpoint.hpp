@@ -45,6 +45,9 @@ struct Checkpoint {
   double time = 0, dt = 0, dt_prev = 0, dt_initial = 0;
   std::int64_t cycle = 0;
   double external_work = 0, contact_energy = 0; // global diagnostics
+  // Mass scaling's element step (time_step.mass_scaling step / scale; 0: none): the
+  // masses of the run, which a restart must keep.
+  double mass_scaling_target = 0;
   OutputState outputs;
   std::vector<std::int64_t> node_gid;               // ascending
   std::vector<double> node_data;                    // node_values per node

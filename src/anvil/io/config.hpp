@@ -132,6 +132,14 @@ struct BoundaryCondition {
   Vec3 value;
   std::optional<TimeCurve> curve;
   std::array<bool, 3> components{false, false, false}; // components it prescribes
+  // A rigid part's rotations (its `part:` a rigid part: the condition holds the body's
+  // centre and spin, LS-DYNA's *MAT_RIGID CON1, CON2 and
+  // *BOUNDARY_PRESCRIBED_MOTION_RIGID): fixed ones (spin 0), prescribed ones (`spin`, rad/s,
+  // times the curve's value), and whether the deck named any (an error on nodes).
+  std::array<bool, 3> fix_spin{false, false, false};
+  std::array<bool, 3> spin_components{false, false, false};
+  Vec3 spin;
+  bool rotations = false;
   // The condition holds its components from `birth` to `death` (s; LS-DYNA's BIRTH and
   // DEATH): a step that starts at t(n) with birth <= t(n) < death; outside, they are free.
   double birth = 0, death = std::numeric_limits<double>::infinity();
@@ -223,9 +231,10 @@ struct Config {
   // Mass scaling at t = 0 (0: none): elements whose step would be below this get the mass
   // that raises it to this (LS-DYNA's DT2MS < 0 with MS1ST = 1: TSSFAC |DT2MS|), s.
   double mass_scaling_step = 0;
-  double fields_every = 0;     // 0: first and last only
-  double checkpoint_every = 0; // 0: checkpoints only when stopped by a signal
-  double history_every = 0;    // 0: every cycle
+  SourceLocation mass_scaling_where; // the deck's key or card field, for messages
+  double fields_every = 0;           // 0: first and last only
+  double checkpoint_every = 0;       // 0: checkpoints only when stopped by a signal
+  double history_every = 0;          // 0: every cycle
   OutputFormat output_format = OutputFormat::vtu;
   bool part_energies = false; // history.csv columns of each part's energies (LS-DYNA's matsum)
   std::vector<MaterialConfig> materials;

@@ -207,6 +207,30 @@ public:
     if (s == "z") return 2;
     fail(fmt::format("axis must be x, y or z, got '{}'", s));
   }
+  // A list of components of a rigid body's motion, x, y, z, rx, ry, rz, or `all` (the six);
+  // `rotations` says whether rx, ry or rz is listed by name.
+  std::array<bool, 6> components6(bool& rotations) const {
+    std::array<bool, 6> out{};
+    if (n_.IsScalar() && n_.Scalar() == "all") return {true, true, true, true, true, true};
+    if (n_.IsScalar())
+      fail(fmt::format("expected a list of x, y, z (rx, ry, rz for a rigid part), or all, got "
+                       "'{}'",
+                       n_.Scalar()));
+    const auto list = items();
+    if (list.empty()) fail("give at least one of x, y, z (rx, ry, rz for a rigid part), or all");
+    for (const auto& c : list) {
+      static constexpr std::array<std::string_view, 6> names{"x", "y", "z", "rx", "ry", "rz"};
+      const std::string v = c.str();
+      const auto it = std::find(names.begin(), names.end(), v);
+      if (it == names.end())
+        c.fail(fmt::format("expected x, y, z (rx, ry, rz for a rigid part), got '{}'", v));
+      const auto k = static_cast<std::size_t>(it - names.begin());
+      if (out[k]) c.fail(fmt::format("{} is listed twice", v));
+      out[k] = true;
+      rotations = rotations || k >= 3;
+    }
+    return out;
+  }
   // A list of components: [x, z], or `all`.
   std::array<bool, 3> components() const {
     std::array<bool, 3> out{false, false, false};
@@ -791,8 +815,9 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
     if (ts.has("mass_scaling")) {
       const Node ms = ts.child("mass_scaling");
       ms.check_keys({"step"});
-      if (!ms.has("step")) ms.fail("give `step`: the smallest time step the run takes, s");
+      if (!ms.has("step")) ms.fail("give `step`: the time step the run starts with, s");
       c.mass_scaling_step = ms.child("step").positive();
+      c.mass_scaling_where = ms.child("step").where();
     }
     if (ts.has("minimum_fraction")) {
       c.time_step_minimum_fraction = ts.child("minimum_fraction").number();
@@ -939,20 +964,27 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
     }
   }
 
+  // The nodes an initial or boundary condition acts on: `part: P` (all of P's; the item's
+  // key, where check_part and the model name the `part` key under it) or `set: S`.
+  auto parse_target = [&](const Node& n) {
+    if (n.has("part") == n.has("set")) n.fail("give exactly one of 'part' or 'set'");
+    Selection s;
+    if (n.has("part")) {
+      s.part = n.child("part").str();
+      s.where = {c.deck_file, n.child("part").line(), n.path()};
+    } else {
+      s = parse_set_ref(n.child("set"));
+    }
+    check_name(s);
+    return s;
+  };
+
   if (top.has("initial_conditions")) {
     for (const auto& n : top.child("initial_conditions").items()) {
       n.check_keys({"part", "set", "velocity", "angular_velocity", "center"});
       InitialCondition ic;
       ic.where = n.where();
-      if (n.has("part") == n.has("set")) n.fail("give exactly one of 'part' or 'set'");
-      if (n.has("part")) {
-        ic.nodes.part = n.child("part").str();
-        // The item's key: check_part and the model name the `part` key under it.
-        ic.nodes.where = {c.deck_file, n.child("part").line(), n.path()};
-      } else {
-        ic.nodes = parse_set_ref(n.child("set"));
-      }
-      check_name(ic.nodes);
+      ic.nodes = parse_target(n);
       if (!n.has("velocity") && !n.has("angular_velocity"))
         n.fail("give a velocity, an angular_velocity, or both");
       if (n.has("velocity")) ic.velocity = n.child("velocity").vec3();
@@ -976,17 +1008,28 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 
   if (top.has("boundary_conditions")) {
     for (const auto& n : top.child("boundary_conditions").items()) {
-      n.check_keys(
-          {"set", "fix", "velocity", "displacement", "curve", "components", "birth", "death"});
+      n.check_keys({"set", "part", "fix", "velocity", "displacement", "angular_velocity", "curve",
+                    "components", "birth", "death"});
       BoundaryCondition bc;
       bc.where = n.where();
       parse_window(n, bc.birth, bc.death);
-      bc.nodes = parse_set_ref(n.required("set"));
-      check_name(bc.nodes);
-      if (int(n.has("fix")) + int(n.has("velocity")) + int(n.has("displacement")) != 1)
+      bc.nodes = parse_target(n);
+      const bool spun = n.has("angular_velocity");
+      if (n.has("velocity") && n.has("displacement"))
         n.fail("give exactly one of 'fix', 'velocity' or 'displacement'");
+      if (n.has("displacement") && spun)
+        n.child("angular_velocity")
+            .fail("angular_velocity goes with velocity (a rotation is not prescribed as an "
+                  "angle)");
+      if (int(n.has("fix")) + int(n.has("velocity") || n.has("displacement") || spun) != 1)
+        n.fail("give exactly one of 'fix', 'velocity' (and/or 'angular_velocity' for a rigid "
+               "part) or 'displacement'");
       if (n.has("fix")) {
-        bc.fix = n.child("fix").components();
+        const auto held = n.child("fix").components6(bc.rotations);
+        for (std::size_t i = 0; i < 3; ++i) {
+          bc.fix[i] = held[i];
+          bc.fix_spin[i] = held[3 + i];
+        }
         for (const char* key : {"components", "curve"})
           if (n.has(key))
             n.child(key).fail(fmt::format(
@@ -994,25 +1037,54 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
       } else {
         bc.prescribed = true;
         const bool moved = n.has("displacement");
+        const bool moving = moved || n.has("velocity");
         bc.motion =
             moved ? BoundaryCondition::Motion::displacement : BoundaryCondition::Motion::velocity;
-        bc.value = n.child(moved ? "displacement" : "velocity").vec3();
-        bc.components = n.has("components") ? n.child("components").components()
-                                            : std::array<bool, 3>{true, true, true};
+        if (moving) bc.value = n.child(moved ? "displacement" : "velocity").vec3();
+        if (spun) {
+          bc.spin = n.child("angular_velocity").vec3();
+          bc.rotations = true;
+        }
+        if (n.has("components")) {
+          bool listed_rotations = false;
+          const auto held = n.child("components").components6(listed_rotations);
+          bc.rotations = bc.rotations || listed_rotations;
+          for (std::size_t i = 0; i < 3; ++i) {
+            bc.components[i] = held[i] && moving;
+            bc.spin_components[i] = held[3 + i] && spun;
+            if (held[i] && !moving)
+              n.child("components")
+                  .fail(fmt::format("{} is listed, but no velocity or displacement is given",
+                                    "xyz"[i]));
+            if (held[3 + i] && !spun)
+              n.child("components")
+                  .fail(fmt::format("r{} is listed, but no angular_velocity is given", "xyz"[i]));
+          }
+        } else {
+          bc.components = {moving, moving, moving};
+          bc.spin_components = {spun, spun, spun};
+        }
         // A value on a component the condition leaves free would be dropped: a driver
         // meant to move along x that holds only z would stand still in x (QA round 24).
-        for (std::size_t i = 0; i < 3; ++i)
-          if (!bc.components[i] && bc.value[static_cast<int>(i)] != 0)
+        for (std::size_t i = 0; i < 3; ++i) {
+          if (moving && !bc.components[i] && bc.value[static_cast<int>(i)] != 0)
             n.child(moved ? "displacement" : "velocity")
                 .fail(fmt::format("{} on {}, which `components` leaves out: list {} there, or "
                                   "give 0",
                                   bc.value[static_cast<int>(i)], "xyz"[i], "xyz"[i]));
+          if (spun && !bc.spin_components[i] && bc.spin[static_cast<int>(i)] != 0)
+            n.child("angular_velocity")
+                .fail(fmt::format("{} about {}, which `components` leaves out: list r{} there, "
+                                  "or give 0",
+                                  bc.spin[static_cast<int>(i)], "xyz"[i], "xyz"[i]));
+        }
         if (n.has("curve")) bc.curve = parse_curve(n.child("curve"));
         if (moved && !bc.curve)
           n.fail("a displacement needs its time history: add curve: [[t0, 0], [t1, 1], ...]");
         if (bc.curve) {
           const double amplitude =
-              std::max({std::abs(bc.value.x), std::abs(bc.value.y), std::abs(bc.value.z)});
+              std::max({std::abs(bc.value.x), std::abs(bc.value.y), std::abs(bc.value.z),
+                        std::abs(bc.spin.x), std::abs(bc.spin.y), std::abs(bc.spin.z)});
           if (const auto problem = time_history_problem(amplitude, *bc.curve, moved);
               !problem.empty())
             n.child("curve").fail(problem);

@@ -567,6 +567,9 @@ struct MaterialCard {
   Where at;
   TableValues tables;
   bool rigid = false; // *MAT_RIGID: its parts are rigid bodies
+  // *MAT_RIGID CMO = 1: CON1, CON2 (0-7: none, x, y, z, xy, yz, zx, all), the translations
+  // and rotations of its bodies held fixed.
+  int con1 = 0, con2 = 0;
   // FS, FAIL, PSFAIL: the plastic strain at which its parts' elements erode (0: never).
   double failure_strain = 0;
   // *MAT_PIECEWISE_LINEAR_PLASTICITY's LCSS: the hardening curve, read from its
@@ -621,7 +624,9 @@ struct CurveCard {
 // velocity or displacement, SF times curve LCID.
 struct MotionCard {
   std::int64_t set = 0, node = 0; // one of them
+  std::int64_t pid = 0;           // or a rigid part (*BOUNDARY_PRESCRIBED_MOTION_RIGID)
   int dof = 0;                    // 0, 1, 2: x, y, z
+  bool rotation = false;          // DOF 5, 6, 7 of a rigid part: its spin about x, y, z
   bool displacement = false;      // VAD 2 (else 0, velocity)
   std::int64_t lcid = 0;
   double sf = 1;
@@ -773,15 +778,19 @@ private:
     if (n == "MAT_JOHNSON_COOK" || n == "MAT_015" || n == "MAT_JOHNSON_COOK_TITLE" ||
         n == "MAT_015_TITLE")
       return mat_johnson_cook(b);
-    // Keywords that drive, load or shape rigid bodies: ignoring them would run another
-    // model (QA round 29: a driven body ran free), so they are errors.
+    if (n == "BOUNDARY_PRESCRIBED_MOTION_RIGID" || n == "BOUNDARY_PRESCRIBED_MOTION_RIGID_ID")
+      return prescribed_motion_rigid(b);
+    // Keywords that drive, load or shape rigid bodies otherwise: ignoring them would run
+    // another model (QA round 29: a driven body ran free), so they are errors.
     for (const char* k : {"BOUNDARY_PRESCRIBED_MOTION_RIGID", "LOAD_RIGID_BODY", "PART_INERTIA",
                           "CONSTRAINED_RIGID_BODIES", "CONSTRAINED_EXTRA_NODES"})
       if (starts_with(n, k))
         throw InputError(where_of(b.head).loc("*" + b.name),
-                         fmt::format("*{} is not supported: anvil's rigid bodies (*MAT_RIGID) "
-                                     "move freely under contact, loads and gravity, with the "
-                                     "mass and inertia of their elements' nodes",
+                         fmt::format("*{} is not supported: anvil's rigid bodies (*MAT_RIGID, "
+                                     "its CMO = 1 constraints) move under contact, loads and "
+                                     "gravity with the mass and inertia of their elements' "
+                                     "nodes, driven by *BOUNDARY_PRESCRIBED_MOTION_RIGID(_ID) "
+                                     "and started by *INITIAL_VELOCITY_RIGID_BODY",
                                      b.name));
     if (n == "MAT_RIGID" || n == "MAT_020" || n == "MAT_RIGID_TITLE" || n == "MAT_020_TITLE")
       return mat_rigid(b);
@@ -1243,9 +1252,9 @@ private:
   static void failure_strain(const Card& card, int field, const char* name, MaterialCard& m) {
     const double strain = card.real(field, name, 0);
     if (strain < 0)
-      card.fail(name, fmt::format("{} = {} (a user failure subroutine or LS-DYNA's other "
-                                  "failure forms) is not supported: give the effective plastic "
-                                  "strain at failure, or 0 for none",
+      card.fail(name, fmt::format("{} = {}: a negative value (LS-DYNA's other failure forms, "
+                                  "such as MAT_024's user failure subroutine) is not supported: "
+                                  "give the effective plastic strain at failure, or 0 for none",
                                   name, strain));
     if (strain == 0 || strain >= 1e16) return;
     m.failure_strain = strain;
@@ -1266,11 +1275,28 @@ private:
     elastic_fields(c1, m.params, 1, 2, 3);
     const Line l2 = c.next();
     const Card c2(b, l2, {10, 10, 10});
+    // CMO = 1: CON1, CON2 hold the translations and rotations in global axes (anvil's
+    // `fix` of the body); CMO = -1 (a local system) is not supported; CMO = 0: none.
     const double cmo = c2.real(0, "CMO", 0);
-    if (cmo != 0 && (c2.real(1, "CON1", 0) != 0 || c2.real(2, "CON2", 0) != 0))
-      c2.fail("CMO", "constraints of a rigid body (CMO with CON1, CON2) are not supported: "
-                     "anvil's rigid bodies move freely");
-    c.next(); // LCO or A1-A6: the constraint directions, unused without constraints
+    const double con1 = c2.real(1, "CON1", 0), con2 = c2.real(2, "CON2", 0);
+    if (cmo == -1 && (con1 != 0 || con2 != 0))
+      c2.fail("CMO", "CMO = -1 (constraints in a local system, VEC) is not supported: give "
+                     "CMO = 1 (global axes)");
+    if (cmo != 0 && cmo != 1 && cmo != -1) c2.fail("CMO", "CMO must be -1, 0 or 1");
+    for (const auto& [value, name] : {std::pair{con1, "CON1"}, {con2, "CON2"}})
+      if (value != std::floor(value) || value < 0 || value > 7)
+        c2.fail(name, fmt::format("{} must be 0-7 (none, x, y, z, xy, yz, zx, all) with "
+                                  "CMO = 1, found {}",
+                                  name, value));
+    if (cmo == 1) {
+      m.con1 = static_cast<int>(con1);
+      m.con2 = static_cast<int>(con2);
+    } else if (con1 != 0 || con2 != 0) {
+      m.notes.push_back(fmt::format("{}: material {}: CON1 and CON2 hold nothing with CMO = 0 "
+                                    "(LS-DYNA's \"no constraints\"): give CMO = 1",
+                                    where_of(l2).str(), mid));
+    }
+    c.next(); // LCO or A1-A6: the local constraint directions, unused
     add_material(c1, mid, std::move(m));
   }
 
@@ -1564,6 +1590,46 @@ private:
       bc.where = where;
       ordered.emplace_back(seq, std::move(bc));
     };
+    // *BOUNDARY_PRESCRIBED_MOTION_RIGID: the body of a rigid part.
+    auto rigid_motion_condition = [&](const MotionCard& m, std::int64_t seq, const Config& cfg) {
+      const std::string key = "*" + m.keyword;
+      const auto p = std::find_if(cfg.parts.begin(), cfg.parts.end(),
+                                  [&](const PartConfig& q) { return q.name == part_name(m.pid); });
+      if (std::none_of(parts_.begin(), parts_.end(),
+                       [&](const PartCard& q) { return q.pid == m.pid; }))
+        throw InputError(m.at.loc(key + ".PID"),
+                         fmt::format("part {} is not defined (*PART)", m.pid));
+      if (p == cfg.parts.end() || !p->rigid)
+        throw InputError(m.at.loc(key + ".PID"),
+                         fmt::format("part {} is not rigid (*MAT_RIGID): *{} drives a rigid "
+                                     "body (give *BOUNDARY_PRESCRIBED_MOTION_SET for nodes)",
+                                     m.pid, m.keyword));
+      const CurveCard& cc = curve(m.lcid, m.at.loc(key + ".LCID"));
+      const TimeCurve& tc = cc.curve;
+      if (const auto problem = time_history_problem(m.sf, tc, m.displacement); !problem.empty())
+        throw InputError(m.at.loc(key + ".LCID"), fmt::format("curve {}: {}", m.lcid, problem));
+      warn_if_curve_ends(m.lcid, cc);
+      warn_if_zero_scale(m.sf, m.at, key, warnings);
+      BoundaryCondition bc;
+      bc.nodes.part = p->name;
+      bc.nodes.where = m.at.loc(key);
+      bc.prescribed = true;
+      bc.motion = m.displacement ? BoundaryCondition::Motion::displacement
+                                 : BoundaryCondition::Motion::velocity;
+      if (m.rotation) {
+        bc.spin_components[static_cast<std::size_t>(m.dof)] = true;
+        bc.spin[m.dof] = m.sf;
+        bc.rotations = true;
+      } else {
+        bc.components[static_cast<std::size_t>(m.dof)] = true;
+        bc.value[m.dof] = m.sf;
+      }
+      bc.curve = tc;
+      bc.birth = m.birth;
+      bc.death = m.death;
+      bc.where = bc.nodes.where;
+      ordered.emplace_back(seq, std::move(bc));
+    };
     auto motion_condition = [&](const MotionCard& m, std::int64_t seq,
                                 const std::string& set_name) {
       const std::string key = "*" + m.keyword;
@@ -1656,7 +1722,9 @@ private:
         const MotionCard& m = motions_[k];
         std::array<bool, 3> on{false, false, false};
         on[static_cast<std::size_t>(m.dof)] = true;
-        if (m.set != 0) {
+        if (m.pid != 0) {
+          rigid_motion_condition(m, seq, c);
+        } else if (m.set != 0) {
           const std::string name = node_set_name(m.set, m.at, "*" + m.keyword + ".NSID");
           motion_condition(m, seq, name);
           for (const auto pos : mesh.node_sets.at(name)) hold(pos, on, seq);
@@ -1687,6 +1755,21 @@ private:
       else
         fix_condition(g.seq, name, g.at.loc(g.keyword == "NODE" ? "*NODE.TC" : "*" + g.keyword),
                       g.on);
+    }
+    // *MAT_RIGID CMO = 1: its bodies' held translations and rotations, before every card
+    // (a prescribed motion on a held component wins, as a later card does).
+    static constexpr int masks[8] = {0, 1, 2, 4, 3, 6, 5, 7};
+    for (const auto& [part, con] : rigid_constraints_) {
+      BoundaryCondition bc;
+      bc.nodes.part = part;
+      bc.nodes.where = con.at.loc("*MAT_RIGID.CMO");
+      bc.where = bc.nodes.where;
+      for (std::size_t i = 0; i < 3; ++i) {
+        bc.fix[i] = (masks[con.con1] >> i & 1) != 0;
+        bc.fix_spin[i] = (masks[con.con2] >> i & 1) != 0;
+      }
+      bc.rotations = con.con2 != 0;
+      ordered.emplace_back(-1, std::move(bc));
     }
     std::stable_sort(ordered.begin(), ordered.end(),
                      [](const auto& a, const auto& b) { return a.first < b.first; });
@@ -2105,19 +2188,54 @@ private:
                                      "(VAD 0) or a displacement (VAD 2)",
                                      vad));
       m.displacement = vad == 2;
-      m.lcid = card.integer(3, "LCID", 0);
-      if (m.lcid <= 0) card.fail("LCID", "LCID must be the id of a *DEFINE_CURVE");
-      m.sf = card.real(4, "SF", 1.0);
-      const double death = card.real(6, "DEATH", 0);
-      if (death != 0 && death < 1e20) m.death = death; // (LS-DYNA's "never" is 1e28)
-      m.birth = card.real(7, "BIRTH", 0);
-      if (m.birth < 0) card.fail("BIRTH", fmt::format("BIRTH = {} is negative", m.birth));
-      if (!(m.death > m.birth))
-        card.fail("DEATH", fmt::format("DEATH = {} is not after BIRTH = {}", m.death, m.birth));
-      m.at = where_of(*l);
-      m.keyword = b.name;
-      m.seq = card_seq_++;
-      motions_.push_back(m);
+      add_motion(b, card, *l, m);
+    }
+  }
+
+  // The fields a prescribed motion card shares after DOF and VAD (LCID, SF, VID, DEATH,
+  // BIRTH in fields 3-7), then m to the motions in card order.
+  void add_motion(const Block& b, const Card& card, const Line& l, MotionCard& m) {
+    m.lcid = card.integer(3, "LCID", 0);
+    if (m.lcid <= 0) card.fail("LCID", "LCID must be the id of a *DEFINE_CURVE");
+    m.sf = card.real(4, "SF", 1.0);
+    const double death = card.real(6, "DEATH", 0);
+    if (death != 0 && death < 1e20) m.death = death; // (LS-DYNA's "never" is 1e28)
+    m.birth = card.real(7, "BIRTH", 0);
+    if (m.birth < 0) card.fail("BIRTH", fmt::format("BIRTH = {} is negative", m.birth));
+    if (!(m.death > m.birth))
+      card.fail("DEATH", fmt::format("DEATH = {} is not after BIRTH = {}", m.death, m.birth));
+    m.at = where_of(l);
+    m.keyword = b.name;
+    m.seq = card_seq_++;
+    motions_.push_back(m);
+  }
+
+  // PID, DOF, VAD, LCID, SF, VID, DEATH, BIRTH (LS-DYNA manual,
+  // *BOUNDARY_PRESCRIBED_MOTION_RIGID): the centre of mass (DOF 1-3) or the spin (DOF 5-7)
+  // of a rigid part, anvil's condition on the body (`part:`).
+  void prescribed_motion_rigid(const Block& b) {
+    Cursor c(b);
+    if (ends_with(b.name, "_ID")) c.next();
+    while (auto l = c.next_record()) {
+      const Card card(b, *l, {10, 10, 10, 10, 10, 10, 10, 10});
+      MotionCard m;
+      m.pid = card.integer(0, "PID", 0);
+      if (m.pid <= 0) card.fail("PID", "PID must be a positive part id");
+      const auto dof = card.integer(1, "DOF", 0);
+      if (!((dof >= 1 && dof <= 3) || (dof >= 5 && dof <= 7)))
+        card.fail("DOF", fmt::format("DOF = {} is not supported: anvil prescribes the "
+                                     "translations x, y, z (DOF 1, 2, 3) and the rotations about "
+                                     "x, y, z (DOF 5, 6, 7) of a rigid body",
+                                     dof));
+      m.rotation = dof >= 5;
+      m.dof = static_cast<int>(m.rotation ? dof - 5 : dof - 1);
+      const auto vad = card.integer(2, "VAD", 0);
+      if (vad != 0 && (vad != 2 || m.rotation))
+        card.fail("VAD", fmt::format("VAD = {} is not supported: anvil prescribes a velocity "
+                                     "(VAD 0) or, of a translation, a displacement (VAD 2)",
+                                     vad));
+      m.displacement = vad == 2;
+      add_motion(b, card, *l, m);
     }
   }
 
@@ -2214,6 +2332,7 @@ private:
     std::vector<std::array<int, 3>> holder(mesh.nodes.size(), {-1, -1, -1});
     std::map<std::pair<int, int>, std::int64_t> clashes; // (earlier, later) -> components
     for (std::size_t b = 0; b < bcs.size(); ++b) {
+      if (bcs[b].nodes.name.empty()) continue; // a rigid body's (its part): held whole
       const auto& on = bcs[b].prescribed ? bcs[b].components : bcs[b].fix;
       for (const std::int64_t n : mesh.node_sets.at(bcs[b].nodes.name))
         for (std::size_t i = 0; i < 3; ++i) {
@@ -2470,7 +2589,11 @@ private:
     Cursor c(b);
     const Line l = c.next();
     const Card card(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+    // (A repeated *CONTROL_TIMESTEP replaces the earlier one whole: its blank TSSFAC is
+    // LS-DYNA's 0.9, and the earlier card's notes go; QA round 30.)
+    timestep_notes_.clear();
     const double tssfac = card.real(1, "TSSFAC", 0);
+    tssfac_ = 0.9;
     if (tssfac != 0) {
       if (!(tssfac > 0 && tssfac <= 1))
         card.fail("TSSFAC", "TSSFAC must be in (0, 1]: a fraction of the stable time step");
@@ -2481,24 +2604,29 @@ private:
     // DT2MS > 0 (mass added to and taken from every element): not supported.
     const double dt2ms = card.real(4, "DT2MS", 0);
     mass_scaling_dt2ms_ = 0;
+    mass_scaling_at_ = where_of(l).loc("*" + b.name + ".DT2MS");
     if (!std::isfinite(dt2ms)) card.fail("DT2MS", "DT2MS must be a finite number");
+    const auto ms1st = card.integer(7, "MS1ST", 0);
+    if (ms1st != 0 && ms1st != 1) card.fail("MS1ST", "MS1ST must be 0 or 1");
     if (dt2ms > 0)
-      warnings_.push_back(fmt::format("{}: DT2MS > 0 (mass added to and taken from every "
-                                      "element) is ignored: anvil takes the stable time step of "
-                                      "the unscaled mass (DT2MS < 0, mass added where needed, "
-                                      "is supported)",
-                                      where_of(l).str()));
+      timestep_notes_.push_back(
+          fmt::format("{}: DT2MS > 0 (mass added to and taken from every "
+                      "element) is ignored: anvil takes the stable time step of "
+                      "the unscaled mass (DT2MS < 0, mass added where needed, "
+                      "is supported)",
+                      where_of(l).str()));
     if (dt2ms < 0) {
       mass_scaling_dt2ms_ = -dt2ms;
-      if (card.integer(7, "MS1ST", 0) == 0)
-        warnings_.push_back(fmt::format(
+      if (ms1st == 0)
+        timestep_notes_.push_back(fmt::format(
             "{}: DT2MS < 0: anvil adds the mass once, at t = 0, to the elements at rest in their "
             "initial shape (LS-DYNA's MS1ST = 1); LS-DYNA's default (MS1ST = 0) adds mass every "
-            "cycle, so that crushed elements keep the step TSSFAC |DT2MS|: here their step falls",
+            "cycle, so that crushed elements keep the step TSSFAC |DT2MS|, where in anvil their "
+            "step falls below it",
             where_of(l).str()));
     }
     if (card.integer(5, "LCTM", 0) != 0)
-      warnings_.push_back(
+      timestep_notes_.push_back(
           fmt::format("{}: LCTM (a time step limit curve) is ignored", where_of(l).str()));
     optional_cards(b, c, 1, true); // card 2: mass scaling options
   }
@@ -2747,8 +2875,16 @@ private:
   double endtim_ = 0;
   std::int64_t endcyc_ = 0;
   double tssfac_ = 0.9;
+  // The rigid parts whose *MAT_RIGID holds them (CMO = 1): part name -> CON1, CON2.
+  struct RigidConstraint {
+    int con1, con2;
+    Where at;
+  };
+  std::map<std::string, RigidConstraint> rigid_constraints_;
   double dtmin_ = 0;              // *CONTROL_TERMINATION DTMIN
   double mass_scaling_dt2ms_ = 0; // |DT2MS| of *CONTROL_TIMESTEP when DT2MS < 0
+  SourceLocation mass_scaling_at_;
+  std::vector<std::string> timestep_notes_; // the warnings of the *CONTROL_TIMESTEP in force
   std::int64_t control_ihq_ = 0;
   double control_qh_ = 0, control_q1_ = 0, control_q2_ = 0;
   double d3plot_dt_ = 0, history_dt_ = 0;
@@ -2821,6 +2957,8 @@ Config KeywordReader::config(const std::string& deck_file) {
   c.time_step_scale = tssfac_;
   c.time_step_minimum_fraction = dtmin_;
   c.mass_scaling_step = tssfac_ * mass_scaling_dt2ms_;
+  c.mass_scaling_where = mass_scaling_at_;
+  warnings.insert(warnings.end(), timestep_notes_.begin(), timestep_notes_.end());
 
   // Parts with solid elements; the others (shells, beams, ...) are left out.
   std::map<std::int64_t, std::size_t> solids;
@@ -2970,6 +3108,7 @@ Config KeywordReader::config(const std::string& deck_file) {
     pc.material = mname;
     pc.rigid = mc.rigid;
     pc.erosion.plastic_strain = mc.failure_strain;
+    if (mc.con1 != 0 || mc.con2 != 0) rigid_constraints_[pc.name] = {mc.con1, mc.con2, mc.at};
 
     // Hourglass and bulk viscosity: the part's *HOURGLASS, else the *CONTROL_ cards, else
     // LS-DYNA's defaults (which are anvil's: viscous 0.1, Q1 1.5, Q2 0.06).

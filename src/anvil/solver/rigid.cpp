@@ -18,6 +18,14 @@
 
 namespace anvil {
 
+int Simulation::rigid_body_of(const BoundaryCondition& bc) const {
+  if (!bc.nodes.name.empty() || bc.nodes.box || !bc.nodes.part) return -1;
+  for (std::size_t p = 0; p < config_.parts.size(); ++p)
+    if (config_.parts[p].rigid && config_.parts[p].name == *bc.nodes.part)
+      return static_cast<int>(p);
+  return -1;
+}
+
 void Simulation::setup_rigid_bodies(const Mesh& mesh) {
   const std::size_t nn = fe_.node_gid.size();
   rigid_gids_.clear();
@@ -49,17 +57,26 @@ void Simulation::setup_rigid_bodies(const Mesh& mesh) {
     throw InputError(config_.parts[0].where,
                      "every part is rigid: anvil needs a deformable part or particles (their "
                      "stable time step sets the step)");
-  // A condition on a rigid body's node would fight the body's motion.
-  for (const auto& bc : config_.boundary_conditions) {
+  // A condition on some of a rigid body's nodes would fight the body's motion; one on the
+  // whole part holds the body.
+  condition_body_.assign(config_.boundary_conditions.size(), -1);
+  for (std::size_t c = 0; c < config_.boundary_conditions.size(); ++c) {
+    const auto& bc = config_.boundary_conditions[c];
+    if (const int p = rigid_body_of(bc); p >= 0) {
+      condition_body_[c] = static_cast<int>(
+          std::find(part_of_body.begin(), part_of_body.end(), static_cast<std::size_t>(p)) -
+          part_of_body.begin());
+      continue;
+    }
     const auto ids = selected_nodes(mesh, bc.nodes);
     for (std::size_t o = 0; o < rigid_gids_.size(); ++o)
       for (const std::int64_t id : ids)
         if (std::binary_search(rigid_gids_[o].begin(), rigid_gids_[o].end(), id))
           throw InputError(bc.where,
-                           fmt::format("this condition holds nodes of the rigid part {}: "
-                                       "anvil's rigid bodies move freely (constraining or "
-                                       "driving them is not supported yet; drive a deformable "
-                                       "part instead)",
+                           fmt::format("this condition holds nodes of the rigid part {}: a "
+                                       "rigid body is held or driven whole (`part: {}`, its "
+                                       "centre and rotations), not node by node",
+                                       config_.parts[part_of_body[o]].name,
                                        config_.parts[part_of_body[o]].name));
   }
   if (!config_.rigid_walls.empty())
@@ -74,6 +91,7 @@ void Simulation::setup_rigid_bodies(const Mesh& mesh) {
   rigid_part_ = std::move(part_of_body);
   rigid_points_.assign(rigid_offset_.back(), RigidPoint{});
   rigid_motion_.assign(rigid_gids_.size(), RigidMotion{});
+  rigid_holder_.assign(rigid_gids_.size(), {-1, -1, -1});
   rigid_node_.assign(nn, 0);
   rigid_nodes_.clear();
   for (std::size_t n = 0; n < nn; ++n)
@@ -169,10 +187,31 @@ void Simulation::move_rigid_bodies(bool with_contact) {
   comm_.allgatherv(std::span<const RigidRecord>(rigid_send_), rigid_recv_, rigid_bytes_);
   for (const auto& r : rigid_recv_) rigid_points_[static_cast<std::size_t>(r.at)] = r.p;
   const Vec3 g{gravity_[0], gravity_[1], gravity_[2]};
+  const auto& bcs = config_.boundary_conditions;
   for (std::size_t o = 0; o < rigid_gids_.size(); ++o) {
     const std::span<const RigidPoint> pts(rigid_points_.data() + rigid_offset_[o],
                                           rigid_gids_[o].size());
-    rigid_motion_[o] = rigid_motion(pts, g, clock_.dt_prev, dt_avg_, clock_.dt);
+    // The components the body's conditions hold over the step: each by the last active
+    // one in the deck that holds it (as for nodes), at its value times its time history.
+    RigidHold hold;
+    rigid_holder_[o] = {-1, -1, -1};
+    for (std::size_t b = 0; b < bcs.size(); ++b) {
+      if (condition_body_[b] != static_cast<int>(o) || !bc_active_[b]) continue;
+      const auto& bc = bcs[b];
+      for (std::size_t i = 0; i < 3; ++i) {
+        const int k = static_cast<int>(i);
+        if (bc.prescribed ? bc.components[i] : bc.fix[i]) {
+          hold.velocity_held[i] = true;
+          hold.velocity[k] = bc.prescribed ? bc.value[k] * motion_factor_[b] : 0.0;
+          rigid_holder_[o][i] = static_cast<int>(b);
+        }
+        if (bc.prescribed ? bc.spin_components[i] : bc.fix_spin[i]) {
+          hold.spin_held[i] = true;
+          hold.spin[k] = bc.prescribed ? bc.spin[k] * motion_factor_[b] : 0.0;
+        }
+      }
+    }
+    rigid_motion_[o] = rigid_motion(pts, g, clock_.dt_prev, dt_avg_, clock_.dt, hold);
     // (Every rank computes the same motion: every rank stops.)
     if (!rigid_motion_[o].converged)
       throw PhysicsError(fmt::format("rigid part {}", config_.parts[rigid_part_[o]].name),

@@ -511,10 +511,15 @@ void Simulation::apply_boundary_conditions(const Mesh& mesh) {
   for (int i = 0; i < 3; ++i) v_bc_[i].assign(nn, 0.0);
   for (auto& s : bc_source_) s.assign(nn, -1);
   for (auto& r : bc_reaction_) r.assign(nn, 0.0);
-  // The conditions that hold each node component, in deck order.
+  // The conditions that hold each node component, in deck order (a rigid body's conditions
+  // hold the body, setup_rigid_bodies).
   std::vector<std::vector<int>> held(3 * nn);
   for (std::size_t b = 0; b < bcs.size(); ++b) {
     const auto& bc = bcs[b];
+    if (rigid_body_of(bc) >= 0) continue;
+    if (bc.rotations)
+      throw InputError(bc.where, "rotations (rx, ry, rz, angular_velocity) are a rigid body's: "
+                                 "give `part:` a rigid part (nodes have no rotations)");
     const auto ids = selected_nodes(mesh, bc.nodes);
     warn_if_outside_model(ids, bc.nodes.where);
     for (std::size_t n = 0; n < nn; ++n) {
@@ -1338,6 +1343,14 @@ std::vector<double> Simulation::reactions() const {
         if (const int b = pt.bc_source[i][k]; b >= 0 && (pt.constrained[k] & (1u << i)))
           mine.push_back({global_nodes_ + pt.gid[k], b, i, 1, p_reaction_[i][k]});
   }
+  // The rigid bodies' held components: the force on the body (every rank computed the
+  // same motion; rank 0 gives it once).
+  if (comm_.rank() == 0)
+    for (std::size_t o = 0; o < rigid_holder_.size(); ++o)
+      for (int i = 0; i < 3; ++i)
+        if (const int b = rigid_holder_[o][static_cast<std::size_t>(i)]; b >= 0)
+          mine.push_back(
+              {-1 - static_cast<std::int64_t>(o), b, i, 1, rigid_motion_[o].held_force[i]});
   // The first step's row (t = 0) holds the impulses that set the constrained components at
   // t = 0 (apply_boundary_conditions), spread over its velocity interval as the walls'.
   if (sample_cycle_ == 0 && clock_.cycle > 0)
@@ -1378,6 +1391,18 @@ void Simulation::restore(const Checkpoint& c) {
                                  "(their order, lattices, spacing or density) differ from those "
                                  "of the run that wrote it (restart with the deck it came from)",
                                  from));
+  // The masses: mass scaling's (QA round 30: a restart without it, or with another step,
+  // ran on with other masses and the velocities of the old ones, the balance off by 16%).
+  if (c.mass_scaling_target != mass_scaling_target()) {
+    auto said = [](double target) {
+      return target > 0 ? fmt::format("scales masses to an element step of {:.9g} s", target)
+                        : std::string("scales no masses");
+    };
+    throw InputError(fmt::format("{} {}, this deck {} (time_step.mass_scaling step / scale): "
+                                 "the masses would change under the run; restart with the "
+                                 "mass scaling of the run that wrote it",
+                                 from, said(c.mass_scaling_target), said(mass_scaling_target())));
+  }
   if (c.time > config_.end_time * (1 + 1e-12) || c.cycle > config_.end_cycles)
     throw InputError(fmt::format(
         "{}: {} is at t = {:.9g} s (cycle {}), past the deck's termination ({}): nothing is "
@@ -1518,6 +1543,7 @@ void Simulation::scale_masses() {
   const CornerView corners{
       {corner_force_[0].data(), corner_force_[1].data(), corner_force_[2].data()}};
   std::vector<double> dte;
+  std::int64_t overflow = 0; // a factor whose mass is not a finite number
   for (auto& b : blocks_) {
     if (b.size() == 0 || b.rigid) continue;
     dte.assign(b.mass.size(), 1e300);
@@ -1534,6 +1560,7 @@ void Simulation::scale_masses() {
       const std::size_t k = std::min(e, n - 1);
       if (!(dte[k] < target)) continue;
       const double f = (target / dte[k]) * (target / dte[k]);
+      if (!std::isfinite(b.mass[e] * f)) overflow = 1;
       const double added = b.mass[e] * (f - 1);
       b.mass_scale[e] = f;
       b.wave_scale[e] = 1 / std::sqrt(f);
@@ -1544,6 +1571,15 @@ void Simulation::scale_masses() {
     }
   }
   for (auto& c : corner_force_) std::fill(c.begin(), c.end(), 0.0);
+  // (QA round 30: a step of 1e300 s made masses of inf, and the run failed at t = 0 with a
+  // non-finite force.)
+  comm_.max(std::span<std::int64_t>(&overflow, 1));
+  if (overflow != 0)
+    throw InputError(config_.mass_scaling_where,
+                     fmt::format("mass scaling to the step {:g} s needs element masses beyond "
+                                 "any number (the smallest elements' steps are many orders of "
+                                 "magnitude below it): give a step near the model's own",
+                                 config_.mass_scaling_step));
   comm_.sum(std::span<double>(part_added_mass_));
   comm_.sum(std::span<std::int64_t>(&mass_scaled_elements_, 1));
   // LS-DYNA's users keep the added mass of a part under a few per cent (its effect on a
@@ -1551,10 +1587,12 @@ void Simulation::scale_masses() {
   for (std::size_t p = 0; p < part_added_mass_.size(); ++p)
     if (part_added_mass_[p] > 0.05 * part_mass_[p])
       warnings_.push_back(fmt::format(
-          "{}: mass scaling adds {:.3g} kg to part {}, {:.1f}% of its {:.6g} kg, to reach the "
+          "{}: mass scaling adds {:.3g} kg to part {}, {:.3g}% of its {:.6g} kg, to reach the "
           "step {:g} s: the dynamics of this part are those of a heavier one",
-          config_.deck_file, part_added_mass_[p], config_.parts[p].name,
-          100 * part_added_mass_[p] / part_mass_[p], part_mass_[p], config_.mass_scaling_step));
+          config_.mass_scaling_where.file.empty() ? config_.deck_file
+                                                  : config_.mass_scaling_where.str(),
+          part_added_mass_[p], config_.parts[p].name, 100 * part_added_mass_[p] / part_mass_[p],
+          part_mass_[p], config_.mass_scaling_step));
 }
 
 void Simulation::decompose_now() {

@@ -155,7 +155,14 @@ public:
   // Mass scaling (time_step.mass_scaling): the mass it added to each part, kg, and the
   // elements it scaled (over all ranks; zeros without it).
   const std::vector<double>& part_added_masses() const { return part_added_mass_; }
+  // Each rigid body's motion over the last step (the same on every rank).
+  const std::vector<RigidMotion>& rigid_motions() const { return rigid_motion_; }
   std::int64_t mass_scaled_elements() const { return mass_scaled_elements_; }
+  // The element step mass scaling raises the elements to (step / scale), or 0 without it.
+  double mass_scaling_target() const {
+    return config_.mass_scaling_step > 0 ? config_.mass_scaling_step / config_.time_step_scale
+                                         : 0.0;
+  }
   // Global element id -> part name (for messages).
   std::string describe_element(std::int64_t gid) const;
   // Per external load, the faces it presses or the nodes it pushes, over all ranks
@@ -178,6 +185,9 @@ private:
   // its initial shape is at least config_.mass_scaling_step / scale (collective).
   void scale_masses();
   Vec3 mass_center(std::span<const std::int64_t> ids) const;
+  // The part index of the rigid part a condition holds as a body (`part:` a rigid part,
+  // whole), or -1.
+  int rigid_body_of(const BoundaryCondition& bc) const;
   void warn_of_setup(const Mesh& mesh);
   void apply_walls();             // the rigid walls' part of correct()
   void sample_probe_velocities(); // at the end of correct()
@@ -348,6 +358,11 @@ private:
   std::vector<std::int64_t> rigid_bytes_;
   std::vector<RigidPoint> rigid_points_;
   std::vector<RigidMotion> rigid_motion_;
+  // The boundary conditions that hold a rigid body (`part:` naming a rigid part): per
+  // condition, its body or -1; per body and component (x, y, z), the condition that holds
+  // it over the current step, or -1.
+  std::vector<int> condition_body_;
+  std::vector<std::array<int, 3>> rigid_holder_;
 
   // Element probes: (block, element) on the rank that holds the element, (-1, -1) elsewhere.
   std::vector<std::array<int, 2>> element_probe_;
