@@ -104,4 +104,23 @@ assert any(f.startswith("../a/") for f in files), files
 assert not any(re.search(r"[^./]/\.\./", f) for f in files), files
 assert all(os.path.isfile(os.path.join(sys.argv[1], f)) for f in files), files
 PY
-echo "restart outputs: changed columns kept apart, a later run's outputs not taken, paths normal"
+# 5. A run ended by its cycle limit, continued with a longer one (QA rounds 29, 30): the
+#    first run's end-of-run row, off the history series, is not kept; the continued
+#    history is the uninterrupted run's, row for row.
+sed -e 's/termination: {cycles: 60}/termination: {cycles: 28}\ncheckpoint: {every: 1.0}/' \
+    -e 's/output: {fields_every: 1.0e-6}/output: {fields_every: 1.0e-6, history_every: 2.5e-6}/' \
+    deck.yaml > short.yaml
+sed -e 's/output: {fields_every: 1.0e-6}/output: {fields_every: 1.0e-6, history_every: 2.5e-6}/' \
+    deck.yaml > long.yaml
+run 1 "$anvil" run short.yaml -o g -q
+run 2 "$anvil" run long.yaml -o h -q --restart g/checkpoint.anvil
+run 3 "$anvil" run long.yaml -o i -q
+/usr/bin/python3 - g h i <<'PY'
+import csv, sys
+g, h, i = (list(csv.reader(open(d + "/history.csv")))[1:] for d in sys.argv[1:])
+cycles = lambda rows: [r[1] for r in rows]
+assert cycles(h) == cycles(i), (cycles(h), cycles(i))
+assert [r[:3] for r in h] == [r[:3] for r in i]  # time, cycle, dt: the same bits
+assert cycles(g)[-1] not in cycles(i), cycles(g)  # the short run's end row is off the series
+PY
+echo "restart outputs: changed columns kept apart, a later run's outputs not taken, paths normal, no end-of-run row kept"

@@ -332,6 +332,13 @@ void Outputs::resume(const OutputState& state, const std::string& from) {
     std::free(line);
     std::fclose(in);
   }
+  // The end-of-run row of the run that wrote the checkpoint, off its series, is not a row
+  // of the run continued (QA rounds 29, 30: a restart from a cycle-limit stop kept it).
+  if (have_old && state.history_rows >= 0 &&
+      static_cast<std::int64_t>(keep.size()) > state.history_rows &&
+      (state.history_rows == 0 ||
+       keep[static_cast<std::size_t>(state.history_rows - 1)] == state.history_last))
+    keep.resize(static_cast<std::size_t>(state.history_rows));
   // The rows must be the checkpoint's run's: a later run in that directory (another deck,
   // or the same one run again from the start past it) wrote over its history and fields
   // (QA round 12: copied as this run's, without a word).
@@ -381,7 +388,7 @@ OutputState Outputs::state() const {
           pvd_,         particle_pvd_, history_rows_, history_last_};
 }
 
-void Outputs::write_history_row(const Sample& s) {
+void Outputs::write_history_row(const Sample& s, bool scheduled) {
   if (!history_) return;
   std::string row = fmt::format(
       "{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", s.time, s.cycle, s.dt,
@@ -393,6 +400,7 @@ void Outputs::write_history_row(const Sample& s) {
   for (double v : s.part_energies) row += fmt::format(",{:.17g}", v);
   std::fprintf(history_, "%s\n", row.c_str());
   std::fflush(history_);
+  if (!scheduled) return;
   ++history_rows_;
   history_last_ = std::move(row);
 }
@@ -421,11 +429,11 @@ void Outputs::after_step() {
     last_sample_ = s;
     have_sample_ = true;
     write_history_row(last_sample_);
-  } else if (t_sample >= next_history_ * (1 - 1e-12) || last) {
+  } else if (const bool due = t_sample >= next_history_ * (1 - 1e-12); due || last) {
     last_sample_ = sim_.sample();
     have_sample_ = true;
-    write_history_row(last_sample_);
-    if (c.history_every > 0)
+    write_history_row(last_sample_, due);
+    if (due && c.history_every > 0)
       next_history_ = next_output_time(next_history_, c.history_every, t_sample);
   }
   if (clk.time >= next_fields_ * (1 - 1e-12) || last) {

@@ -80,7 +80,9 @@ private:
   void write_series(const std::string& name, const VtuPiece& piece,
                     std::vector<std::pair<double, std::string>>& series, const std::string& pvd);
   void open_exodus(const std::string& stem);
-  void write_history_row(const Sample& s);
+  // `scheduled`: a row of the history_every series (the end of a run's is not, unless it
+  // falls on the series: a restart from the run's last checkpoint drops it).
+  void write_history_row(const Sample& s, bool scheduled = true);
   void write_summary(int status, const std::string& message);
   void progress(bool last);
 
@@ -94,7 +96,7 @@ private:
   double next_fields_ = 0, next_history_ = 0;
   std::int64_t last_field_cycle_ = -1;
   int field_count_ = 0;
-  std::int64_t history_rows_ = 0; // rows of history.csv (rank 0), and the last of them
+  std::int64_t history_rows_ = 0; // scheduled rows of history.csv (rank 0), and the last
   std::string history_last_;
   double start_wall_ = 0, last_progress_wall_ = 0, last_progress_fraction_ = 0;
   std::int64_t start_cycle_ = 0; // the cycle this run started from (its checkpoint's)
