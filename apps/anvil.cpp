@@ -177,6 +177,9 @@ int check(const std::string& deck, const anvil::Comm& comm) {
   }
   std::printf("stable dt   %.6g s (element kernel at t = 0), step %.6g s with scale %g\n", dt,
               dt * config.time_step_scale, config.time_step_scale);
+  if (sim.sph())
+    std::printf("            the elements' step: the particles set theirs at the first cycle, "
+                "and the run takes the smaller\n");
   if (config.mass_scaling_step > 0 &&
       dt * config.time_step_scale < config.mass_scaling_step * (1 - 1e-9))
     std::printf("            below the mass-scaling step %g s: elements that the initial "
