@@ -599,7 +599,15 @@ TEST(Keyword, RigidMaterial) {
   expect_error(with(rigid, "*END", curve + "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n1,4,0,9\n*END"),
                {"*BOUNDARY_PRESCRIBED_MOTION_RIGID.DOF", "not supported"});
   expect_error(with(rigid, "*END", curve + "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n1,5,2,9\n*END"),
-               {"*BOUNDARY_PRESCRIBED_MOTION_RIGID.VAD", "not supported"});
+               {"*BOUNDARY_PRESCRIBED_MOTION_RIGID.VAD", "DOF 5 (a rotation)"});
+  expect_error(
+      with(rigid, "*END", curve + "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n1,3,0,9,1.0,1.0e-3\n*END"),
+      {"*BOUNDARY_PRESCRIBED_MOTION_RIGID.VID"});
+  // Two cards on one DOF of a body: the later wins, said as for nodes (QA round 31).
+  const Config twice = kw(with(
+      rigid, "*END", curve + "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n1,3,0,9,1.0\n1,3,0,9,2.0\n*END"));
+  ASSERT_EQ(twice.warnings.size(), 1u);
+  EXPECT_NE(twice.warnings[0].find("the later card wins"), std::string::npos) << twice.warnings[0];
   expect_error(with(good, "*END", curve + "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n1,3,0,9\n*END"),
                {"*BOUNDARY_PRESCRIBED_MOTION_RIGID.PID", "not rigid"});
   expect_error(with(rigid, "*END", curve + "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n4,3,0,9\n*END"),

@@ -232,12 +232,27 @@ TEST(RigidBody, HeldComponentsTakeTheirValues) {
     for (std::size_t b = a + 1; b < p.size(); ++b)
       worst = std::max(worst, std::abs(norm(p[a].x - p[b].x) / norm(start[a].x - start[b].x) - 1));
   EXPECT_LT(worst, 1e-12);
-  // All three spins held: omega is the held one, nothing iterated.
+  // All three spins held: the step turns the body by exactly |omega| dt about omega (QA
+  // round 31: the plain Cayley step turned a driven wheel short by (omega dt)^2 / 12); a
+  // point on the axis stays, one across it turns by that angle (1e-14). Past a radian a
+  // step: not followed (`converged` false).
   hold.spin_held = {true, true, true};
-  hold.spin = {1, 2, 3};
-  const RigidMotion all = rigid_motion(p, {0, 0, 0}, dt, dt, dt, hold);
-  EXPECT_EQ(all.omega, (Vec3{1, 2, 3}));
+  hold.velocity_held = {true, true, true};
+  hold.velocity = {0, 0, 0};
+  const Vec3 w{100.0, 200.0, 300.0};
+  hold.spin = w;
+  const double h = 2e-3; // |omega| dt = 0.75
+  const RigidMotion all = rigid_motion(p, {0, 0, 0}, h, h, h, hold);
   EXPECT_TRUE(all.converged);
+  const Vec3 axis = w * (1 / norm(w));
+  const Vec3 across = cross(axis, Vec3{1, 0, 0});
+  auto moved = [&](const Vec3& r) { return r + h * all.point_velocity(all.centre + r); };
+  const Vec3 on = moved(axis), off = moved(across);
+  EXPECT_LT(norm(on - axis), 1e-14);
+  const double angle = std::atan2(norm(cross(across, off)), dot(across, off));
+  EXPECT_NEAR(angle, norm(w) * h, 1e-14);
+  hold.spin = w * 2.0; // 1.5 rad a step
+  EXPECT_FALSE(rigid_motion(p, {0, 0, 0}, h, h, h, hold).converged);
 }
 
 } // namespace

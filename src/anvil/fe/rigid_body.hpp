@@ -44,7 +44,9 @@ struct RigidMotion {
   double dt = 0;
   double mass = 0;
   // Whether omega settled (it cannot when the body would turn by about a radian or more
-  // in the step: the caller stops the run rather than lose the spin).
+  // in the step: the caller stops the run rather than lose the spin); false too for a
+  // held spin of more than a radian a step. A held spin's omega is the step's Cayley
+  // parameter over dt / 2, which turns the body by exactly |omega_held| dt.
   bool converged = true;
   // The force and the torque about the centre the held components take (what the body's
   // momentum and angular momentum change by beyond the forces', per dt_avg): 0 where free.

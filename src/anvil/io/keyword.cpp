@@ -2230,10 +2230,16 @@ private:
       m.rotation = dof >= 5;
       m.dof = static_cast<int>(m.rotation ? dof - 5 : dof - 1);
       const auto vad = card.integer(2, "VAD", 0);
-      if (vad != 0 && (vad != 2 || m.rotation))
+      if (m.rotation && vad != 0)
+        card.fail("VAD", fmt::format("VAD = {} is not supported for DOF {} (a rotation): anvil "
+                                     "prescribes a rigid body's spin as an angular velocity "
+                                     "(VAD 0)",
+                                     vad, dof));
+      if (vad != 0 && vad != 2)
         card.fail("VAD", fmt::format("VAD = {} is not supported: anvil prescribes a velocity "
-                                     "(VAD 0) or, of a translation, a displacement (VAD 2)",
+                                     "(VAD 0) or a displacement (VAD 2)",
                                      vad));
+      card.integer(5, "VID", 0); // (a vector's id, unused for DOF 1-3 and 5-7: an id all the same)
       m.displacement = vad == 2;
       add_motion(b, card, *l, m);
     }
@@ -2331,8 +2337,27 @@ private:
     const auto& bcs = c.boundary_conditions;
     std::vector<std::array<int, 3>> holder(mesh.nodes.size(), {-1, -1, -1});
     std::map<std::pair<int, int>, std::int64_t> clashes; // (earlier, later) -> components
+    // A rigid body's conditions (on its part) hold its six components (QA round 31: two
+    // motion cards on one DOF went unsaid).
+    std::map<std::string, std::array<int, 6>> body_holder;
     for (std::size_t b = 0; b < bcs.size(); ++b) {
-      if (bcs[b].nodes.name.empty()) continue; // a rigid body's (its part): held whole
+      const auto& bc = bcs[b];
+      if (!bc.nodes.name.empty()) continue;
+      auto& holder6 =
+          body_holder.try_emplace(*bc.nodes.part, std::array<int, 6>{-1, -1, -1, -1, -1, -1})
+              .first->second;
+      for (std::size_t i = 0; i < 6; ++i) {
+        const bool on = i < 3 ? (bc.prescribed ? bc.components[i] : bc.fix[i])
+                              : (bc.prescribed ? bc.spin_components[i - 3] : bc.fix_spin[i - 3]);
+        if (!on) continue;
+        int& h = holder6[i];
+        if (h >= 0 && (bc.prescribed || bcs[static_cast<std::size_t>(h)].prescribed))
+          ++clashes[{h, static_cast<int>(b)}];
+        h = static_cast<int>(b);
+      }
+    }
+    for (std::size_t b = 0; b < bcs.size(); ++b) {
+      if (bcs[b].nodes.name.empty()) continue; // a rigid body's (its part): above
       const auto& on = bcs[b].prescribed ? bcs[b].components : bcs[b].fix;
       for (const std::int64_t n : mesh.node_sets.at(bcs[b].nodes.name))
         for (std::size_t i = 0; i < 3; ++i) {

@@ -217,7 +217,8 @@ void Simulation::move_rigid_bodies(bool with_contact) {
       throw PhysicsError(fmt::format("rigid part {}", config_.parts[rigid_part_[o]].name),
                          clock_.time,
                          "it spins too fast for the time step (by about a radian or more a "
-                         "step): its angular velocity does not settle; lower time_step.scale");
+                         "step, or a held spin by more than a radian): its rotation over a "
+                         "step cannot be followed; lower time_step.scale or the spin");
   }
 }
 
