@@ -379,6 +379,15 @@ initial_conditions:
                 norm(v1 - V) / norm(V), norm(L1 - L0) / norm(L0));
   EXPECT_LT(norm(v1 - V), 1e-12 * norm(V));
   EXPECT_LT(norm(L1 - L0), 1e-12 * norm(L0));
+  // history.csv's rigid.body.* (LS-DYNA's RBDOUT): the centre's displacement V t at the
+  // sample's time (the start of the last step) and its velocity V over the step.
+  const Sample s = sim.sample();
+  ASSERT_EQ(s.rigid_bodies.size(), 9u);
+  const Vec3 u{s.rigid_bodies[0], s.rigid_bodies[1], s.rigid_bodies[2]};
+  const Vec3 v{s.rigid_bodies[3], s.rigid_bodies[4], s.rigid_bodies[5]};
+  const double t_sample = sim.clock().time - sim.clock().dt;
+  EXPECT_LT(norm(u - t_sample * V), 1e-12 * norm(V) * t_sample);
+  EXPECT_LT(norm(v - V), 1e-12 * norm(V));
 }
 
 // 4. The driven plate: the keyword deck of a column of N cubes of side h on a rigid plate.
@@ -468,6 +477,15 @@ TEST(RigidBody, DrivenPlateSendsTheOneDimensionalWave) {
                 force, f_ref, test::relative_error(force, f_ref), stress, s_ref,
                 test::relative_error(stress, s_ref));
   EXPECT_TRUE(exact) << "the plate's held velocity and spin";
+  // history.csv's rigid.plate.*: the held components exactly, the centre at V t.
+  const Sample last = sim.sample();
+  ASSERT_EQ(last.rigid_bodies.size(), 9u);
+  EXPECT_EQ(last.rigid_bodies[0], 0.0);
+  EXPECT_EQ(last.rigid_bodies[1], 0.0);
+  EXPECT_EQ(last.rigid_bodies[5], V);
+  for (int k = 6; k < 9; ++k) EXPECT_EQ(last.rigid_bodies[static_cast<std::size_t>(k)], 0.0);
+  const double t_sample = sim.clock().time - sim.clock().dt;
+  EXPECT_NEAR(last.rigid_bodies[2], V * t_sample, 1e-12 * V * t_sample);
   EXPECT_LT(test::relative_error(force, f_ref), 0.01);
   EXPECT_LT(test::relative_error(stress, s_ref), 0.01);
 }

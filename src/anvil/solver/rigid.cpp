@@ -106,6 +106,20 @@ void Simulation::setup_rigid_bodies(const Mesh& mesh) {
     }
   rigid_send_.reserve(rigid_nodes_.size());
   rigid_recv_.reserve(rigid_points_.size());
+  // Each body's centre of mass at t = 0 (history's rigid.NAME.ux...): its points gathered
+  // in body order, as each step does (the same bits on any rank count, and at a restart,
+  // which builds the model from the deck again).
+  gather_rigid_points(false);
+  rigid_centre0_.assign(rigid_gids_.size(), Vec3{0, 0, 0});
+  for (std::size_t o = 0; o < rigid_gids_.size(); ++o) {
+    double M = 0;
+    Vec3 mx{0, 0, 0};
+    for (std::size_t k = rigid_offset_[o]; k < rigid_offset_[o + 1]; ++k) {
+      M += rigid_points_[k].m;
+      mx += rigid_points_[k].m * rigid_points_[k].x;
+    }
+    rigid_centre0_[o] = mx * (1 / M);
+  }
   warn_of_thin_rigid_parts(rigid_part_);
 }
 
@@ -166,10 +180,11 @@ void Simulation::warn_of_thin_rigid_parts(const std::vector<std::size_t>& parts)
         global_speed * dt, dt, reach, config_.contact[0].depth_fraction));
 }
 
-// The bodies' motion over the step, from every rank's owned points in each body's node
-// order (collective). Without contact (predict): the forces of t(n), v(n - 1/2) in
-// nodes_.v. With contact (correct): the contact forces added, v(n - 1/2) in v_prev_.
-void Simulation::move_rigid_bodies(bool with_contact) {
+// Every body's points (mass, x(n), v(n - 1/2), force) from every rank's owned nodes into
+// rigid_points_, in each body's node order (collective). Without contact (predict): the
+// forces of t(n), v(n - 1/2) in nodes_.v. With contact (correct): the contact forces
+// added, v(n - 1/2) in v_prev_.
+void Simulation::gather_rigid_points(bool with_contact) {
   rigid_send_.clear();
   for (const auto& rn : rigid_nodes_) {
     if (!rn.owned) continue;
@@ -186,6 +201,13 @@ void Simulation::move_rigid_bodies(bool with_contact) {
   }
   comm_.allgatherv(std::span<const RigidRecord>(rigid_send_), rigid_recv_, rigid_bytes_);
   for (const auto& r : rigid_recv_) rigid_points_[static_cast<std::size_t>(r.at)] = r.p;
+}
+
+// The bodies' motion over the step, from every rank's owned points in each body's node
+// order (collective). Without contact (predict): the forces of t(n), v(n - 1/2) in
+// nodes_.v. With contact (correct): the contact forces added, v(n - 1/2) in v_prev_.
+void Simulation::move_rigid_bodies(bool with_contact) {
+  gather_rigid_points(with_contact);
   const Vec3 g{gravity_[0], gravity_[1], gravity_[2]};
   const auto& bcs = config_.boundary_conditions;
   for (std::size_t o = 0; o < rigid_gids_.size(); ++o) {

@@ -1273,6 +1273,15 @@ Sample Simulation::sample() const {
     wall_forces(all, dt_avg_, s.wall_force);
   }
   s.reaction = reactions();
+  // The rigid bodies' motion over the last step (the same on every rank); before the first
+  // step, at rest where they stand.
+  for (std::size_t o = 0; o < rigid_motion_.size(); ++o) {
+    const RigidMotion& m = rigid_motion_[o];
+    const bool moved = m.mass > 0;
+    const Vec3 u = moved ? m.centre - rigid_centre0_[o] : Vec3{0, 0, 0};
+    for (const Vec3& q : {u, moved ? m.velocity : Vec3{0, 0, 0}, moved ? m.omega : Vec3{0, 0, 0}})
+      for (int i = 0; i < 3; ++i) s.rigid_bodies.push_back(q[i]);
+  }
   if (config_.part_energies) {
     s.part_energies = part_energies();
     comm_.sum(std::span<double>(s.part_energies));

@@ -77,6 +77,10 @@ struct Sample {
   std::vector<double> part_energies;
   std::vector<double> wall_force; // per rigid wall: normal force, N
   std::vector<double> reaction;   // per boundary condition: fx, fy, fz on its nodes, N
+  // per rigid body (its part, in deck order): the displacement of its centre of mass at
+  // the time (ux, uy, uz, m) and its velocity and spin over the step from it (vx, vy, vz,
+  // m/s; wx, wy, wz, rad/s: v(n + 1/2), the step's rotation), LS-DYNA's RBDOUT
+  std::vector<double> rigid_bodies;
 };
 
 class Simulation {
@@ -204,6 +208,7 @@ private:
   // step before (predict).
   void setup_loads(const Mesh& mesh);
   void setup_rigid_bodies(const Mesh& mesh);
+  void gather_rigid_points(bool with_contact);
   void move_rigid_bodies(bool with_contact);
   void warn_of_thin_rigid_parts(const std::vector<std::size_t>& parts);
   void press_faces();
@@ -362,6 +367,7 @@ private:
   // condition, its body or -1; per body and component (x, y, z), the condition that holds
   // it over the current step, or -1.
   std::vector<int> condition_body_;
+  std::vector<Vec3> rigid_centre0_; // each body's centre of mass at t = 0
   std::vector<std::array<int, 3>> rigid_holder_;
 
   // Element probes: (block, element) on the rank that holds the element, (-1, -1) elsewhere.
