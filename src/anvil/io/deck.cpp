@@ -207,9 +207,9 @@ public:
     if (s == "z") return 2;
     fail(fmt::format("axis must be x, y or z, got '{}'", s));
   }
-  // A list of components of a rigid body's motion, x, y, z, rx, ry, rz, or `all` (the six);
-  // `rotations` says whether rx, ry or rz is listed by name.
-  std::array<bool, 6> components6(bool& rotations) const {
+  // A list of components, x, y, z (and a rigid body's rotations rx, ry, rz), or `all` (the
+  // six); `rotations` says whether rx, ry or rz is listed by name.
+  std::array<bool, 6> components(bool& rotations) const {
     std::array<bool, 6> out{};
     if (n_.IsScalar() && n_.Scalar() == "all") return {true, true, true, true, true, true};
     if (n_.IsScalar())
@@ -228,21 +228,6 @@ public:
       if (out[k]) c.fail(fmt::format("{} is listed twice", v));
       out[k] = true;
       rotations = rotations || k >= 3;
-    }
-    return out;
-  }
-  // A list of components: [x, z], or `all`.
-  std::array<bool, 3> components() const {
-    std::array<bool, 3> out{false, false, false};
-    if (n_.IsScalar() && n_.Scalar() == "all") return {true, true, true};
-    if (n_.IsScalar())
-      fail(fmt::format("expected a list of x, y, z, or all, got '{}'", n_.Scalar()));
-    const auto list = items();
-    if (list.empty()) fail("give at least one of x, y, z, or all");
-    for (const auto& c : list) {
-      const int a = c.axis();
-      if (out[static_cast<std::size_t>(a)]) c.fail(fmt::format("{} is listed twice", "xyz"[a]));
-      out[static_cast<std::size_t>(a)] = true;
     }
     return out;
   }
@@ -1025,7 +1010,7 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
         n.fail("give exactly one of 'fix', 'velocity' (and/or 'angular_velocity' for a rigid "
                "part) or 'displacement'");
       if (n.has("fix")) {
-        const auto held = n.child("fix").components6(bc.rotations);
+        const auto held = n.child("fix").components(bc.rotations);
         for (std::size_t i = 0; i < 3; ++i) {
           bc.fix[i] = held[i];
           bc.fix_spin[i] = held[3 + i];
@@ -1047,7 +1032,7 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
         }
         if (n.has("components")) {
           bool listed_rotations = false;
-          const auto held = n.child("components").components6(listed_rotations);
+          const auto held = n.child("components").components(listed_rotations);
           bc.rotations = bc.rotations || listed_rotations;
           for (std::size_t i = 0; i < 3; ++i) {
             bc.components[i] = held[i] && moving;

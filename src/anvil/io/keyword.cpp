@@ -1591,19 +1591,11 @@ private:
       ordered.emplace_back(seq, std::move(bc));
     };
     // *BOUNDARY_PRESCRIBED_MOTION_RIGID: the body of a rigid part.
-    auto rigid_motion_condition = [&](const MotionCard& m, std::int64_t seq, const Config& cfg) {
+    // A prescribed motion on the nodes of `set_name`, or (*BOUNDARY_PRESCRIBED_MOTION_RIGID,
+    // m.pid) on the body of a rigid part.
+    auto motion_condition = [&](const MotionCard& m, std::int64_t seq,
+                                const std::string& set_name) {
       const std::string key = "*" + m.keyword;
-      const auto p = std::find_if(cfg.parts.begin(), cfg.parts.end(),
-                                  [&](const PartConfig& q) { return q.name == part_name(m.pid); });
-      if (std::none_of(parts_.begin(), parts_.end(),
-                       [&](const PartCard& q) { return q.pid == m.pid; }))
-        throw InputError(m.at.loc(key + ".PID"),
-                         fmt::format("part {} is not defined (*PART)", m.pid));
-      if (p == cfg.parts.end() || !p->rigid)
-        throw InputError(m.at.loc(key + ".PID"),
-                         fmt::format("part {} is not rigid (*MAT_RIGID): *{} drives a rigid "
-                                     "body (give *BOUNDARY_PRESCRIBED_MOTION_SET for nodes)",
-                                     m.pid, m.keyword));
       const CurveCard& cc = curve(m.lcid, m.at.loc(key + ".LCID"));
       const TimeCurve& tc = cc.curve;
       if (const auto problem = time_history_problem(m.sf, tc, m.displacement); !problem.empty())
@@ -1611,7 +1603,12 @@ private:
       warn_if_curve_ends(m.lcid, cc);
       warn_if_zero_scale(m.sf, m.at, key, warnings);
       BoundaryCondition bc;
-      bc.nodes.part = p->name;
+      if (m.pid != 0)
+        bc.nodes.part = rigid_part(m.pid, m.at.loc(key + ".PID"),
+                                   key + " drives a rigid body (give "
+                                         "*BOUNDARY_PRESCRIBED_MOTION_SET for nodes)");
+      else
+        bc.nodes.name = set_name;
       bc.nodes.where = m.at.loc(key);
       bc.prescribed = true;
       bc.motion = m.displacement ? BoundaryCondition::Motion::displacement
@@ -1624,29 +1621,6 @@ private:
         bc.components[static_cast<std::size_t>(m.dof)] = true;
         bc.value[m.dof] = m.sf;
       }
-      bc.curve = tc;
-      bc.birth = m.birth;
-      bc.death = m.death;
-      bc.where = bc.nodes.where;
-      ordered.emplace_back(seq, std::move(bc));
-    };
-    auto motion_condition = [&](const MotionCard& m, std::int64_t seq,
-                                const std::string& set_name) {
-      const std::string key = "*" + m.keyword;
-      const CurveCard& cc = curve(m.lcid, m.at.loc(key + ".LCID"));
-      const TimeCurve& tc = cc.curve;
-      if (const auto problem = time_history_problem(m.sf, tc, m.displacement); !problem.empty())
-        throw InputError(m.at.loc(key + ".LCID"), fmt::format("curve {}: {}", m.lcid, problem));
-      warn_if_curve_ends(m.lcid, cc);
-      warn_if_zero_scale(m.sf, m.at, key, warnings);
-      BoundaryCondition bc;
-      bc.nodes.name = set_name;
-      bc.nodes.where = m.at.loc(key);
-      bc.prescribed = true;
-      bc.motion = m.displacement ? BoundaryCondition::Motion::displacement
-                                 : BoundaryCondition::Motion::velocity;
-      bc.components[static_cast<std::size_t>(m.dof)] = true;
-      bc.value[m.dof] = m.sf;
       bc.curve = tc;
       bc.birth = m.birth;
       bc.death = m.death;
@@ -1723,7 +1697,7 @@ private:
         std::array<bool, 3> on{false, false, false};
         on[static_cast<std::size_t>(m.dof)] = true;
         if (m.pid != 0) {
-          rigid_motion_condition(m, seq, c);
+          motion_condition(m, seq, "");
         } else if (m.set != 0) {
           const std::string name = node_set_name(m.set, m.at, "*" + m.keyword + ".NSID");
           motion_condition(m, seq, name);
@@ -2820,6 +2794,19 @@ private:
   }
 
   std::string part_name(std::int64_t pid) const { return fmt::format("part{}", pid); }
+  // The name of part `pid`, which a card naming a rigid body at `at` (`why`: what the card
+  // does with it) must give: defined, of *MAT_RIGID, with solid elements.
+  std::string rigid_part(std::int64_t pid, const SourceLocation& at, const std::string& why) const {
+    const auto p =
+        std::find_if(parts_.begin(), parts_.end(), [&](const PartCard& q) { return q.pid == pid; });
+    if (p == parts_.end()) throw InputError(at, fmt::format("part {} is not defined (*PART)", pid));
+    const auto m = materials_.find(p->mid);
+    if (m == materials_.end() || !m->second.rigid ||
+        std::none_of(elements_.begin(), elements_.end(),
+                     [&](const auto& e) { return e.pid == pid; }))
+      throw InputError(at, fmt::format("part {} is not rigid (*MAT_RIGID solids): {}", pid, why));
+    return part_name(pid);
+  }
 
   // The parts of a part set, those anvil keeps (parts with solid elements).
   std::vector<std::string> part_set(std::int64_t sid, const Where& at, const std::string& key,
@@ -3182,17 +3169,9 @@ Config KeywordReader::config(const std::string& deck_file) {
       std::vector<std::string> names;
       if (v.mass_center) {
         // LS-DYNA: "for a rigid body or a nodal rigid body".
-        const std::string field = key + ".PID";
-        if (part_ref(v.id, v.at, field)) names.push_back(part_name(v.id));
-        const auto p = std::find_if(parts_.begin(), parts_.end(),
-                                    [&](const PartCard& q) { return q.pid == v.id; });
-        const auto m = materials_.find(p->mid);
-        if (m == materials_.end() || !m->second.rigid)
-          throw InputError(v.at.loc(field),
-                           fmt::format("part {} is not rigid (*MAT_RIGID): *{} sets the velocity "
-                                       "of a rigid body (give *INITIAL_VELOCITY_GENERATION for "
-                                       "a deformable part)",
-                                       v.id, v.keyword));
+        names.push_back(rigid_part(v.id, v.at.loc(key + ".PID"),
+                                   key + " sets the velocity of a rigid body (give "
+                                         "*INITIAL_VELOCITY_GENERATION for a deformable part)"));
       } else if (v.styp == 2) {
         if (part_ref(v.id, v.at, key + ".ID")) names.push_back(part_name(v.id));
       } else if (v.styp == 1) {

@@ -106,20 +106,10 @@ void Simulation::setup_rigid_bodies(const Mesh& mesh) {
     }
   rigid_send_.reserve(rigid_nodes_.size());
   rigid_recv_.reserve(rigid_points_.size());
-  // Each body's centre of mass at t = 0 (history's rigid.NAME.ux...): its points gathered
-  // in body order, as each step does (the same bits on any rank count, and at a restart,
-  // which builds the model from the deck again).
-  gather_rigid_points(false);
-  rigid_centre0_.assign(rigid_gids_.size(), Vec3{0, 0, 0});
-  for (std::size_t o = 0; o < rigid_gids_.size(); ++o) {
-    double M = 0;
-    Vec3 mx{0, 0, 0};
-    for (std::size_t k = rigid_offset_[o]; k < rigid_offset_[o + 1]; ++k) {
-      M += rigid_points_[k].m;
-      mx += rigid_points_[k].m * rigid_points_[k].x;
-    }
-    rigid_centre0_[o] = mx * (1 / M);
-  }
+  // Each body's centre of mass at t = 0 (history's rigid.NAME.ux...; the same bits on any
+  // rank count, and at a restart, which builds the model from the deck again).
+  rigid_centre0_.clear();
+  for (const auto& gids : rigid_gids_) rigid_centre0_.push_back(mass_center(gids));
   warn_of_thin_rigid_parts(rigid_part_);
 }
 
