@@ -124,6 +124,27 @@ TEST(DeckParticles, BadInputNamesKeyAndLine) {
   expect_error("part: ball", "part: bal", {"deck.yaml:21", "bal"});
   expect_error("sph: {rebalance_threshold: 1.5}", "sph: {dimensions: 4}",
                {"deck.yaml:19", "sph.dimensions"});
+  expect_error("smoothing_ratio: 1.2", "smoothing_ratio: 1.2\n    smoothing_length: 1.2e-3",
+               {"deck.yaml:12", "smoothing_length", "not both"});
+  expect_error("smoothing_ratio: 1.2", "smoothing_length: 4.0e-3",
+               {"deck.yaml:11", "smoothing_length", "4 times the spacing"});
+}
+
+// `smoothing_length` gives h0 itself (LS-DYNA's SPHINI) instead of a ratio to the spacing.
+TEST(DeckParticles, SmoothingLengthIsTheInitialH) {
+  const Config c = test::deck(R"(termination: {time: 1.0e-5}
+materials:
+  copper: {model: elastic, density: 8930, youngs_modulus: 117.0e9, poissons_ratio: 0.35}
+particles:
+  ball: {generate: {shape: sphere, center: [0, 0, 0], radius: 3.0e-3, spacing: 1.0e-3},
+         material: copper, smoothing_length: 1.25e-3}
+)");
+  EXPECT_EQ(c.particles[0].smoothing_length, 1.25e-3);
+  const Comm world = Comm::world();
+  Simulation sim(c, world);
+  const auto& pt = sim.sph()->particles();
+  ASSERT_GT(pt.size(), 0u);
+  for (std::size_t i = 0; i < pt.size(); ++i) EXPECT_EQ(pt.h[i], 1.25e-3);
 }
 
 TEST(DeckParticles, FluidsAndEquationsOfStateAreForParticlesOnly) {
@@ -177,6 +198,25 @@ TEST(Lattice, BoxSphereCylinderRing) {
 
 // The kernels are normalised (integral of W over space is 1) and the branch-free forms
 // agree with the reference ones.
+// LS-DYNA's spacing of particles given one by one: the largest distance from a particle
+// to its nearest neighbour. On a lattice, its spacing; a lone outlier sets it.
+TEST(Lattice, CloudSpacingIsTheLargestNearestDistance) {
+  LatticeSpec box;
+  box.min = {0, 0, 0};
+  box.max = {4e-3, 3e-3, 2e-3};
+  box.spacing = 1e-3;
+  std::vector<Vec3> pts = sph::generate_lattice(box).points;
+  EXPECT_NEAR(sph::cloud_spacing(pts).spacing, 1e-3, 1e-15);
+  pts.push_back({0.5e-3, 0.5e-3, 5.5e-3}); // 3 mm above the top layer's centres
+  EXPECT_NEAR(sph::cloud_spacing(pts).spacing, 4e-3, 1e-15);
+  pts.push_back(pts[7]);
+  const sph::CloudSpacing same = sph::cloud_spacing(pts);
+  EXPECT_EQ(same.spacing, 0.0);
+  EXPECT_EQ(std::min(same.a, same.b), 7);
+  EXPECT_EQ(std::max(same.a, same.b), static_cast<int>(pts.size()) - 1);
+  EXPECT_EQ(sph::cloud_spacing({Vec3{0, 0, 0}}).spacing, 0.0);
+}
+
 TEST(Kernel, NormalisedAndConsistent) {
   for (auto k : {sph::KernelType::cubic_spline, sph::KernelType::wendland_c2}) {
     const double h = 0.7;

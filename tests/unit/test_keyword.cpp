@@ -1226,6 +1226,150 @@ TEST(Keyword, JohnsonCookWithGOnlyTakesEachPartsEquationOfState) {
   EXPECT_EQ(one.materials[0].name, "mat1");
 }
 
+// SPH particles (*ELEMENT_SPH, *SECTION_SPH, *CONTROL_SPH): a particle set per part, its
+// particles at their nodes in card order, each with its mass or volume; the section's
+// smoothing length; the part's *EOS_GRUNEISEN as the particles' equation of state; node
+// sets that list particles hold them. Beside the two bricks of `good` (part 1).
+const std::string sph_cards = R"(*CONTROL_SPH
+$   ncbs     boxid        dt      idim   nmneigh      form
+                                     3                   1
+*SECTION_SPH
+         2       1.2       0.5       1.5
+*PART
+ball
+         2         2         1         2
+*EOS_GRUNEISEN
+         2    3940.0      1.49       0.0       0.0      1.96
+       0.0
+*NODE
+     101             0.0             0.0             3.0
+     102           0.001             0.0             3.0
+     103             0.0           0.001             3.0
+     104           0.001           0.001             3.0
+*ELEMENT_SPH
+$    nid     pid            mass    nend
+     101       2        -1.0e-09
+     102       2         2.0e-06     104
+*SET_NODE_LIST
+        20
+       101       103         1
+*BOUNDARY_SPC_SET
+        20         0         1         0         0
+*INITIAL_VELOCITY_GENERATION
+         2         2       0.0       5.0
+       0.0       0.0       0.0       0.0       0.0       0.0
+)";
+
+std::string with_sph(const std::string& cards = sph_cards) {
+  return with(good, "*END\n", cards + "*END\n");
+}
+
+TEST(Keyword, SphParticles) {
+  const Config c = kw(with_sph());
+  ASSERT_EQ(c.parts.size(), 1u);
+  ASSERT_EQ(c.particles.size(), 1u);
+  const ParticleSetConfig& ps = c.particles[0];
+  EXPECT_EQ(ps.name, "part2");
+  ASSERT_TRUE(ps.list);
+  const ParticleList& l = *ps.list;
+  EXPECT_EQ(l.id, (std::vector<std::int64_t>{101, 102, 103, 104})); // NEND: 102 to 104
+  EXPECT_EQ(l.mass, (std::vector<double>{0, 2e-6, 2e-6, 2e-6}));
+  EXPECT_EQ(l.volume, (std::vector<double>{1e-9, 0, 0, 0})); // a negative MASS: a volume
+  EXPECT_EQ(l.x[3], (Vec3{0.001, 0.001, 3.0}));
+  EXPECT_EQ(ps.smoothing_ratio, 1.2);
+  EXPECT_EQ(ps.smoothing_length, 0.0);
+  EXPECT_EQ(ps.h_min, 0.5);
+  EXPECT_EQ(ps.h_max, 1.5);
+  EXPECT_TRUE(ps.corrected_gradient);     // FORM 1
+  EXPECT_EQ(ps.viscosity_quadratic, 1.5); // LS-DYNA's Q1, Q2 defaults
+  EXPECT_EQ(ps.viscosity_linear, 0.06);
+  // The particles' material carries the part's Gruneisen EOS; the bricks' does not.
+  EXPECT_EQ(c.parts[0].material, "mat1");
+  EXPECT_EQ(ps.material, "mat1_gruneisen2");
+  const MaterialConfig* m = c.material("mat1_gruneisen2");
+  ASSERT_NE(m, nullptr);
+  EXPECT_EQ(m->eos_model, "mie_gruneisen");
+  EXPECT_EQ(m->eos_params.at("c0"), 3940.0);
+  EXPECT_EQ(m->eos_params.at("s"), 1.49);
+  EXPECT_EQ(m->eos_params.at("gamma0"), 1.96);
+  EXPECT_EQ(c.material("mat1")->eos_model, "");
+  // Node set 20 holds particles 101 and 103 and brick node 1.
+  EXPECT_EQ(l.sets.at("nodeset_20"), (std::vector<std::int64_t>{0, 2}));
+  for (const auto& w : c.warnings) ADD_FAILURE() << "unexpected warning: " << w;
+
+  // Run: the set's particles are held in x, the others keep their velocity; the bricks'
+  // node 1 is held too.
+  const Comm world = Comm::world();
+  Simulation sim(c, world);
+  for (int i = 0; i < 3; ++i) sim.step();
+  const auto& pt = sim.sph()->particles();
+  ASSERT_EQ(pt.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const bool held = pt.gid[i] == 0 || pt.gid[i] == 2;
+    if (held)
+      EXPECT_EQ(pt.v[0][i], 0.0) << "particle " << pt.gid[i];
+    else
+      EXPECT_NE(pt.v[0][i], 0.0) << "particle " << pt.gid[i];
+    // Each particle's mass: given, or the material's density times its volume.
+    EXPECT_EQ(pt.mass[i], pt.gid[i] == 0 ? 7850.0 * 1e-9 : 2e-6);
+  }
+}
+
+TEST(Keyword, SphParticleErrors) {
+  auto sph_with = [](const std::string& from, const std::string& to) {
+    return with_sph(with(sph_cards, from, to));
+  };
+  expect_error(sph_with("       0.0       0.0      1.96", "       0.1       0.0      1.96"),
+               {"model.k:", "*EOS_GRUNEISEN.S2", "linear Us-up"});
+  expect_error(sph_with("       0.0\n*NODE", "       0.9\n*NODE"), {"*EOS_GRUNEISEN.V0"});
+  expect_error(sph_with("     101       2        -1.0e-09", "       1       2        -1.0e-09"),
+               {"*ELEMENT_SPH.NID", "node 1 is a solid element's node"});
+  expect_error(sph_with("     101       2        -1.0e-09", "     101       2             0.0"),
+               {"*ELEMENT_SPH.MASS", "no mass"});
+  expect_error(sph_with("     101       2        -1.0e-09", "     103       2        -1.0e-09"),
+               {"*ELEMENT_SPH.NID", "node 103 has a particle already (at model.k:"});
+  expect_error(sph_with("     101       2        -1.0e-09", "     101       3        -1.0e-09"),
+               {"*ELEMENT_SPH.PID", "particle 101 belongs to part 3, which no *PART defines"});
+  expect_error(sph_with("     102       2         2.0e-06     104",
+                        "     102       2         2.0e-06     100"),
+               {"*ELEMENT_SPH.NEND", "below NID"});
+  expect_error(
+      sph_with("                                     3", "                                     2"),
+      {"*CONTROL_SPH.IDIM", "three-dimensional"});
+  expect_error(sph_with("         2         2         1         2",
+                        "         2         1         1         2"),
+               {"*PART.SECID", "part 2 has SPH particles but its section 1 is a *SECTION_SOLID"});
+  expect_error(sph_with("       0.5       1.5", "       0.5       0.5"), {"*SECTION_SPH.HMAX"});
+  expect_error(sph_with("         2       1.2", "         2       4.0"), {"*SECTION_SPH.CSLH"});
+  // Particles of the bricks' part; a solid part on the particles' section.
+  expect_error(sph_with("     101       2        -1.0e-09", "     101       1        -1.0e-09"),
+               {"*PART.PID", "part 1 has both solid elements and SPH particles"});
+  expect_error(with_sph(with(with(sph_cards, "*PART\nball\n", "*PART\nball\n"),
+                             "*SECTION_SPH\n         2", "*SECTION_SPH\n         1")),
+               {"*SECTION_SPH.SECID", "section 1 is defined twice"});
+  // Two particles at one point: an error naming both when the model is built.
+  const Config same = kw(with_sph(with(sph_cards, "     102           0.001             0.0",
+                                       "     102             0.0             0.0")));
+  try {
+    const Comm world = Comm::world();
+    Simulation sim(same, world);
+    ADD_FAILURE() << "no error for coincident particles";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("particles 101 and 102 of set 'part2' are at the same "
+                                         "point"),
+              std::string::npos)
+        << e.what();
+  }
+  // What anvil does otherwise is said.
+  const Config w = kw(with_sph(
+      with(with(sph_cards, "                   1\n*SECTION", "                   5\n*SECTION"),
+           "       1.5\n", "       1.5                                       2\n")));
+  ASSERT_EQ(w.warnings.size(), 2u);
+  EXPECT_NE(w.warnings[0].find("SPHKERN 2"), std::string::npos) << w.warnings[0];
+  EXPECT_NE(w.warnings[1].find("FORM 5"), std::string::npos) << w.warnings[1];
+  EXPECT_FALSE(w.particles[0].corrected_gradient);
+}
+
 // keyword.md: "never fields dropped silently". A card more than a keyword takes (a second
 // wall in one *RIGIDWALL_PLANAR, a second *CONTROL_TERMINATION card) was ignored; it is an
 // error at its line naming the keyword (QA round 5, item 3).

@@ -49,7 +49,7 @@ int NearestGrid::cell_of(double v, int d) const {
   return c >= n_[d] - 1 ? n_[d] - 1 : static_cast<int>(c);
 }
 
-NearestGrid::Hit NearestGrid::nearest(const Vec3& q) const {
+NearestGrid::Hit NearestGrid::nearest(const Vec3& q, int skip) const {
   Hit best{std::numeric_limits<double>::infinity(), std::numeric_limits<std::int64_t>::max(), -1};
   if (points_.empty()) return best;
   // The query's cell, clamped into the grid. Every cell at ring r + 1 or beyond (in the
@@ -75,6 +75,7 @@ NearestGrid::Hit NearestGrid::nearest(const Vec3& q) const {
           const std::size_t c = (static_cast<std::size_t>(k) * n_[1] + j) * n_[0] + i;
           for (int s = start_[c]; s < start_[c + 1]; ++s) {
             const int p = points_[static_cast<std::size_t>(s)];
+            if (p == skip) continue;
             const double dx = x_[p] - q.x, dy = y_[p] - q.y, dz = z_[p] - q.z;
             const double r2 = dx * dx + dy * dy + dz * dz;
             if (r2 < best.r2 || (r2 == best.r2 && id_[p] < best.id)) best = {r2, id_[p], p};

@@ -23,8 +23,9 @@ public:
     int index;       // its index into the arrays, or -1
   };
   // The same answer as a pass over every point keeping the nearest, the lowest id on a
-  // tie.
-  Hit nearest(const Vec3& q) const;
+  // tie. `skip`: an index into the arrays that is not a candidate (a point's own, when
+  // looking for its nearest neighbour).
+  Hit nearest(const Vec3& q, int skip = -1) const;
 
 private:
   const double *x_, *y_, *z_;

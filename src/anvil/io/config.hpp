@@ -74,12 +74,27 @@ struct LatticeSpec {
   double spacing = 0;      // lattice spacing, m
 };
 
+// Particles given one by one (LS-DYNA's *ELEMENT_SPH) instead of a lattice, in 3-D.
+struct ParticleList {
+  std::vector<Vec3> x;
+  std::vector<double> mass;     // kg; 0 where the volume is given instead
+  std::vector<double> volume;   // m^3 where the mass is 0: the mass is density * volume
+  std::vector<std::int64_t> id; // the deck's ids (node ids), for messages
+  // Named node sets (a keyword deck's) that hold particles of this set: name -> indices
+  // into x, ascending. Conditions on such a set act on these particles too.
+  std::map<std::string, std::vector<std::int64_t>> sets;
+};
+
 struct ParticleSetConfig {
   enum class Kernel { cubic_spline, wendland_c2 };
   std::string name;
   LatticeSpec lattice;
+  std::shared_ptr<const ParticleList> list; // instead of the lattice when given
   std::string material;
-  double smoothing_ratio = 1.3; // h = ratio * (lattice cell volume)^(1/dimensions)
+  // h0 = smoothing_ratio * spacing: the lattice's (cell volume)^(1/dimensions); a list's,
+  // the largest distance from a particle to its nearest neighbour (LS-DYNA's rule).
+  double smoothing_ratio = 1.3;
+  double smoothing_length = 0; // h0 itself, m, when > 0 (LS-DYNA's SPHINI)
   // Bounds of h / h0 as the density changes (LS-DYNA's *SECTION_SPH HMIN and HMAX, with
   // their defaults): h = h0 (rho0 / rho)^(1/d) clamped to [h_min, h_max] h0.
   double h_min = 0.2, h_max = 2.0;

@@ -557,8 +557,9 @@ ParticleSetConfig parse_particle_set(const std::string& name, const Node& n, int
   ParticleSetConfig p;
   p.name = name;
   p.where = n.where();
-  n.check_keys({"generate", "material", "smoothing_ratio", "smoothing_bounds", "kernel",
-                "viscosity", "artificial_stress", "corrected_gradient", "summation_density"});
+  n.check_keys({"generate", "material", "smoothing_ratio", "smoothing_length", "smoothing_bounds",
+                "kernel", "viscosity", "artificial_stress", "corrected_gradient",
+                "summation_density"});
   const Node g = n.required("generate");
   const std::string shape = g.required("shape").str();
   LatticeSpec& l = p.lattice;
@@ -606,6 +607,18 @@ ParticleSetConfig parse_particle_set(const std::string& name, const Node& n, int
     if (p.smoothing_ratio < 0.8 || p.smoothing_ratio > 3)
       n.child("smoothing_ratio")
           .fail("must be between 0.8 and 3 (h = ratio * (cell volume)^(1/dimensions))");
+  }
+  if (n.has("smoothing_length")) {
+    if (n.has("smoothing_ratio"))
+      n.child("smoothing_length")
+          .fail("give smoothing_ratio or smoothing_length, not both (the length is h0 itself)");
+    p.smoothing_length = n.child("smoothing_length").positive();
+    // The same bounds as the ratio's, against the lattice spacing.
+    const double ratio = p.smoothing_length / l.spacing;
+    if (ratio < 0.8 || ratio > 3)
+      n.child("smoothing_length")
+          .fail(fmt::format("is {:.6g} times the spacing; it must be between 0.8 and 3 times",
+                            ratio));
   }
   if (n.has("smoothing_bounds")) {
     const Node b = n.child("smoothing_bounds");

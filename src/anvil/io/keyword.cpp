@@ -9,9 +9,11 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <initializer_list>
 #include <limits>
 #include <map>
+#include <memory>
 #include <new>
 #include <optional>
 #include <set>
@@ -545,6 +547,27 @@ struct RawElement {
   Where at;
 };
 
+// An *ELEMENT_SPH card: particles at nodes NID (to NEND, when given) of part PID, each of
+// mass MASS (of volume |MASS| when MASS < 0 or with the _VOLUME option).
+struct RawSph {
+  std::int64_t nid, nend, pid;
+  double mass, volume; // one of them is 0
+  Where at;
+};
+
+// Where a node's particle went: its particle set, its index there, its card.
+struct ParticleAt {
+  std::size_t set;
+  std::int64_t index;
+  const RawSph* card;
+};
+
+// A *SECTION_SPH: the smoothing length of its parts' particles.
+struct SphSectionCard {
+  double cslh, hmin, hmax, sphini;
+  Where at;
+};
+
 struct PartCard {
   std::int64_t pid, secid, mid, eosid, hgid;
   std::string heading;
@@ -589,8 +612,11 @@ MaterialCard material_card(const Block& b, std::string model, const Line& l) {
 
 struct EosCard {
   std::string keyword;
-  double c = 0; // *EOS_GRUNEISEN: bulk sound speed
-  Where at;
+  // *EOS_GRUNEISEN: bulk sound speed C, the Hugoniot's slopes S1-S3, GAMA0, its volume
+  // correction A, the initial energy E0 and relative volume V0, the LCID of card 2.
+  double c = 0, s1 = 0, s2 = 0, s3 = 0, gamma0 = 0, a = 0, e0 = 0, v0 = 0;
+  std::int64_t lcid = 0;
+  Where at, at2; // its two cards
 };
 
 struct HourglassCard {
@@ -717,9 +743,9 @@ public:
     // Keywords that hold one setting of the whole run: a repeat replaces the earlier one,
     // said in a warning. Decks often *INCLUDE shared controls and override one of them, so
     // a repeat is not an error, but a silent override could hide a forgotten copy.
-    static const std::set<std::string> settings{"CONTROL_TERMINATION",    "CONTROL_TIMESTEP",
-                                                "CONTROL_HOURGLASS",      "CONTROL_CONTACT",
-                                                "CONTROL_BULK_VISCOSITY", "DATABASE_BINARY_D3PLOT"};
+    static const std::set<std::string> settings{
+        "CONTROL_TERMINATION",    "CONTROL_TIMESTEP",       "CONTROL_HOURGLASS", "CONTROL_CONTACT",
+        "CONTROL_BULK_VISCOSITY", "DATABASE_BINARY_D3PLOT", "CONTROL_SPH"};
     std::map<std::string, Where> first;
     for (const Block& b : blocks) {
       dispatch(b);
@@ -769,6 +795,9 @@ private:
     if (n == "SET_PART_LIST_GENERATE" || n == "SET_PART_LIST_GENERATE_TITLE")
       return id_set(b, part_sets_, true);
     if (n == "SECTION_SOLID" || n == "SECTION_SOLID_TITLE") return section_solid(b);
+    if (n == "SECTION_SPH" || n == "SECTION_SPH_TITLE") return section_sph(b);
+    if (n == "ELEMENT_SPH" || n == "ELEMENT_SPH_VOLUME") return element_sph(b);
+    if (n == "CONTROL_SPH") return control_sph(b);
     if (starts_with(n, "SECTION_")) return other_with_id(b, other_sections_);
     if (n == "MAT_ELASTIC" || n == "MAT_001" || n == "MAT_ELASTIC_TITLE" || n == "MAT_001_TITLE")
       return mat_elastic(b);
@@ -1058,10 +1087,135 @@ private:
   }
 
   void add_section(const Card& card, std::int64_t secid, SectionCard s) {
+    if (const auto it = sph_sections_.find(secid); it != sph_sections_.end())
+      card.fail("SECID", fmt::format("section {} is defined twice (first at {})", secid,
+                                     it->second.at.str()));
     const auto [it, fresh] = sections_.emplace(secid, std::move(s));
     if (!fresh)
       card.fail("SECID", fmt::format("section {} is defined twice (first at {})", secid,
                                      it->second.at.str()));
+  }
+
+  // *SECTION_SPH: SECID, CSLH, HMIN, HMAX, SPHINI, DEATH, START, SPHKERN (one card a
+  // section): the smoothing length h0 = CSLH times the largest distance from a particle to
+  // its nearest neighbour, or SPHINI; h stays within [HMIN, HMAX] h0.
+  void section_sph(const Block& b) {
+    Cursor c(b);
+    while (!c.done()) {
+      skip_title(b, c);
+      const Line l = c.next();
+      const Card card(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+      const std::int64_t secid = card.integer(0, "SECID", 0);
+      if (secid <= 0)
+        card.fail("SECID", fmt::format("SECID must be a positive id, found {}", secid));
+      SphSectionCard sc{card.real(1, "CSLH"), card.real(2, "HMIN"), card.real(3, "HMAX"),
+                        card.real(4, "SPHINI"), where_of(l)};
+      // LS-DYNA's defaults: CSLH 1.2, HMIN 0.2, HMAX 2.0 (a blank or 0 field).
+      if (sc.cslh == 0) sc.cslh = 1.2;
+      if (sc.hmin == 0) sc.hmin = 0.2;
+      if (sc.hmax == 0) sc.hmax = 2.0;
+      if (!(sc.cslh >= 0.8 && sc.cslh <= 3))
+        card.fail("CSLH", fmt::format("CSLH must be between 0.8 and 3 (LS-DYNA advises 1.05 to "
+                                      "1.3), found {}",
+                                      sc.cslh));
+      if (!(sc.hmin > 0 && sc.hmin <= 1))
+        card.fail("HMIN", fmt::format("HMIN must be in (0, 1], found {}", sc.hmin));
+      if (!(sc.hmax >= 1))
+        card.fail("HMAX", fmt::format("HMAX must be at least 1, found {}", sc.hmax));
+      if (sc.sphini < 0) card.fail("SPHINI", "SPHINI must not be negative");
+      const double death = card.real(5, "DEATH");
+      if (death != 0 && death < 1e20)
+        sph_notes_.push_back(fmt::format("{}: section {}: DEATH {} is not used: anvil's "
+                                         "particles live to the end of the run",
+                                         where_of(l).str(), secid, death));
+      if (card.real(6, "START") != 0)
+        sph_notes_.push_back(fmt::format("{}: section {}: START is not used: anvil's particles "
+                                         "act from t = 0",
+                                         where_of(l).str(), secid));
+      if (const std::int64_t k = card.integer(7, "SPHKERN", 0); k != 0)
+        sph_notes_.push_back(fmt::format("{}: section {}: SPHKERN {} is not anvil's: its "
+                                         "particles use the cubic B-spline kernel (SPHKERN 0)",
+                                         where_of(l).str(), secid, k));
+      if (const auto it = sections_.find(secid); it != sections_.end())
+        card.fail("SECID", fmt::format("section {} is defined twice (first at {})", secid,
+                                       it->second.at.str()));
+      const auto [it, fresh] = sph_sections_.emplace(secid, sc);
+      if (!fresh)
+        card.fail("SECID", fmt::format("section {} is defined twice (first at {})", secid,
+                                       it->second.at.str()));
+    }
+  }
+
+  // *ELEMENT_SPH (_VOLUME): any number of cards NID, PID, MASS, NEND.
+  void element_sph(const Block& b) {
+    const bool volume = b.name == "ELEMENT_SPH_VOLUME";
+    Cursor c(b);
+    while (auto l = c.next_record()) {
+      const Card card(b, *l, {8, 8, 16, 8});
+      RawSph e{card.integer(0, "NID", 0),
+               card.id(3, "NEND"),
+               card.integer(1, "PID", 0),
+               0,
+               0,
+               where_of(*l)};
+      if (card.blank(0))
+        card.fail("NID", "NID is blank: *ELEMENT_SPH's fields are 8 characters wide (for 10 "
+                         "characters give *KEYWORD I10=Y or '*ELEMENT_SPH %')");
+      if (e.nid <= 0)
+        card.fail("NID", fmt::format("NID must be a positive node id, found {}", e.nid));
+      if (e.pid <= 0)
+        card.fail("PID", fmt::format("particle {}: PID must be a positive part id, found {}", e.nid,
+                                     e.pid));
+      if (e.nend != 0 && e.nend < e.nid)
+        card.fail("NEND", fmt::format("NEND {} is below NID {}", e.nend, e.nid));
+      const double m = card.real(2, "MASS");
+      if (m == 0)
+        card.fail("MASS", fmt::format("particle {} has no mass: give its mass, or its volume as "
+                                      "a negative MASS (or with *ELEMENT_SPH_VOLUME)",
+                                      e.nid));
+      if (volume && m < 0)
+        card.fail("MASS", fmt::format("particle {}: with *ELEMENT_SPH_VOLUME, MASS is the "
+                                      "particle's volume and must be positive",
+                                      e.nid));
+      (volume || m < 0 ? e.volume : e.mass) = std::abs(m);
+      sph_elements_.push_back(e);
+    }
+  }
+
+  // *CONTROL_SPH: card 1 NCBS, BOXID, DT, IDIM, NMNEIGH, FORM, START, MAXV; the optional
+  // cards that follow are taken, not read.
+  void control_sph(const Block& b) {
+    Cursor c(b);
+    const Line l = c.next();
+    const Card card(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+    c.skip_rest();
+    control_sph_at_ = where_of(l);
+    const std::int64_t idim = card.integer(3, "IDIM", 0);
+    if (idim != 0 && idim != 3)
+      card.fail("IDIM", fmt::format("IDIM {} is not supported: anvil reads three-dimensional "
+                                    "particle models (IDIM 3) from keyword decks",
+                                    idim));
+    const std::int64_t form = card.integer(5, "FORM", 0);
+    sph_corrected_ = form == 1;
+    sph_control_notes_.clear();
+    const std::string at = where_of(l).str();
+    if (form != 0 && form != 1)
+      sph_control_notes_.push_back(fmt::format(
+          "{}: *CONTROL_SPH FORM {} is not anvil's: its particles use the standard form "
+          "(FORM 0) with the Monaghan-Gingold viscosity and artificial stress (docs/sph.md)",
+          at, form));
+    if (card.id(1, "BOXID") != 0)
+      sph_control_notes_.push_back(fmt::format(
+          "{}: *CONTROL_SPH BOXID is not used: anvil computes every particle everywhere", at));
+    if (const double dt = card.real(2, "DT"); dt != 0 && dt < 1e20)
+      sph_control_notes_.push_back(fmt::format(
+          "{}: *CONTROL_SPH DT {} is not used: anvil computes the particles to the end", at, dt));
+    if (card.real(6, "START") != 0)
+      sph_control_notes_.push_back(
+          fmt::format("{}: *CONTROL_SPH START is not used: the particles act from t = 0", at));
+    if (const double v = card.real(7, "MAXV"); v != 0 && v < 1e15)
+      sph_control_notes_.push_back(fmt::format(
+          "{}: *CONTROL_SPH MAXV {} is not used: anvil keeps every particle, however fast", at, v));
   }
 
   // A keyword anvil does not model whose first field is an id others may refer to
@@ -1511,13 +1665,23 @@ private:
     const Card card(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
     const std::int64_t id = card.integer(0, "EOSID", 0);
     if (id <= 0) card.fail("EOSID", fmt::format("EOSID must be a positive id, found {}", id));
-    EosCard e{b.name, 0, where_of(l)};
+    EosCard e;
+    e.keyword = b.name;
+    e.at = e.at2 = where_of(l);
     if (starts_with(b.name, "EOS_GRUNEISEN")) {
       e.c = card.real(1, "C");
-      // Card 2 (V0, LCID) completes the Gruneisen form; its fields are not modelled.
+      e.s1 = card.real(2, "S1");
+      e.s2 = card.real(3, "S2");
+      e.s3 = card.real(4, "S3");
+      e.gamma0 = card.real(5, "GAMAO");
+      e.a = card.real(6, "A");
+      e.e0 = card.real(7, "E0");
+      // Card 2: V0, (unused), LCID.
       const Line l2 = c.next();
       const Card card2(b, l2, {10, 10, 10});
-      (void)card2;
+      e.at2 = where_of(l2);
+      e.v0 = card2.real(0, "V0");
+      e.lcid = card2.id(2, "LCID");
     } else {
       c.skip_rest(); // other forms' cards vary; anvil models none of them
     }
@@ -2832,6 +2996,163 @@ private:
     return out;
   }
 
+  // The particle sets of the parts `pids` (with *ELEMENT_SPH particles) into c.particles
+  // and `lists` (their lists, still open for the node sets), `particle_of` where each
+  // particle's node went. `material`: the part's material name (config()).
+  void particle_sets(Config& c, const std::vector<std::int64_t>& pids,
+                     const std::function<std::string(const PartCard&, bool)>& material,
+                     const std::vector<char>& in_solid,
+                     std::vector<std::shared_ptr<ParticleList>>& lists,
+                     std::unordered_map<std::int64_t, ParticleAt>& particle_of,
+                     std::vector<std::string>& warnings) const {
+    std::map<std::int64_t, std::size_t> set_of_part;
+    for (const auto pid : pids) {
+      const PartCard& p = *std::find_if(parts_.begin(), parts_.end(),
+                                        [&](const PartCard& q) { return q.pid == pid; });
+      const auto sec = sph_sections_.find(p.secid);
+      if (sec == sph_sections_.end()) {
+        const auto solid = sections_.find(p.secid);
+        const auto other = other_sections_.find(p.secid);
+        const SectionCard* found = solid != sections_.end()         ? &solid->second
+                                   : other != other_sections_.end() ? &other->second
+                                                                    : nullptr;
+        throw InputError(
+            p.at.loc("*PART.SECID"),
+            found
+                ? fmt::format("part {} has SPH particles but its section {} is a *{} (at {}), "
+                              "not a *SECTION_SPH",
+                              p.pid, p.secid, found->keyword, found->at.str())
+                : fmt::format("part {}: section {} is not defined (*SECTION_SPH)", p.pid, p.secid));
+      }
+      ParticleSetConfig ps;
+      ps.name = part_name(p.pid);
+      ps.where = p.at.loc("*PART");
+      ps.material = material(p, true);
+      ps.smoothing_ratio = sec->second.cslh;
+      ps.smoothing_length = sec->second.sphini;
+      ps.h_min = sec->second.hmin;
+      ps.h_max = sec->second.hmax;
+      ps.corrected_gradient = sph_corrected_;
+      // LS-DYNA's particles take their Monaghan viscosity from the bulk viscosity cards:
+      // Q1 the quadratic coefficient (beta), Q2 the linear one (alpha); its defaults 1.5
+      // and 0.06.
+      const HourglassCard h = hourglass_card_of(p);
+      ps.viscosity_quadratic = h.q1 > 0 ? h.q1 : 1.5;
+      ps.viscosity_linear = h.q2 > 0 ? h.q2 : 0.06;
+      if (const auto& mc = materials_.at(p.mid); mc.failure_strain > 0)
+        warnings.push_back(fmt::format("{}: part {}: the failure strain of material {} is not "
+                                       "used: anvil's particles do not erode",
+                                       p.at.str(), p.pid, p.mid));
+      set_of_part[pid] = c.particles.size();
+      lists.push_back(std::make_shared<ParticleList>());
+      ps.list = lists.back();
+      c.particles.push_back(std::move(ps));
+    }
+    // NEND generates the particles at every node with an id from NID to NEND.
+    std::vector<std::pair<std::int64_t, std::int64_t>> by_id; // (node id, position)
+    if (std::any_of(sph_elements_.begin(), sph_elements_.end(),
+                    [](const RawSph& e) { return e.nend != 0; })) {
+      for (std::size_t i = 0; i < node_ids_.size(); ++i)
+        by_id.emplace_back(node_ids_[i], static_cast<std::int64_t>(i));
+      std::sort(by_id.begin(), by_id.end());
+    }
+    for (const auto& e : sph_elements_) {
+      const auto set = set_of_part.find(e.pid);
+      if (set == set_of_part.end())
+        throw InputError(
+            e.at.loc("*ELEMENT_SPH.PID"),
+            fmt::format("particle {} belongs to part {}, which no *PART defines", e.nid, e.pid));
+      ParticleList& list = *lists[set->second];
+      auto add = [&](std::int64_t pos) {
+        const std::int64_t nid = node_ids_[static_cast<std::size_t>(pos)];
+        if (in_solid[static_cast<std::size_t>(pos)])
+          throw InputError(e.at.loc("*ELEMENT_SPH.NID"),
+                           fmt::format("node {} is a solid element's node: a particle needs a "
+                                       "node of its own",
+                                       nid));
+        const auto [it, fresh] = particle_of.emplace(
+            pos, ParticleAt{set->second, static_cast<std::int64_t>(list.x.size()), &e});
+        if (!fresh)
+          throw InputError(e.at.loc("*ELEMENT_SPH.NID"),
+                           fmt::format("node {} has a particle already (at {})", nid,
+                                       it->second.card->at.str()));
+        list.x.push_back(nodes_[static_cast<std::size_t>(pos)]);
+        list.mass.push_back(e.mass);
+        list.volume.push_back(e.volume);
+        list.id.push_back(nid);
+      };
+      if (e.nend == 0) {
+        add(node_position(e.nid, e.at, "*ELEMENT_SPH.NID", fmt::format("particle {}", e.nid)));
+        continue;
+      }
+      const auto lo =
+          std::lower_bound(by_id.begin(), by_id.end(), std::pair{e.nid, std::int64_t{-1}});
+      const auto hi = std::upper_bound(by_id.begin(), by_id.end(),
+                                       std::pair{e.nend, std::numeric_limits<std::int64_t>::max()});
+      if (lo == hi)
+        throw InputError(e.at.loc("*ELEMENT_SPH.NEND"),
+                         fmt::format("no node has an id from {} to {}", e.nid, e.nend));
+      for (auto it = lo; it != hi; ++it) add(it->second);
+    }
+    warnings.insert(warnings.end(), sph_notes_.begin(), sph_notes_.end());
+    warnings.insert(warnings.end(), sph_control_notes_.begin(), sph_control_notes_.end());
+  }
+
+  // The hourglass and bulk viscosity of part p: its *HOURGLASS, else the *CONTROL_ cards
+  // (q1, q2 0: not given).
+  HourglassCard hourglass_card_of(const PartCard& p) const {
+    HourglassCard h{control_ihq_, control_qh_, control_q1_, control_q2_, p.at};
+    if (p.hgid == 0) return h;
+    const auto it = hourglass_.find(p.hgid);
+    if (it == hourglass_.end())
+      throw InputError(p.at.loc("*PART.HGID"), fmt::format("part {}: hourglass {} is not defined "
+                                                           "(*HOURGLASS)",
+                                                           p.pid, p.hgid));
+    h.ihq = it->second.ihq;
+    h.qm = it->second.qm;
+    if (it->second.q1 > 0) h.q1 = it->second.q1;
+    if (it->second.q2 > 0) h.q2 = it->second.q2;
+    return h;
+  }
+
+  // The Mie-Gruneisen parameters of anvil's particles (`eos: mie_gruneisen`) from an
+  // *EOS_GRUNEISEN: its linear Us-up Hugoniot (C, S1) and GAMA0, which is LS-DYNA's form
+  // with S2 = S3 = A = 0 (E, LS-DYNA's energy per initial volume, is rho0 e).
+  static ParamValues gruneisen_params(const EosCard& e) {
+    auto fail = [&](const Where& at, const char* field, const std::string& why) {
+      throw InputError(at.loc(fmt::format("*{}.{}", e.keyword, field)), why);
+    };
+    if (!(e.c > 0)) fail(e.at, "C", fmt::format("C must be positive, found {}", e.c));
+    if (e.s1 < 0) fail(e.at, "S1", fmt::format("S1 must not be negative, found {}", e.s1));
+    if (e.gamma0 < 0)
+      fail(e.at, "GAMAO", fmt::format("GAMAO must not be negative, found {}", e.gamma0));
+    for (const auto& [v, f] : {std::pair{e.s2, "S2"}, std::pair{e.s3, "S3"}})
+      if (v != 0)
+        fail(e.at, f,
+             fmt::format("{} = {}: anvil's Mie-Gruneisen has a linear Us-up Hugoniot "
+                         "(C, S1); S2 and S3 must be 0",
+                         f, v));
+    if (e.a != 0)
+      fail(e.at, "A",
+           fmt::format("A = {}: anvil's Gruneisen coefficient is GAMA0 at every "
+                       "compression; the volume correction A must be 0",
+                       e.a));
+    if (e.e0 != 0)
+      fail(e.at, "E0",
+           fmt::format("E0 = {}: anvil's particles start with no internal energy; "
+                       "E0 must be 0",
+                       e.e0));
+    if (e.v0 != 0 && e.v0 != 1)
+      fail(e.at2, "V0",
+           fmt::format("V0 = {}: anvil's particles start at their material's "
+                       "density (V0 = 1)",
+                       e.v0));
+    if (e.lcid != 0)
+      fail(e.at2, "LCID",
+           fmt::format("LCID {}: an energy deposition curve is not supported", e.lcid));
+    return {{"c0", e.c}, {"s", e.s1}, {"gamma0", e.gamma0}};
+  }
+
   HourglassControl hourglass_of(std::int64_t ihq, double qm) const {
     HourglassControl h;
     // IHQ 1-3: viscous forms; 4, 5, 7 (7 with exact volume integration) and 8 (a shell
@@ -2864,6 +3185,12 @@ private:
   std::unordered_map<std::int64_t, std::size_t> element_index_;
   std::vector<PartCard> parts_;
   std::map<std::int64_t, SectionCard> sections_, other_sections_;
+  std::map<std::int64_t, SphSectionCard> sph_sections_;
+  std::vector<RawSph> sph_elements_;
+  std::vector<std::string> sph_notes_;         // what anvil does otherwise with particles
+  std::vector<std::string> sph_control_notes_; // those of the *CONTROL_SPH in force
+  std::optional<Where> control_sph_at_;
+  bool sph_corrected_ = false; // *CONTROL_SPH FORM 1: the renormalised gradient
   std::map<std::int64_t, MaterialCard> materials_;
   std::map<std::int64_t, EosCard> eos_;
   std::map<std::int64_t, HourglassCard> hourglass_;
@@ -2972,25 +3299,35 @@ Config KeywordReader::config(const std::string& deck_file) {
   c.mass_scaling_where = mass_scaling_at_;
   warnings.insert(warnings.end(), timestep_notes_.begin(), timestep_notes_.end());
 
-  // Parts with solid elements; the others (shells, beams, ...) are left out.
-  std::map<std::int64_t, std::size_t> solids;
-  for (const auto& e : elements_) ++solids[e.pid];
+  // Parts with solid elements (`order`) and parts of SPH particles (`sph_order`); the
+  // others (shells, beams, ...) are left out.
+  std::set<std::int64_t> solids, particles;
+  for (const auto& e : elements_) solids.insert(e.pid);
+  for (const auto& e : sph_elements_) particles.insert(e.pid);
   std::set<std::int64_t> kept;
-  std::vector<std::int64_t> order;
+  std::vector<std::int64_t> order, sph_order;
   for (const auto& p : parts_) {
-    if (!solids.count(p.pid)) {
-      warnings.push_back(fmt::format("{}: part {}{} has no *ELEMENT_SOLID elements and is left "
-                                     "out (anvil models solid hexahedra only)",
+    const bool has_solids = solids.count(p.pid) > 0, has_particles = particles.count(p.pid) > 0;
+    if (has_solids && has_particles)
+      throw InputError(p.at.loc("*PART.PID"),
+                       fmt::format("part {} has both solid elements and SPH particles "
+                                   "(*ELEMENT_SPH): give the particles a part of their own",
+                                   p.pid));
+    if (!has_solids && !has_particles) {
+      warnings.push_back(fmt::format("{}: part {}{} has no *ELEMENT_SOLID elements or "
+                                     "*ELEMENT_SPH particles and is left out (anvil models "
+                                     "solid hexahedra and SPH particles only)",
                                      p.at.str(), p.pid,
                                      p.heading.empty() ? "" : " (" + shown(p.heading) + ")"));
       continue;
     }
     kept.insert(p.pid);
-    order.push_back(p.pid);
+    (has_solids ? order : sph_order).push_back(p.pid);
   }
-  if (order.empty())
+  if (order.empty() && sph_order.empty())
     throw InputError({deck_file, 0, "*PART"},
-                     "no part has solid elements: anvil needs *PART and *ELEMENT_SOLID cards");
+                     "no part has solid elements or SPH particles: anvil needs *PART and "
+                     "*ELEMENT_SOLID (or *ELEMENT_SPH) cards");
   Mesh mesh = build_mesh(order, true); // shared by the parts once complete (below)
 
   // Materials, in order of first use; hourglass and bulk viscosity per part. A
@@ -3007,34 +3344,10 @@ Config KeywordReader::config(const std::string& deck_file) {
   std::set<std::string> material_names;
   std::set<std::int64_t> material_notes_given;
   const std::string part_key = "*PART";
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    const PartCard& p = *std::find_if(parts_.begin(), parts_.end(),
-                                      [&](const PartCard& q) { return q.pid == order[i]; });
-    PartConfig pc;
-    pc.name = part_name(p.pid);
-    pc.where = p.at.loc(part_key);
-    pc.mesh.kind = MeshConfig::Kind::embedded;
-    pc.mesh.embedded_block = i;
-    pc.mesh.where = pc.where;
-
-    // Section.
-    const auto sec = sections_.find(p.secid);
-    if (sec == sections_.end()) {
-      const auto other = other_sections_.find(p.secid);
-      throw InputError(
-          p.at.loc("*PART.SECID"),
-          other != other_sections_.end()
-              ? fmt::format("part {} has solid elements but its section {} is a *{} "
-                            "(at {}), not a *SECTION_SOLID",
-                            p.pid, p.secid, other->second.keyword, other->second.at.str())
-              : fmt::format("part {}: section {} is not defined (*SECTION_SOLID)", p.pid, p.secid));
-    }
-    if (sec->second.elform != 1 && sec->second.elform != 0)
-      warnings.push_back(fmt::format("{}: section {} asks for ELFORM {}; anvil uses its one-point "
-                                     "hexahedron with hourglass control (ELFORM 1) for part {}",
-                                     sec->second.at.str(), p.secid, sec->second.elform, p.pid));
-
-    // Material.
+  // The material of part p (its name; added to c.materials at its first use): for its
+  // elements, or for its particles, which take the part's *EOS_GRUNEISEN as their
+  // equation of state (the hexahedra do not track the specific internal energy).
+  auto part_material = [&](const PartCard& p, bool particles) -> std::string {
     const auto mat = materials_.find(p.mid);
     if (mat == materials_.end())
       throw InputError(p.at.loc("*PART.MID"),
@@ -3048,7 +3361,12 @@ Config KeywordReader::config(const std::string& deck_file) {
                                    "*MAT_SIMPLIFIED_JOHNSON_COOK, *MAT_RIGID)",
                                    p.pid, p.mid, mc.keyword, mc.at.str()));
     std::string mname = fmt::format("mat{}", p.mid);
+    if (particles && mc.rigid)
+      throw InputError(p.at.loc("*PART.MID"),
+                       fmt::format("part {}: SPH particles cannot be rigid (*{} at {})", p.pid,
+                                   mc.keyword, mc.at.str()));
     ParamValues params = mc.params; // this part's copy: its EOS may complete it
+    ParamValues eos;                // the particles' Mie-Gruneisen parameters, if any
     const bool g_only = params.count("shear_modulus_only") > 0;
     if (g_only && p.eosid == 0)
       throw InputError(mc.at.loc(fmt::format("*{}.PR", mc.keyword)),
@@ -3063,6 +3381,11 @@ Config KeywordReader::config(const std::string& deck_file) {
         throw InputError(
             p.at.loc("*PART.EOSID"),
             fmt::format("part {}: equation of state {} is not defined", p.pid, p.eosid));
+      const bool gruneisen = particles && starts_with(e->second.keyword, "EOS_GRUNEISEN");
+      if (gruneisen) {
+        eos = gruneisen_params(e->second);
+        mname = fmt::format("mat{}_gruneisen{}", p.mid, p.eosid);
+      }
       if (g_only) {
         // *MAT_JOHNSON_COOK with G only: the EOS's bulk sound speed gives K = rho C^2.
         const double G = params["shear_modulus_only"], rho = params["density"];
@@ -3077,13 +3400,15 @@ Config KeywordReader::config(const std::string& deck_file) {
         params.erase("shear_modulus_only");
         params["youngs_modulus"] = 2 * G * (1 + nu);
         params["poissons_ratio"] = nu;
-        if (eos_of_material[p.mid].size() > 1) mname += fmt::format("_eos{}", p.eosid);
-        warnings.push_back(fmt::format(
-            "{}: part {}: *{} {} is not modelled; anvil gives material {} (G only) the bulk "
-            "modulus rho C^2 = {:.6g} Pa of this EOS's sound speed C and a linear elastic "
-            "pressure (S1-S3, GAMA0 and the energy term are ignored)",
-            p.at.str(), p.pid, e->second.keyword, p.eosid, p.mid, K));
-      } else {
+        if (!gruneisen && eos_of_material[p.mid].size() > 1)
+          mname += fmt::format("_eos{}", p.eosid);
+        if (!gruneisen)
+          warnings.push_back(fmt::format(
+              "{}: part {}: *{} {} is not modelled; anvil gives material {} (G only) the bulk "
+              "modulus rho C^2 = {:.6g} Pa of this EOS's sound speed C and a linear elastic "
+              "pressure (S1-S3, GAMA0 and the energy term are ignored)",
+              p.at.str(), p.pid, e->second.keyword, p.eosid, p.mid, K));
+      } else if (!gruneisen) {
         warnings.push_back(fmt::format(
             "{}: part {}: *{} {} is not supported; anvil computes the pressure of material {} "
             "from its linear elastic bulk modulus (E, PR) instead",
@@ -3091,7 +3416,13 @@ Config KeywordReader::config(const std::string& deck_file) {
       }
     }
     if (material_names.insert(mname).second) {
-      MaterialConfig m{mname, mc.model, params, mc.tables, {}, {}, mc.at.loc("*" + mc.keyword)};
+      MaterialConfig m{mname,
+                       mc.model,
+                       params,
+                       mc.tables,
+                       eos.empty() ? "" : "mie_gruneisen",
+                       eos,
+                       mc.at.loc("*" + mc.keyword)};
       if (mc.lcss > 0) {
         // The hardening curve: plastic strain against yield stress (the curve's abscissae
         // and values, its scale factors and offsets applied).
@@ -3117,6 +3448,42 @@ Config KeywordReader::config(const std::string& deck_file) {
       }
       c.materials.push_back(std::move(m));
     }
+    return mname;
+  };
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const PartCard& p = *std::find_if(parts_.begin(), parts_.end(),
+                                      [&](const PartCard& q) { return q.pid == order[i]; });
+    PartConfig pc;
+    pc.name = part_name(p.pid);
+    pc.where = p.at.loc(part_key);
+    pc.mesh.kind = MeshConfig::Kind::embedded;
+    pc.mesh.embedded_block = i;
+    pc.mesh.where = pc.where;
+
+    // Section.
+    const auto sec = sections_.find(p.secid);
+    if (sec == sections_.end()) {
+      if (const auto sph = sph_sections_.find(p.secid); sph != sph_sections_.end())
+        throw InputError(p.at.loc("*PART.SECID"),
+                         fmt::format("part {} has solid elements but its section {} is a "
+                                     "*SECTION_SPH (at {}), not a *SECTION_SOLID",
+                                     p.pid, p.secid, sph->second.at.str()));
+      const auto other = other_sections_.find(p.secid);
+      throw InputError(
+          p.at.loc("*PART.SECID"),
+          other != other_sections_.end()
+              ? fmt::format("part {} has solid elements but its section {} is a *{} "
+                            "(at {}), not a *SECTION_SOLID",
+                            p.pid, p.secid, other->second.keyword, other->second.at.str())
+              : fmt::format("part {}: section {} is not defined (*SECTION_SOLID)", p.pid, p.secid));
+    }
+    if (sec->second.elform != 1 && sec->second.elform != 0)
+      warnings.push_back(fmt::format("{}: section {} asks for ELFORM {}; anvil uses its one-point "
+                                     "hexahedron with hourglass control (ELFORM 1) for part {}",
+                                     sec->second.at.str(), p.secid, sec->second.elform, p.pid));
+
+    const std::string mname = part_material(p, false);
+    const MaterialCard& mc = materials_.at(p.mid);
     pc.material = mname;
     pc.rigid = mc.rigid;
     pc.erosion.plastic_strain = mc.failure_strain;
@@ -3124,19 +3491,9 @@ Config KeywordReader::config(const std::string& deck_file) {
 
     // Hourglass and bulk viscosity: the part's *HOURGLASS, else the *CONTROL_ cards, else
     // LS-DYNA's defaults (which are anvil's: viscous 0.1, Q1 1.5, Q2 0.06).
-    std::int64_t ihq = control_ihq_;
-    double qm = control_qh_, q1 = control_q1_, q2 = control_q2_;
-    if (p.hgid != 0) {
-      const auto h = hourglass_.find(p.hgid);
-      if (h == hourglass_.end())
-        throw InputError(
-            p.at.loc("*PART.HGID"),
-            fmt::format("part {}: hourglass {} is not defined (*HOURGLASS)", p.pid, p.hgid));
-      ihq = h->second.ihq;
-      qm = h->second.qm;
-      if (h->second.q1 > 0) q1 = h->second.q1;
-      if (h->second.q2 > 0) q2 = h->second.q2;
-    }
+    const HourglassCard hg = hourglass_card_of(p);
+    const std::int64_t ihq = hg.ihq;
+    const double qm = hg.qm, q1 = hg.q1, q2 = hg.q2;
     if (ihq >= 7)
       warnings.push_back(fmt::format("{}: part {}: hourglass type IHQ {} is replaced by anvil's "
                                      "{} with the same coefficient",
@@ -3148,6 +3505,15 @@ Config KeywordReader::config(const std::string& deck_file) {
     if (q2 > 0) pc.bulk_viscosity.linear = q2;
     c.parts.push_back(std::move(pc));
   }
+
+  // Particle sets: the parts of *ELEMENT_SPH particles in *PART order, each with its
+  // particles in card order, at their nodes (which no solid element may use).
+  std::vector<char> in_solid(nodes_.size(), 0);
+  for (const auto& e : elements_)
+    for (const auto n : e.nodes) in_solid[static_cast<std::size_t>(node_index_.at(n))] = 1;
+  std::vector<std::shared_ptr<ParticleList>> lists;
+  std::unordered_map<std::int64_t, ParticleAt> particle_of; // node position -> its particle
+  particle_sets(c, sph_order, part_material, in_solid, lists, particle_of, warnings);
 
   auto part_ref = [&](std::int64_t pid, const Where& at, const std::string& key) {
     if (std::none_of(parts_.begin(), parts_.end(), [&](const PartCard& p) { return p.pid == pid; }))
@@ -3178,6 +3544,7 @@ Config KeywordReader::config(const std::string& deck_file) {
         names = part_set(v.id, v.at, key + ".ID", kept);
       } else {
         for (const auto pid : order) names.push_back(part_name(pid));
+        for (const auto pid : sph_order) names.push_back(part_name(pid));
       }
       for (const auto& n : names) {
         Selection s;
@@ -3200,6 +3567,22 @@ Config KeywordReader::config(const std::string& deck_file) {
 
   conditions(c, mesh, warnings);
   loads(c, mesh, warnings);
+  // A node set's particles go to their particle list (conditions on the set act on them
+  // too); its other nodes stay.
+  if (!particle_of.empty())
+    for (auto& [name, positions] : mesh.node_sets) {
+      std::vector<std::int64_t> nodes;
+      for (const auto pos : positions) {
+        const auto it = particle_of.find(pos);
+        if (it == particle_of.end())
+          nodes.push_back(pos);
+        else
+          lists[it->second.set]->sets[name].push_back(it->second.index);
+      }
+      positions = std::move(nodes);
+    }
+  for (auto& list : lists)
+    for (auto& [name, members] : list->sets) std::sort(members.begin(), members.end());
 
   const auto shared = std::make_shared<const Mesh>(std::move(mesh));
   for (auto& pc : c.parts) pc.mesh.embedded = shared;
@@ -3225,7 +3608,7 @@ Config KeywordReader::config(const std::string& deck_file) {
       }
       if (parts.empty())
         throw InputError(k.at.loc(key), fmt::format("the contact's {} side has no part with "
-                                                    "solid elements",
+                                                    "solid elements or particles",
                                                     field[0] == 'S' ? "slave" : "master"));
       for (auto& p : parts)
         if (std::find(cc.parts.begin(), cc.parts.end(), p) == cc.parts.end()) cc.parts.push_back(p);
@@ -3331,9 +3714,8 @@ Config KeywordReader::config(const std::string& deck_file) {
   // Probes: *DATABASE_HISTORY_NODE (and _ID, _SET), at the node's position. anvil probes
   // the model's node nearest to a point, the lowest id among coincident ones; a node that
   // no element uses is in no rank's model, so a probe there would follow another node.
-  std::vector<char> used(nodes_.size(), 0);
-  for (const auto& e : elements_)
-    for (const auto n : e.nodes) used[static_cast<std::size_t>(node_index_.at(n))] = 1;
+  std::vector<char> used = in_solid; // and the particles' nodes
+  for (const auto& [pos, particle] : particle_of) used[static_cast<std::size_t>(pos)] = 1;
   std::set<std::int64_t> probed;
   std::map<std::array<double, 3>, std::int64_t> first_at; // position -> first node there
   if (!history_nodes_.empty())

@@ -26,9 +26,20 @@ std::vector<std::uint8_t> Simulation::select_particles(const Selection& sel) con
   const std::size_t n = pt.size();
   out.assign(n, 0);
   if (!sel.name.empty()) {
-    // Deck node sets are inline selections; generated PART.SET sets hold mesh nodes only.
+    // Deck node sets are inline selections; generated PART.SET sets hold mesh nodes only;
+    // a keyword deck's node sets may list particles of its particle lists.
     const auto it = config_.node_sets.find(sel.name);
     if (it != config_.node_sets.end()) return select_particles(it->second);
+    const auto& offsets = sph_->set_offsets();
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto s = static_cast<std::size_t>(pt.set[i]);
+      const ParticleList* list = config_.particles[s].list.get();
+      if (!list) continue;
+      const auto m = list->sets.find(sel.name);
+      if (m != list->sets.end() &&
+          std::binary_search(m->second.begin(), m->second.end(), pt.gid[i] - offsets[s]))
+        out[i] = 1;
+    }
     return out;
   }
   int set = -1;

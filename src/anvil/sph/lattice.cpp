@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <numeric>
+
+#include "anvil/core/nearest.hpp"
 
 namespace anvil::sph {
 
@@ -70,6 +74,29 @@ Lattice generate_lattice(const LatticeSpec& l, int dims) {
   }
   out.spacing =
       dims == 3 ? std::cbrt(out.volume) : (dims == 2 ? std::sqrt(out.volume) : out.volume);
+  return out;
+}
+
+CloudSpacing cloud_spacing(const std::vector<Vec3>& points) {
+  CloudSpacing out;
+  const std::size_t n = points.size();
+  if (n < 2) return out;
+  std::vector<double> c[3];
+  for (auto& a : c) a.resize(n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int d = 0; d < 3; ++d) c[d][i] = points[i][d];
+  std::vector<std::int64_t> id(n);
+  std::iota(id.begin(), id.end(), std::int64_t{0});
+  std::vector<int> all(n);
+  std::iota(all.begin(), all.end(), 0);
+  const NearestGrid grid(c[0].data(), c[1].data(), c[2].data(), id.data(), all);
+  double largest = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const NearestGrid::Hit h = grid.nearest(points[i], static_cast<int>(i));
+    if (!(h.r2 > 0)) return {0, static_cast<int>(i), h.index};
+    largest = std::max(largest, h.r2);
+  }
+  out.spacing = std::sqrt(largest);
   return out;
 }
 

@@ -29,4 +29,14 @@ struct Lattice {
 // (line) to interact with the others in plane. Volume is then per unit thickness or area.
 Lattice generate_lattice(const LatticeSpec& spec, int dimensions = 3);
 
+// The spacing of particles placed one by one (ParticleList), as LS-DYNA takes it for
+// *ELEMENT_SPH: the largest distance from a particle to its nearest neighbour (on a
+// lattice, the lattice spacing). 0 for fewer than two points, and 0 with the first pair
+// found when two points coincide (`a`, `b`: their indices).
+struct CloudSpacing {
+  double spacing = 0;
+  int a = -1, b = -1;
+};
+CloudSpacing cloud_spacing(const std::vector<Vec3>& points);
+
 } // namespace anvil::sph

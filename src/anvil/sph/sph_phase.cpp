@@ -16,6 +16,50 @@ namespace {
 double seconds_since(PhaseTimers::clock::time_point t0) {
   return std::chrono::duration<double>(PhaseTimers::clock::now() - t0).count();
 }
+// The particles of set `ps`: its lattice, or its list (then `volume` is unused: each
+// particle has its own mass or volume) with LS-DYNA's spacing (lattice.hpp).
+Lattice set_points(const ParticleSetConfig& ps, int dimensions) {
+  if (ps.list) {
+    if (dimensions != 3)
+      throw InputError(ps.where, "particles given one by one need a three-dimensional model");
+    Lattice out;
+    out.points = ps.list->x;
+    const CloudSpacing c = cloud_spacing(out.points);
+    if (c.a >= 0) {
+      const auto& id = ps.list->id;
+      throw InputError(ps.where,
+                       fmt::format("particles {} and {} of set '{}' are at the same point",
+                                   id[static_cast<std::size_t>(std::min(c.a, c.b))],
+                                   id[static_cast<std::size_t>(std::max(c.a, c.b))], ps.name));
+    }
+    if (out.points.empty())
+      throw InputError(ps.where, fmt::format("particle set '{}' holds no particle", ps.name));
+    if (c.spacing == 0 && !(ps.smoothing_length > 0))
+      throw InputError(ps.where, fmt::format("particle set '{}' holds a single particle, which "
+                                             "has no spacing to take its smoothing length "
+                                             "from: give the smoothing length",
+                                             ps.name));
+    out.spacing = c.spacing > 0 ? c.spacing : ps.smoothing_length / ps.smoothing_ratio;
+    return out;
+  }
+  const LatticeSpec& ls = ps.lattice;
+  if (dimensions == 1 && ls.shape != LatticeSpec::Shape::box)
+    throw InputError(ps.where, "a one-dimensional particle model takes boxes only");
+  if (dimensions == 2 && ls.shape == LatticeSpec::Shape::cylinder && ls.axis != 2)
+    throw InputError(ps.where, "in two dimensions a cylinder's axis must be z");
+  Lattice out;
+  try {
+    out = generate_lattice(ls, dimensions);
+  } catch (const std::bad_alloc&) {
+    throw InputError(ps.where, "the particle lattice does not fit in memory");
+  } catch (const std::length_error&) {
+    throw InputError(ps.where, "the particle lattice does not fit in memory");
+  }
+  if (out.points.empty())
+    throw InputError(ps.where, "the particle set's shape holds no lattice point: "
+                               "make the spacing smaller than the shape");
+  return out;
+}
 } // namespace
 
 SphPhase::SphPhase(const Config& config, const std::function<const Material*(int)>& material,
@@ -32,41 +76,31 @@ SphPhase::SphPhase(const Config& config, const std::function<const Material*(int
   if (!psets.empty())
     kernel_ = psets[0].kernel == ParticleSetConfig::Kernel::wendland_c2 ? KernelType::wendland_c2
                                                                         : KernelType::cubic_spline;
-  // Every rank generates every lattice (deterministic) and keeps its share of ids.
+  // Every rank generates every lattice (deterministic), or takes every list, and keeps
+  // its share of ids.
   std::vector<Lattice> lattices;
   set_offsets_.assign(1, 0);
   for (std::size_t s = 0; s < psets.size(); ++s) {
-    const LatticeSpec& ls = psets[s].lattice;
-    if (config.sph.dimensions == 1 && ls.shape != LatticeSpec::Shape::box)
-      throw InputError(psets[s].where, "a one-dimensional particle model takes boxes only");
-    if (config.sph.dimensions == 2 && ls.shape == LatticeSpec::Shape::cylinder && ls.axis != 2)
-      throw InputError(psets[s].where, "in two dimensions a cylinder's axis must be z");
-    try {
-      lattices.push_back(generate_lattice(ls, config.sph.dimensions));
-    } catch (const std::bad_alloc&) {
-      throw InputError(psets[s].where, "the particle lattice does not fit in memory");
-    } catch (const std::length_error&) {
-      throw InputError(psets[s].where, "the particle lattice does not fit in memory");
-    }
-    if (lattices.back().points.empty())
-      throw InputError(psets[s].where, "the particle set's shape holds no lattice point: "
-                                       "make the spacing smaller than the shape");
+    const ParticleSetConfig& ps = psets[s];
+    lattices.push_back(set_points(ps, config.sph.dimensions));
     set_offsets_.push_back(set_offsets_.back() +
                            static_cast<std::int64_t>(lattices.back().points.size()));
     const Material* m = material(static_cast<int>(s));
     SetParams sp;
     sp.material = m;
     sp.rho0 = m->elastic().density;
-    sp.h0 = psets[s].smoothing_ratio * lattices.back().spacing;
-    sp.h_min = psets[s].h_min * sp.h0;
-    sp.h_max = psets[s].h_max * sp.h0;
-    sp.alpha = psets[s].viscosity_linear;
-    sp.beta = psets[s].viscosity_quadratic;
-    sp.epsilon = psets[s].artificial_stress;
-    sp.exponent = psets[s].artificial_stress_exponent;
-    sp.w_spacing = kernel_shape(kernel_, 1.0 / psets[s].smoothing_ratio);
-    sp.corrected = psets[s].corrected_gradient;
-    sp.summation = psets[s].summation_density;
+    const double spacing = lattices.back().spacing;
+    sp.h0 = ps.smoothing_length > 0 ? ps.smoothing_length : ps.smoothing_ratio * spacing;
+    sp.h_min = ps.h_min * sp.h0;
+    sp.h_max = ps.h_max * sp.h0;
+    sp.alpha = ps.viscosity_linear;
+    sp.beta = ps.viscosity_quadratic;
+    sp.epsilon = ps.artificial_stress;
+    sp.exponent = ps.artificial_stress_exponent;
+    sp.w_spacing =
+        kernel_shape(kernel_, ps.smoothing_length > 0 ? spacing / sp.h0 : 1.0 / ps.smoothing_ratio);
+    sp.corrected = ps.corrected_gradient;
+    sp.summation = ps.summation_density;
     sp.dimensions = config.sph.dimensions;
     sets_.push_back(sp);
   }
@@ -101,7 +135,11 @@ SphPhase::SphPhase(const Config& config, const std::function<const Material*(int
     p_.gid[k] = g;
     p_.set[k] = static_cast<int>(s);
     for (int i = 0; i < 3; ++i) p_.x[i][k] = x[i];
-    p_.mass[k] = sp.rho0 * lattices[s].volume;
+    const std::size_t j = static_cast<std::size_t>(g - set_offsets_[s]);
+    const ParticleList* list = psets[s].list.get();
+    p_.mass[k] = list && list->mass[j] > 0
+                     ? list->mass[j]
+                     : sp.rho0 * (list ? list->volume[j] : lattices[s].volume);
     p_.rho[k] = sp.rho0;
     p_.h[k] = sp.h0;
     const double p0 = sp.material->initial_pressure();
