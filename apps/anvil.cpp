@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -150,8 +151,12 @@ int check(const std::string& deck, const anvil::Comm& comm) {
                   set_mass[i], static_cast<long long>(off[i + 1] - off[i]));
   }
   if (!config.boundary_conditions.empty()) {
-    std::printf("conditions  %zu (history.csv: bcN.fx, bcN.fy, bcN.fz)\n",
-                config.boundary_conditions.size());
+    const bool moments =
+        std::any_of(config.boundary_conditions.begin(), config.boundary_conditions.end(),
+                    [](const anvil::BoundaryCondition& bc) { return bc.holds_spin(); });
+    std::printf("conditions  %zu (history.csv: bcN.fx, bcN.fy, bcN.fz%s)\n",
+                config.boundary_conditions.size(),
+                moments ? "; bcN.mx, bcN.my, bcN.mz of those that hold rotations" : "");
     for (std::size_t b = 0; b < config.boundary_conditions.size(); ++b)
       std::printf("%s\n", describe_condition(b, config.boundary_conditions[b]).c_str());
   }

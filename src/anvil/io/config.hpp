@@ -155,6 +155,12 @@ struct BoundaryCondition {
   std::array<bool, 3> spin_components{false, false, false};
   Vec3 spin;
   bool rotations = false;
+  // Whether it holds a rotation (fixed or prescribed): its moment goes to history.csv.
+  bool holds_spin() const {
+    for (std::size_t i = 0; i < 3; ++i)
+      if (prescribed ? spin_components[i] : fix_spin[i]) return true;
+    return false;
+  }
   // The condition holds its components from `birth` to `death` (s; LS-DYNA's BIRTH and
   // DEATH): a step that starts at t(n) with birth <= t(n) < death; outside, they are free.
   double birth = 0, death = std::numeric_limits<double>::infinity();

@@ -226,6 +226,9 @@ std::string Outputs::history_header() const {
   for (std::size_t w = 0; w < c.rigid_walls.size(); ++w) h += fmt::format(",wall{}.force", w);
   for (std::size_t b = 0; b < c.boundary_conditions.size(); ++b)
     for (const char* f : {"fx", "fy", "fz"}) h += fmt::format(",bc{}.{}", b, f);
+  for (std::size_t b = 0; b < c.boundary_conditions.size(); ++b)
+    if (c.boundary_conditions[b].holds_spin())
+      for (const char* f : {"mx", "my", "mz"}) h += fmt::format(",bc{}.{}", b, f);
   for (const auto& p : c.parts)
     if (p.rigid)
       for (const char* f : {"ux", "uy", "uz", "vx", "vy", "vz", "wx", "wy", "wz"})
@@ -401,6 +404,7 @@ void Outputs::write_history_row(const Sample& s, bool scheduled) {
   for (double v : s.element_probes) row += fmt::format(",{:.17g}", v);
   for (double v : s.wall_force) row += fmt::format(",{:.17g}", v);
   for (double v : s.reaction) row += fmt::format(",{:.17g}", v);
+  for (double v : s.reaction_moment) row += fmt::format(",{:.17g}", v);
   for (double v : s.rigid_bodies) row += fmt::format(",{:.17g}", v);
   for (double v : s.part_energies) row += fmt::format(",{:.17g}", v);
   std::fprintf(history_, "%s\n", row.c_str());

@@ -91,7 +91,7 @@ void Simulation::setup_rigid_bodies(const Mesh& mesh) {
   rigid_part_ = std::move(part_of_body);
   rigid_points_.assign(rigid_offset_.back(), RigidPoint{});
   rigid_motion_.assign(rigid_gids_.size(), RigidMotion{});
-  rigid_holder_.assign(rigid_gids_.size(), {-1, -1, -1});
+  rigid_holder_.assign(rigid_gids_.size(), {-1, -1, -1, -1, -1, -1});
   rigid_node_.assign(nn, 0);
   rigid_nodes_.clear();
   for (std::size_t n = 0; n < nn; ++n)
@@ -206,7 +206,7 @@ void Simulation::move_rigid_bodies(bool with_contact) {
     // The components the body's conditions hold over the step: each by the last active
     // one in the deck that holds it (as for nodes), at its value times its time history.
     RigidHold hold;
-    rigid_holder_[o] = {-1, -1, -1};
+    rigid_holder_[o] = {-1, -1, -1, -1, -1, -1};
     for (std::size_t b = 0; b < bcs.size(); ++b) {
       if (condition_body_[b] != static_cast<int>(o) || !bc_active_[b]) continue;
       const auto& bc = bcs[b];
@@ -220,6 +220,7 @@ void Simulation::move_rigid_bodies(bool with_contact) {
         if (bc.prescribed ? bc.spin_components[i] : bc.fix_spin[i]) {
           hold.spin_held[i] = true;
           hold.spin[k] = bc.prescribed ? bc.spin[k] * motion_factor_[b] : 0.0;
+          rigid_holder_[o][3 + i] = static_cast<int>(b);
         }
       }
     }

@@ -1273,6 +1273,17 @@ Sample Simulation::sample() const {
     wall_forces(all, dt_avg_, s.wall_force);
   }
   s.reaction = reactions();
+  // The moments of the conditions that hold rotations: the torque each held rotation
+  // takes (the same on every rank: every rank computed the motion).
+  for (std::size_t b = 0; b < config_.boundary_conditions.size(); ++b) {
+    if (!config_.boundary_conditions[b].holds_spin()) continue;
+    Vec3 moment{0, 0, 0};
+    for (std::size_t o = 0; o < rigid_holder_.size(); ++o)
+      for (int i = 0; i < 3; ++i)
+        if (rigid_holder_[o][static_cast<std::size_t>(3 + i)] == static_cast<int>(b))
+          moment[i] += rigid_motion_[o].held_torque[i];
+    for (int i = 0; i < 3; ++i) s.reaction_moment.push_back(moment[i]);
+  }
   // The rigid bodies' motion over the last step (the same on every rank); before the first
   // step, at rest where they stand.
   for (std::size_t o = 0; o < rigid_motion_.size(); ++o) {

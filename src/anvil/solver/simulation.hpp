@@ -77,6 +77,9 @@ struct Sample {
   std::vector<double> part_energies;
   std::vector<double> wall_force; // per rigid wall: normal force, N
   std::vector<double> reaction;   // per boundary condition: fx, fy, fz on its nodes, N
+  // per condition that holds rotations (BoundaryCondition::holds_spin), in deck order: the
+  // moment it applies to its rigid body about the body's centre of mass (mx, my, mz, N m)
+  std::vector<double> reaction_moment;
   // per rigid body (its part, in deck order): the displacement of its centre of mass at
   // the time (ux, uy, uz, m) and its velocity and spin over the step from it (vx, vy, vz,
   // m/s; wx, wy, wz, rad/s: v(n + 1/2), the step's rotation), LS-DYNA's RBDOUT
@@ -364,11 +367,11 @@ private:
   std::vector<RigidPoint> rigid_points_;
   std::vector<RigidMotion> rigid_motion_;
   // The boundary conditions that hold a rigid body (`part:` naming a rigid part): per
-  // condition, its body or -1; per body and component (x, y, z), the condition that holds
-  // it over the current step, or -1.
+  // condition, its body or -1; per body and component (x, y, z, then the rotations about
+  // x, y, z), the condition that holds it over the current step, or -1.
   std::vector<int> condition_body_;
   std::vector<Vec3> rigid_centre0_; // each body's centre of mass at t = 0
-  std::vector<std::array<int, 3>> rigid_holder_;
+  std::vector<std::array<int, 6>> rigid_holder_;
 
   // Element probes: (block, element) on the rank that holds the element, (-1, -1) elsewhere.
   std::vector<std::array<int, 2>> element_probe_;
