@@ -11,7 +11,8 @@
 #  3. the same deck run again over the directory is the same run: no warning, its rows
 #     continue;
 #  4. chained restarts into other directories list the earlier fields by normal paths
-#     (`../a/fields/...`, not `../b/../a/fields/...`), every one of them readable.
+#     (`../a/fields/...`, not `../b/../a/fields/...`), every one of them readable;
+#  5. and 6. below.
 set -euo pipefail
 anvil=$1
 work=$(mktemp -d)
@@ -123,4 +124,36 @@ assert cycles(h) == cycles(i), (cycles(h), cycles(i))
 assert [r[:3] for r in h] == [r[:3] for r in i]  # time, cycle, dt: the same bits
 assert cycles(g)[-1] not in cycles(i), cycles(g)  # the short run's end row is off the series
 PY
-echo "restart outputs: changed columns kept apart, a later run's outputs not taken, paths normal, no end-of-run row kept"
+# 6. summary.json's balance_error is scaled by the largest energy of the run (QA round 31:
+#    a body driven and brought back to rest read 1.0, its round-off over energies of
+#    0): about 0 here, and the same bits after a restart (on the same rank count: energies
+#    are MPI sums, docs/cycle.md) from cycle 150, past the spin's end, whose scale comes
+#    from the earlier rows of the checkpoint's history.
+cat > driven.yaml <<'EOF'
+termination: {time: 3.0e-5}
+materials:
+  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+parts:
+  wheel:
+    mesh: {generate: box, min: [-0.01, -0.01, 0], max: [0.01, 0.01, 0.004], divisions: [4, 4, 1]}
+    material: steel
+    rigid: true
+  far:
+    mesh: {generate: box, min: [0.1, 0.1, 0.1], max: [0.102, 0.102, 0.102], divisions: [1, 1, 1]}
+    material: steel
+boundary_conditions:
+  - {part: wheel, fix: all}
+  - {part: wheel, velocity: [0, 0, 2.0], components: [z], birth: 5.0e-6, death: 1.5e-5}
+  - {part: wheel, angular_velocity: [0, 0, 500.0], components: [rz], birth: 1.0e-5, death: 2.0e-5}
+  - {part: wheel, displacement: [1.0e-4, 0, 0], components: [x], curve: [[0, 0], [1.0e-5, 0], [2.5e-5, 1]]}
+EOF
+run 1 "$anvil" run driven.yaml -o j -q
+stop 1 driven.yaml k 150
+run 1 "$anvil" run driven.yaml -o k -q --restart k/checkpoint.anvil
+/usr/bin/python3 - j k <<'PY'
+import json, sys
+j, k = (json.load(open(d + "/summary.json"))["energy"] for d in sys.argv[1:])
+assert j["balance_error"] < 1e-12, j  # (1.0 before: total 0, external work 1e-16)
+assert j["balance_error"] == k["balance_error"], (j, k)
+PY
+echo "restart outputs: changed columns kept apart, a later run's outputs not taken, paths normal, no end-of-run row kept, the balance scaled by the run's energies"

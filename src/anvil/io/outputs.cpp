@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -363,6 +364,14 @@ void Outputs::resume(const OutputState& state, const std::string& from) {
     fs::remove(fs::path(opt_.directory) / "results.pvd", ignored);
     fs::remove(fs::path(opt_.directory) / "particles.pvd", ignored);
   }
+  // The run's energies so far (external_work and total, the 8th and 9th column of every
+  // row), the scale of its balance error.
+  for (const auto& l : keep) {
+    std::istringstream row(l);
+    std::string cell;
+    for (int column = 0; std::getline(row, cell, ','); ++column)
+      if (column == 7 || column == 8) note_energy(std::strtod(cell.c_str(), nullptr));
+  }
   // Other columns (the deck's probes or rigid walls changed): the earlier rows keep their
   // own header in a file of their own, history.csv starts at the checkpoint.
   if (!keep.empty() && old_header != history_header()) {
@@ -395,7 +404,13 @@ OutputState Outputs::state() const {
           pvd_,         particle_pvd_, history_rows_, history_last_};
 }
 
+void Outputs::note_energy(double e) {
+  if (std::isfinite(e)) energy_scale_ = std::max(energy_scale_, std::abs(e));
+}
+
 void Outputs::write_history_row(const Sample& s, bool scheduled) {
+  note_energy(s.total());
+  note_energy(s.external_work);
   if (!history_) return;
   std::string row = fmt::format(
       "{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", s.time, s.cycle, s.dt,
@@ -680,7 +695,7 @@ void Outputs::write_summary(int status, const std::string& message) {
                  {"contact", s.contact},
                  {"external_work", s.external_work},
                  {"total", s.total()},
-                 {"balance_error", sim_.balance_error(s)}};
+                 {"balance_error", sim_.balance_error(s, energy_scale_)}};
   json parts = json::array();
   for (const auto& p : sim_.config().parts) parts.push_back(p.name);
   j["parts"] = parts; // part index in the `part` cell field -> name

@@ -98,6 +98,10 @@ private:
   int field_count_ = 0;
   std::int64_t history_rows_ = 0; // scheduled rows of history.csv (rank 0), and the last
   std::string history_last_;
+  // The largest |total| and |external_work| of the run's history rows (and of the kept
+  // rows of a restart): the scale of summary.json's balance_error.
+  double energy_scale_ = 0;
+  void note_energy(double e);
   double start_wall_ = 0, last_progress_wall_ = 0, last_progress_fraction_ = 0;
   std::int64_t start_cycle_ = 0; // the cycle this run started from (its checkpoint's)
   double start_fraction_ = 0;    // the fraction done at that cycle

@@ -1387,10 +1387,10 @@ std::vector<double> Simulation::reactions() const {
   return out;
 }
 
-double Simulation::balance_error(const Sample& s) const {
+double Simulation::balance_error(const Sample& s, double scale) const {
   const double e = s.total();
-  const double scale =
-      std::max({std::abs(e), std::abs(s.external_work), std::abs(initial_energy_), 1e-300});
+  scale =
+      std::max({std::abs(e), std::abs(s.external_work), std::abs(initial_energy_), scale, 1e-300});
   return std::abs(e - initial_energy_ - s.external_work) / scale;
 }
 
