@@ -765,6 +765,37 @@ TEST(Keyword, ConstraintsVelocitiesContactWalls) {
   EXPECT_EQ(c.rigid_walls[0].friction, 0.3);
 }
 
+// The _MPP forms (LS-PrePost writes them for MPP runs): the MPP 1 card, and MPP 2 when the
+// line after it opens with a lone '&', come after the _ID card and before card 1, with
+// the suffixes in either order. They read like the plain form (before, the whole keyword
+// was ignored, and a deck whose only contact was such a form ran with none).
+TEST(Keyword, MppContactCardsAreTaken) {
+  const std::string plain = R"(*CONTACT_AUTOMATIC_SINGLE_SURFACE_ID
+         7single
+         0                             0
+      0.25
+       2.0
+*END)";
+  const Config ref = kw(with(good, "*END", plain));
+  ASSERT_EQ(ref.contact.size(), 1u);
+  for (const std::string& name : {std::string("*CONTACT_AUTOMATIC_SINGLE_SURFACE_MPP_ID"),
+                                  std::string("*CONTACT_AUTOMATIC_SINGLE_SURFACE_ID_MPP")})
+    for (const std::string mpp2 : {"", "&                 1       1.0\n"}) {
+      SCOPED_TRACE(name + (mpp2.empty() ? "" : " with MPP 2"));
+      const std::string deck = with(
+          good, "*END",
+          with(plain, "*CONTACT_AUTOMATIC_SINGLE_SURFACE_ID\n         7single\n",
+               name + "\n         7single\n         1       200         0         3         2\n" +
+                   mpp2));
+      const Config c = kw(deck);
+      ASSERT_EQ(c.contact.size(), 1u);
+      EXPECT_EQ(c.contact[0].friction, 0.25);
+      EXPECT_EQ(c.contact[0].penalty_scale, ref.contact[0].penalty_scale);
+      EXPECT_TRUE(c.contact[0].parts.empty());
+      for (const auto& w : c.warnings) EXPECT_EQ(w.find("not supported"), std::string::npos) << w;
+    }
+}
+
 // Two-surface and eroding *CONTACT_ forms are anvil's general contact among the parts of
 // both sides (with a warning saying so); several contact cards are one contact among all
 // their parts, and must agree on the friction and the penalty scale (one contact has one).

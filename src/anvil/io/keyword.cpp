@@ -495,6 +495,11 @@ public:
     }
     return std::nullopt;
   }
+  // The next line without taking it (none at the block's end).
+  std::optional<Line> peek() const {
+    if (i_ < end_) return b_.lines[i_];
+    return std::nullopt;
+  }
   // The rest of the block is not read, on purpose (a keyword anvil only lists).
   void skip_rest() {
     i_ = end_;
@@ -2604,13 +2609,32 @@ private:
 
   // The *CONTACT_ forms anvil reads (with or without _ID or _TITLE): 1 a single surface,
   // 2 two surfaces (slave and master sides), 0 none. All become anvil's general contact.
+  // The options of a contact keyword's name: the _ID (or _TITLE) card and the _MPP cards,
+  // in either order of the suffixes.
+  struct ContactOptions {
+    bool id = false, mpp = false;
+  };
+  static ContactOptions contact_options(std::string_view& n) {
+    ContactOptions o;
+    for (int k = 0; k < 2; ++k) {
+      if (!o.mpp && ends_with(n, "_MPP")) {
+        n.remove_suffix(4);
+        o.mpp = true;
+      } else if (!o.id && ends_with(n, "_ID")) {
+        n.remove_suffix(3);
+        o.id = true;
+      } else if (!o.id && ends_with(n, "_TITLE")) {
+        n.remove_suffix(6);
+        o.id = true;
+      }
+    }
+    return o;
+  }
+
   static int contact_form(std::string_view n) {
     if (!starts_with(n, "CONTACT_")) return 0;
     n.remove_prefix(8);
-    if (ends_with(n, "_ID"))
-      n.remove_suffix(3);
-    else if (ends_with(n, "_TITLE"))
-      n.remove_suffix(6);
+    contact_options(n);
     for (const char* f : {"AUTOMATIC_SINGLE_SURFACE", "SINGLE_SURFACE", "ERODING_SINGLE_SURFACE",
                           "AUTOMATIC_GENERAL"})
       if (n == f) return 1;
@@ -2643,7 +2667,18 @@ private:
 
   void contact(const Block& b) {
     Cursor c(b);
-    if (ends_with(b.name, "_ID") || ends_with(b.name, "_TITLE")) c.next(); // CID and HEADING
+    std::string_view name = b.name;
+    const ContactOptions options = contact_options(name);
+    if (options.id) c.next(); // CID and HEADING
+    if (options.mpp) {
+      // MPP 1 (IGNORE, BCKT, LCBCKT, NS2TRK, INITITR, PARMAX, CPARM8: the decomposition's
+      // search and the treatment of initial penetrations, which anvil's contact does its
+      // own way, docs/contact.md), then MPP 2 when the next line opens with a lone '&'.
+      c.next();
+      if (const auto l = c.peek(); l && !l->text.empty() && l->text.front() == '&' &&
+                                   (l->text.size() == 1 || l->text[1] == ' ' || l->text[1] == ','))
+        c.next();
+    }
     const Line l = c.next();
     const Card c1(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
     ContactCard k{};
