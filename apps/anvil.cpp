@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <limits>
 #include <new>
 #include <span>
 #include <vector>
@@ -105,6 +106,9 @@ int check(const std::string& deck, const anvil::Comm& comm) {
   if (comm.rank() == 0)
     for (const auto& w : sim.warnings()) std::fprintf(stderr, "anvil: warning: %s\n", w.c_str());
   const double dt = sim.stable_time_step();
+  // The particles' first step if no pair approaches (a reduction, as the masses below).
+  const double dt_particles =
+      sim.sph() ? sim.sph()->initial_step() : std::numeric_limits<double>::infinity();
   // Particle sets: mass per set (a reduction: before rank 0 prints alone).
   std::vector<double> set_mass(config.particles.size(), 0.0);
   if (const auto* sph = sim.sph()) {
@@ -174,17 +178,16 @@ int check(const std::string& deck, const anvil::Comm& comm) {
       std::printf("%s\n",
                   describe_load(l, config.loads[l], load_targets[l], pressed_area[l]).c_str());
   }
-  if (sim.global_elements() == 0) {
-    // The particles' step needs their first phase (wave speeds from the materials).
-    std::printf("stable dt   (particles only: set by the particle phase at the first cycle)\n");
-    std::printf("deck and mesh are valid\n");
-    return 0;
-  }
-  std::printf("stable dt   %.6g s (element kernel at t = 0), step %.6g s with scale %g\n", dt,
-              dt * config.time_step_scale, config.time_step_scale);
+  if (sim.global_elements() > 0)
+    std::printf("stable dt   %.6g s (element kernel at t = 0), step %.6g s with scale %g\n", dt,
+                dt * config.time_step_scale, config.time_step_scale);
   if (sim.sph())
-    std::printf("            the elements' step: the particles set theirs at the first cycle, "
-                "and the run takes the smaller\n");
+    std::printf("%s%.6g s for the particles at rest (0.3 h / (c (1 + 1.2 alpha)), and 0.3 h "
+                "/ |v|; their first cycle sets it), step %.6g s\n",
+                sim.global_elements() > 0 ? "            " : "stable dt   ", dt_particles,
+                dt_particles * config.time_step_scale);
+  const double step = std::min(sim.global_elements() > 0 ? dt : dt_particles, dt_particles) *
+                      config.time_step_scale;
   if (config.mass_scaling_step > 0 &&
       dt * config.time_step_scale < config.mass_scaling_step * (1 - 1e-9))
     std::printf("            below the mass-scaling step %g s: elements that the initial "
@@ -193,7 +196,7 @@ int check(const std::string& deck, const anvil::Comm& comm) {
                 config.mass_scaling_step);
   if (std::isfinite(config.end_time))
     std::printf("end time    %.6g s, about %.0f cycles at the initial step\n", config.end_time,
-                std::ceil(config.end_time / (dt * config.time_step_scale)));
+                std::ceil(config.end_time / step));
   std::printf("deck and mesh are valid\n");
   return 0;
 }

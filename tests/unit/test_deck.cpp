@@ -153,7 +153,9 @@ TEST(Deck, MissingRequiredValues) {
   expect_error("    material: copper\n", "", {"deck.yaml:8", "parts.bar.material", "missing"});
   // Under an empty mapping, at the mapping's key (QA round 22: at line 1).
   expect_error("output: {fields_every", "checkpoint: {}\noutput: {fields_every",
-               {"deck.yaml:21", "checkpoint.every", "missing"});
+               {"deck.yaml:21", "checkpoint", "`every`", "missing"});
+  expect_error("output: {fields_every", "checkpoint: {cycles: 0}\noutput: {fields_every",
+               {"deck.yaml:21", "checkpoint.cycles", "at least 1"});
 }
 
 TEST(Deck, ImpossibleValues) {
@@ -621,3 +623,16 @@ TEST(Deck, DeckFileMustBeARegularFile) {
 }
 
 } // namespace
+
+// `checkpoint: {cycles: N}` (LS-DYNA's *DATABASE_BINARY_RUNRSF CYCL) beside `every: T`.
+TEST(Deck, CheckpointEveryCycles) {
+  const anvil::Config c = anvil::test::deck(R"(termination: {cycles: 10}
+materials:
+  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+parts:
+  b: {mesh: {generate: box, min: [0, 0, 0], max: [1, 1, 1], divisions: [1, 1, 1]}, material: steel}
+checkpoint: {cycles: 50, every: 1.0e-5}
+)");
+  EXPECT_EQ(c.checkpoint_every_cycles, 50);
+  EXPECT_EQ(c.checkpoint_every, 1.0e-5);
+}

@@ -1332,6 +1332,10 @@ TEST(Keyword, SphParticles) {
   // node 1 is held too.
   const Comm world = Comm::world();
   Simulation sim(c, world);
+  // `anvil check`'s step of the particles at rest: 0.3 h0 / (c (1 + 1.2 alpha)), c the
+  // plane wave speed of mat1 (E 200 GPa, nu 0.3, 7850 kg/m^3), h0 = 1.2 x 1 mm.
+  const double wave = std::sqrt(2e11 * 0.7 / (1.3 * 0.4) / 7850);
+  EXPECT_NEAR(sim.sph()->initial_step(), 0.3 * 1.2e-3 / (wave * (1 + 1.2 * 0.06)), 1e-20);
   for (int i = 0; i < 3; ++i) sim.step();
   const auto& pt = sim.sph()->particles();
   ASSERT_EQ(pt.size(), 4u);
@@ -1391,6 +1395,40 @@ TEST(Keyword, SphParticleErrors) {
               std::string::npos)
         << e.what();
   }
+  // SPHINI within 0.8 to 3 spacings (the largest nearest distance, here 1 mm), named at
+  // its field when the model is built; a single particle needs it.
+  for (const char* sphini : {"    0.0001", "     0.005"}) {
+    const Config bad = kw(with_sph(with(sph_cards, "       0.5       1.5\n",
+                                        std::string("       0.5       1.5") + sphini + "\n")));
+    try {
+      const Comm world = Comm::world();
+      Simulation sim(bad, world);
+      ADD_FAILURE() << "no error for SPHINI " << sphini;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("*SECTION_SPH.SPHINI"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("between 0.8 and 3"), std::string::npos) << e.what();
+    }
+  }
+  // *ELEMENT_SPH holds four fields: more is an error, not dropped.
+  expect_error(sph_with("     101       2        -1.0e-09",
+                        "     101       2        -1.0e-09       0       5"),
+               {"*ELEMENT_SPH.card", "found '5'"});
+  expect_error(sph_with("     101       2        -1.0e-09", "101,2,-1.0e-09,0,5"),
+               {"*ELEMENT_SPH.card", "a field more ('5')"});
+  // A stray particle (1 m off) sets h0 for the whole set by LS-DYNA's rule: warned of.
+  {
+    const Config stray = kw(
+        with_sph(with(with(sph_cards, "     104           0.001           0.001             3.0\n",
+                           "     104           0.001           0.001             3.0\n"
+                           "     105             1.0           0.001             3.0\n"),
+                      "*SET_NODE_LIST", "     105       2         2.0e-06\n*SET_NODE_LIST")));
+    const Comm world = Comm::world();
+    Simulation sim(stray, world);
+    bool warned = false;
+    for (const auto& w : sim.warnings())
+      warned = warned || w.find("a stray particle? h0 = ") != std::string::npos;
+    EXPECT_TRUE(warned);
+  }
   // What anvil does otherwise is said.
   const Config w = kw(with_sph(
       with(with(sph_cards, "                   1\n*SECTION", "                   5\n*SECTION"),
@@ -1399,6 +1437,30 @@ TEST(Keyword, SphParticleErrors) {
   EXPECT_NE(w.warnings[0].find("SPHKERN 2"), std::string::npos) << w.warnings[0];
   EXPECT_NE(w.warnings[1].find("FORM 5"), std::string::npos) << w.warnings[1];
   EXPECT_FALSE(w.particles[0].corrected_gradient);
+  // *CONTROL_SPH card 2 with a field set (CONT = 1: LS-DYNA's parts would not interact).
+  const Config c2 = kw(with_sph(with(sph_cards, "                   1\n*SECTION",
+                                     "                   1\n         1\n*SECTION")));
+  ASSERT_EQ(c2.warnings.size(), 1u);
+  EXPECT_NE(c2.warnings[0].find("*CONTROL_SPH card 2 sets fields anvil does not read"),
+            std::string::npos)
+      << c2.warnings[0];
+  // A blank id in the I10 format is told its own width.
+  expect_error(with_sph(with(with(sph_cards, "     101       2        -1.0e-09",
+                                  "                   2        -1.0e-09"),
+                             "*ELEMENT_SPH\n", "*ELEMENT_SPH %\n")),
+               {"*ELEMENT_SPH.NID", "10 characters wide here"});
+}
+
+// *DATABASE_BINARY_D3DUMP and *DATABASE_BINARY_RUNRSF: checkpoints every CYCL cycles, the
+// smaller of the two.
+TEST(Keyword, RestartDumpsAreCheckpoints) {
+  EXPECT_EQ(kw(good).checkpoint_every_cycles, 0);
+  const Config c = kw(with(good, "*END",
+                           "*DATABASE_BINARY_D3DUMP\n       500\n"
+                           "*DATABASE_BINARY_RUNRSF\n       200\n*END"));
+  EXPECT_EQ(c.checkpoint_every_cycles, 200);
+  expect_error(with(good, "*END", "*DATABASE_BINARY_RUNRSF\n      20.5\n*END"),
+               {"*DATABASE_BINARY_RUNRSF.CYCL", "whole number"});
 }
 
 // keyword.md: "never fields dropped silently". A card more than a keyword takes (a second
@@ -1528,7 +1590,7 @@ TEST(Keyword, AProbeOnANodeNoElementUsesIsAnError) {
                           "     777             5.0             5.0             5.0\n");
   text = with(text, "*DATABASE_HISTORY_NODE\n        12\n", "*DATABASE_HISTORY_NODE\n12,777\n");
   expect_error(text, {fmt::format("model.k:{}: *DATABASE_HISTORY_NODE.ID", line_of(text, "12,777")),
-                      "history node 777 belongs to no solid element"});
+                      "history node 777 belongs to no solid element or particle"});
   // The same node in a history node set: skipped, with a warning.
   text = with(with(text, "12,777\n", "12\n"), "*END",
               "*SET_NODE_LIST\n         8\n         1       777\n*DATABASE_HISTORY_NODE_SET\n"

@@ -94,7 +94,8 @@ struct ParticleSetConfig {
   // h0 = smoothing_ratio * spacing: the lattice's (cell volume)^(1/dimensions); a list's,
   // the largest distance from a particle to its nearest neighbour (LS-DYNA's rule).
   double smoothing_ratio = 1.3;
-  double smoothing_length = 0; // h0 itself, m, when > 0 (LS-DYNA's SPHINI)
+  double smoothing_length = 0;    // h0 itself, m, when > 0 (LS-DYNA's SPHINI)
+  SourceLocation smoothing_where; // the deck's key of the smoothing length (empty: `where`)
   // Bounds of h / h0 as the density changes (LS-DYNA's *SECTION_SPH HMIN and HMAX, with
   // their defaults): h = h0 (rho0 / rho)^(1/d) clamped to [h_min, h_max] h0.
   double h_min = 0.2, h_max = 2.0;
@@ -252,10 +253,11 @@ struct Config {
   // Mass scaling at t = 0 (0: none): elements whose step would be below this get the mass
   // that raises it to this (LS-DYNA's DT2MS < 0 with MS1ST = 1: TSSFAC |DT2MS|), s.
   double mass_scaling_step = 0;
-  SourceLocation mass_scaling_where; // the deck's key or card field, for messages
-  double fields_every = 0;           // 0: first and last only
-  double checkpoint_every = 0;       // 0: checkpoints only when stopped by a signal
-  double history_every = 0;          // 0: every cycle
+  SourceLocation mass_scaling_where;        // the deck's key or card field, for messages
+  double fields_every = 0;                  // 0: first and last only
+  double checkpoint_every = 0;              // 0: checkpoints only when stopped by a signal
+  std::int64_t checkpoint_every_cycles = 0; // and/or every that many cycles (0: none)
+  double history_every = 0;                 // 0: every cycle
   OutputFormat output_format = OutputFormat::vtu;
   bool part_energies = false; // history.csv columns of each part's energies (LS-DYNA's matsum)
   std::vector<MaterialConfig> materials;

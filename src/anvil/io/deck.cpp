@@ -1244,8 +1244,14 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 
   if (top.has("checkpoint")) {
     const Node cp = top.child("checkpoint");
-    cp.check_keys({"every"});
-    c.checkpoint_every = cp.required("every").positive();
+    cp.check_keys({"every", "cycles"});
+    if (!cp.has("every") && !cp.has("cycles"))
+      cp.fail("`every` (seconds of simulated time) or `cycles` is missing: give either or both");
+    if (cp.has("every")) c.checkpoint_every = cp.child("every").positive();
+    if (cp.has("cycles")) {
+      c.checkpoint_every_cycles = cp.child("cycles").integer();
+      if (c.checkpoint_every_cycles < 1) cp.child("cycles").fail("must be at least 1");
+    }
   }
 
   if (top.has("output")) {

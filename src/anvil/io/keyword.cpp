@@ -353,6 +353,21 @@ public:
 
   // Fields on the card: its widths in fixed format, every comma-separated one in free.
   int size() const { return static_cast<int>(fields_.size()); }
+  // A card of exactly n fields (its fixed form shorter than 80 columns): a field after the
+  // n-th, or text after its columns, is an error, not dropped.
+  void no_fields_after(int n) const {
+    for (int i = n; i < size(); ++i)
+      if (!fields_[static_cast<std::size_t>(i)].empty())
+        fail("card", fmt::format("*{} has {} fields; this card holds a field more ('{}')", kw_.name,
+                                 n, shown(fields_[static_cast<std::size_t>(i)])));
+    if (ends_.size() >= static_cast<std::size_t>(n) && n > 0) {
+      const std::string_view text = line_.text;
+      const std::size_t end = ends_[static_cast<std::size_t>(n - 1)];
+      if (end < text.size() && !trim(text.substr(end)).empty())
+        fail("card", fmt::format("*{} has {} fields, in {} columns; found '{}' after them",
+                                 kw_.name, n, end, shown(trim(text.substr(end)))));
+    }
+  }
   bool blank(int i) const { return i >= size() || fields_[i].empty(); }
 
   std::int64_t integer(int i, std::string_view name, std::int64_t def = 0) const {
@@ -572,6 +587,7 @@ struct SphSectionCard {
   double cslh, hmin, hmax, sphini;
   Where at;
 };
+// (The field SPHINI of a section is at its card's line: at.loc("*SECTION_SPH.SPHINI").)
 
 struct PartCard {
   std::int64_t pid, secid, mid, eosid, hgid;
@@ -869,6 +885,7 @@ private:
     if (n == "CONTROL_HOURGLASS") return control_hourglass(b);
     if (n == "CONTROL_BULK_VISCOSITY") return control_bulk_viscosity(b);
     if (n == "DATABASE_BINARY_D3PLOT") return d3plot(b);
+    if (n == "DATABASE_BINARY_D3DUMP" || n == "DATABASE_BINARY_RUNRSF") return restart_dump(b);
     if (n == "DATABASE_GLSTAT" || n == "DATABASE_NODOUT" || n == "DATABASE_ELOUT")
       return history_interval(b);
     if (n == "DATABASE_MATSUM") {
@@ -923,14 +940,23 @@ private:
 
   // ---- mesh -----------------------------------------------------------------------------
 
+  // The message for a blank first id of a mesh card (`field` of keyword b): its width, and
+  // the wider formats when it is the standard one.
+  static std::string blank_id(const Block& b, std::string_view field) {
+    if (b.long_format || b.i10)
+      return fmt::format("{} is blank: *{}'s first field is {} characters wide here", field, b.name,
+                         b.long_format ? 20 : 10);
+    return fmt::format("{} is blank: *{}'s first field is 8 characters wide (for 10 characters "
+                       "give *KEYWORD I10=Y or '*{} %')",
+                       field, b.name, b.name);
+  }
+
   void node(const Block& b) {
     Cursor c(b);
     while (auto l = c.next_record()) {
       const Card card(b, *l, {8, 16, 16, 16, 8, 8});
       const std::int64_t nid = card.integer(0, "NID", 0);
-      if (card.blank(0))
-        card.fail("NID", "NID is blank: *NODE's first field is 8 characters wide (for 10 "
-                         "characters give *KEYWORD I10=Y or '*NODE %')");
+      if (card.blank(0)) card.fail("NID", blank_id(b, "NID"));
       if (nid <= 0) card.fail("NID", fmt::format("NID must be a positive node id, found {}", nid));
       Vec3 x;
       try {
@@ -963,9 +989,7 @@ private:
       e.eid = first.integer(0, "EID", 0);
       e.pid = first.integer(1, "PID", 0);
       e.at = where_of(*l);
-      if (first.blank(0))
-        first.fail("EID", "EID is blank: *ELEMENT_SOLID's fields are 8 characters wide (for "
-                          "10-character fields give *KEYWORD I10=Y or '*ELEMENT_SOLID %')");
+      if (first.blank(0)) first.fail("EID", blank_id(b, "EID"));
       if (e.eid <= 0) first.fail("EID", fmt::format("EID must be a positive id, found {}", e.eid));
       if (e.pid <= 0)
         first.fail("PID", fmt::format("element {}: PID must be a positive part id, found {}", e.eid,
@@ -1163,9 +1187,8 @@ private:
                0,
                0,
                where_of(*l)};
-      if (card.blank(0))
-        card.fail("NID", "NID is blank: *ELEMENT_SPH's fields are 8 characters wide (for 10 "
-                         "characters give *KEYWORD I10=Y or '*ELEMENT_SPH %')");
+      if (card.blank(0)) card.fail("NID", blank_id(b, "NID"));
+      card.no_fields_after(4); // NID, PID, MASS, NEND: nothing after column 40
       if (e.nid <= 0)
         card.fail("NID", fmt::format("NID must be a positive node id, found {}", e.nid));
       if (e.pid <= 0)
@@ -1193,7 +1216,26 @@ private:
     Cursor c(b);
     const Line l = c.next();
     const Card card(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
-    c.skip_rest();
+    // Cards 2 and 3 (CONT, DERIV, INI, ISHOW, IEROD, ICONT, IAVIS, ISYMP; ITHK, ISTAB, QL,
+    // ...): taken; any field set is said not to be read (CONT = 1, IEROD, IAVIS change the
+    // run in LS-DYNA).
+    sph_control_notes_.clear();
+    static const char* const card2[] = {"CONT",  "DERIV", "INI",   "ISHOW",
+                                        "IEROD", "ICONT", "IAVIS", "ISYMP"};
+    for (int k = 2; !c.done(); ++k) {
+      const Line lk = c.next();
+      const Card ck(b, lk, {10, 10, 10, 10, 10, 10, 10, 10}, Card::Extra::keep);
+      for (int i = 0; i < ck.size(); ++i)
+        if (!ck.blank(i) &&
+            ck.real(i, k == 2 && i < 8 ? std::string(card2[i])
+                                       : fmt::format("card{}.field{}", k, i + 1)) != 0) {
+          sph_control_notes_.push_back(fmt::format(
+              "{}: *CONTROL_SPH card {} sets fields anvil does not read (its particles interact "
+              "with every particle set, are not eroded, and take the Monaghan viscosity)",
+              where_of(lk).str(), k));
+          break;
+        }
+    }
     control_sph_at_ = where_of(l);
     const std::int64_t idim = card.integer(3, "IDIM", 0);
     if (idim != 0 && idim != 3)
@@ -1202,12 +1244,11 @@ private:
                                     idim));
     const std::int64_t form = card.integer(5, "FORM", 0);
     sph_corrected_ = form == 1;
-    sph_control_notes_.clear();
     const std::string at = where_of(l).str();
     if (form != 0 && form != 1)
       sph_control_notes_.push_back(fmt::format(
           "{}: *CONTROL_SPH FORM {} is not anvil's: its particles use the standard form "
-          "(FORM 0) with the Monaghan-Gingold viscosity and artificial stress (docs/sph.md)",
+          "(FORM 0) with the Monaghan-Gingold viscosity (docs/sph.md)",
           at, form));
     if (card.id(1, "BOXID") != 0)
       sph_control_notes_.push_back(fmt::format(
@@ -1993,7 +2034,7 @@ private:
       load.force[nl.dof] = nl.sf;
       load.curve = load_curve(nl.lcid, nl.sf, nl.at, key, warnings);
       load.where = nl.at.loc(key);
-      load.target.where = load.where;
+      load.target.where = nl.at.loc(key + (nl.set != 0 ? ".NSID" : ".NID"));
       if (nl.set != 0) {
         load.target.name = node_set_name(nl.set, nl.at, key + ".NSID");
         c.loads.push_back(load);
@@ -2848,6 +2889,21 @@ private:
     if (control_q2_ < 0) card.fail("Q2", "Q2 must not be negative");
   }
 
+  // *DATABASE_BINARY_D3DUMP, *DATABASE_BINARY_RUNRSF: CYCL, the cycles between restart
+  // dumps: anvil's checkpoints (`checkpoint: {cycles: N}`), every CYCL cycles (the smaller
+  // of the two keywords').
+  void restart_dump(const Block& b) {
+    Cursor c(b);
+    const Line l = c.next();
+    const Card card(b, l, {10, 10, 10, 10});
+    const double cycl = card.real(0, "CYCL");
+    if (cycl < 0 || cycl != std::floor(cycl) || cycl > 9e15)
+      card.fail("CYCL", fmt::format("CYCL must be a whole number of cycles, found {}", cycl));
+    if (cycl == 0) return;
+    const auto n = static_cast<std::int64_t>(cycl);
+    if (checkpoint_cycles_ == 0 || n < checkpoint_cycles_) checkpoint_cycles_ = n;
+  }
+
   void d3plot(const Block& b) {
     Cursor c(b);
     const Line l = c.next();
@@ -3065,6 +3121,11 @@ private:
       ps.material = material(p, true);
       ps.smoothing_ratio = sec->second.cslh;
       ps.smoothing_length = sec->second.sphini;
+      ps.smoothing_where =
+          sec->second.at.loc(sec->second.sphini > 0 ? "*SECTION_SPH.SPHINI" : "*SECTION_SPH.CSLH");
+      // LS-DYNA's SPH has no artificial stress (Gray, Monaghan and Swift's remedy for the
+      // tensile instability, on by default in a YAML deck): off, as there.
+      ps.artificial_stress = 0;
       ps.h_min = sec->second.hmin;
       ps.h_max = sec->second.hmax;
       ps.corrected_gradient = sph_corrected_;
@@ -3249,6 +3310,7 @@ private:
   double endtim_ = 0;
   std::int64_t endcyc_ = 0;
   double tssfac_ = 0.9;
+  std::int64_t checkpoint_cycles_ = 0; // *DATABASE_BINARY_D3DUMP / RUNRSF CYCL
   // The rigid parts whose *MAT_RIGID holds them (CMO = 1): part name -> CON1, CON2.
   struct RigidConstraint {
     int con1, con2;
@@ -3329,6 +3391,7 @@ Config KeywordReader::config(const std::string& deck_file) {
   if (endtim_ > 0) c.end_time = endtim_;
   if (endcyc_ > 0) c.end_cycles = endcyc_;
   c.time_step_scale = tssfac_;
+  c.checkpoint_every_cycles = checkpoint_cycles_;
   c.time_step_minimum_fraction = dtmin_;
   c.mass_scaling_step = tssfac_ * mass_scaling_dt2ms_;
   c.mass_scaling_where = mass_scaling_at_;
@@ -3774,9 +3837,9 @@ Config KeywordReader::config(const std::string& deck_file) {
       const auto pos = node_position(h.id, h.at, h.keyword + ".ID", "the history node list");
       if (!used[static_cast<std::size_t>(pos)])
         throw InputError(h.at.loc(h.keyword + ".ID"),
-                         fmt::format("history node {} belongs to no solid element: anvil's model "
-                                     "holds only the nodes of its elements, so nothing there "
-                                     "can be recorded",
+                         fmt::format("history node {} belongs to no solid element or particle: "
+                                     "anvil's model holds only the nodes of its elements, so "
+                                     "nothing there can be recorded",
                                      h.id));
       probe(pos, h);
       continue;
@@ -3795,7 +3858,7 @@ Config KeywordReader::config(const std::string& deck_file) {
     }
     if (!unused.empty())
       warnings.push_back(fmt::format("{}: {} node{} of history node set {} (node {}{}) belong "
-                                     "to no solid element and get no probe",
+                                     "to no solid element or particle and get no probe",
                                      h.at.str(), unused.size(), unused.size() == 1 ? "" : "s", h.id,
                                      unused.front(), unused.size() > 1 ? ", ..." : ""));
   }

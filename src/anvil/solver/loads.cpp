@@ -42,10 +42,10 @@ void Simulation::setup_loads(const Mesh& mesh) {
             comm_.sum(static_cast<std::int64_t>(std::count(mask.begin(), mask.end(), 1)));
         if (held > 0)
           throw InputError(load.target.where,
-                           fmt::format("the selection holds {} particles: forces act on the "
-                                       "nodes of the mesh only (a particle model takes a body "
-                                       "force, `gravity`)",
-                                       held));
+                           fmt::format("the selection holds {} particle{}: forces act on the "
+                                       "nodes of the mesh only (particles take body loads: "
+                                       "`gravity`, *LOAD_BODY_X/Y/Z in a keyword deck)",
+                                       held, held == 1 ? "" : "s"));
       }
       const auto ids = resolve_selection(mesh, config_, load.target);
       warn_if_outside_model(ids, load.target.where);

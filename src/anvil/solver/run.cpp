@@ -98,9 +98,13 @@ int run(const Config& config, const RunOptions& options, const Comm& comm) {
       if (stop_signal != 0 || stop_here) sim.request_stop();
       sim.step();
       out.after_step();
-      if (sim.clock().time >= next_checkpoint * (1 - 1e-12) && !sim.finished()) {
-        next_checkpoint =
-            next_output_time(next_checkpoint, config.checkpoint_every, sim.clock().time);
+      const bool by_time = sim.clock().time >= next_checkpoint * (1 - 1e-12);
+      const bool by_cycle = config.checkpoint_every_cycles > 0 &&
+                            sim.clock().cycle % config.checkpoint_every_cycles == 0;
+      if ((by_time || by_cycle) && !sim.finished()) {
+        if (by_time)
+          next_checkpoint =
+              next_output_time(next_checkpoint, config.checkpoint_every, sim.clock().time);
         checkpoint();
       }
       if (sim.stop_requested() && !sim.finished()) {
@@ -130,7 +134,8 @@ int run(const Config& config, const RunOptions& options, const Comm& comm) {
     }
     throw;
   }
-  if (config.checkpoint_every > 0) checkpoint(); // the final state, for continuing later
+  if (config.checkpoint_every > 0 || config.checkpoint_every_cycles > 0)
+    checkpoint(); // the final state, for continuing later
   out.finish(exit_ok, "");
   return exit_ok;
 }

@@ -155,6 +155,7 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
           return material_of(config_.particles[static_cast<std::size_t>(set)].material);
         },
         comm_);
+    warnings_.insert(warnings_.end(), sph_->notes().begin(), sph_->notes().end());
     // The particles' fingerprint, as the mesh's: of each particle's id, set, mass and
     // reference position, summed over the particles (in two 32-bit halves, so that the
     // sums neither overflow nor depend on which rank holds which particle).
@@ -284,9 +285,10 @@ void Simulation::warn_of_setup(const Mesh& mesh) {
           config_.contact[0].where.str()));
     else if (const std::int64_t inside = particles_inside_contact_parts(mesh); inside > 0)
       warnings_.push_back(fmt::format(
-          "{}: {} particles start inside elements of parts in contact; contact takes a particle "
-          "only when it comes through a face, so it ignores these",
-          config_.contact[0].where.str(), inside));
+          "{}: {} particle{} start{} inside elements of parts in contact; contact takes a "
+          "particle only when it comes through a face, so it ignores {}",
+          config_.contact[0].where.str(), inside, inside == 1 ? "" : "s", inside == 1 ? "s" : "",
+          inside == 1 ? "it" : "these"));
   }
   if (contact_) warn_of_initial_overlap(mesh);
   for (const auto* probes : {&config_.probes, &config_.element_probes})
@@ -322,7 +324,7 @@ void Simulation::warn_of_setup(const Mesh& mesh) {
             "{}: particle set '{}' is given an angular velocity with the plain SPH gradient, "
             "which does not reproduce a rigid rotation near a free surface: the spin turns "
             "into spurious strain and the body stops turning; set corrected_gradient: true "
-            "(docs/sph.md, Verification: spinning ball)",
+            "(a keyword deck: *CONTROL_SPH FORM 1; docs/sph.md, Verification: spinning ball)",
             ic.where.str(), ps.name));
       }
     }

@@ -90,13 +90,17 @@ CloudSpacing cloud_spacing(const std::vector<Vec3>& points) {
   std::vector<int> all(n);
   std::iota(all.begin(), all.end(), 0);
   const NearestGrid grid(c[0].data(), c[1].data(), c[2].data(), id.data(), all);
-  double largest = 0;
+  std::vector<double> r2(n);
   for (std::size_t i = 0; i < n; ++i) {
     const NearestGrid::Hit h = grid.nearest(points[i], static_cast<int>(i));
     if (!(h.r2 > 0)) return {0, static_cast<int>(i), h.index};
-    largest = std::max(largest, h.r2);
+    r2[i] = h.r2;
+    if (out.farthest < 0 || h.r2 > r2[static_cast<std::size_t>(out.farthest)])
+      out.farthest = static_cast<int>(i);
   }
-  out.spacing = std::sqrt(largest);
+  out.spacing = std::sqrt(r2[static_cast<std::size_t>(out.farthest)]);
+  std::nth_element(r2.begin(), r2.begin() + static_cast<std::ptrdiff_t>(n / 2), r2.end());
+  out.median = std::sqrt(r2[n / 2]);
   return out;
 }
 

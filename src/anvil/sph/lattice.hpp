@@ -36,6 +36,8 @@ Lattice generate_lattice(const LatticeSpec& spec, int dimensions = 3);
 struct CloudSpacing {
   double spacing = 0;
   int a = -1, b = -1;
+  double median = 0; // the median distance from a particle to its nearest neighbour
+  int farthest = -1; // the particle whose nearest neighbour is farthest (`spacing` away)
 };
 CloudSpacing cloud_spacing(const std::vector<Vec3>& points);
 

@@ -17,9 +17,11 @@ double seconds_since(PhaseTimers::clock::time_point t0) {
   return std::chrono::duration<double>(PhaseTimers::clock::now() - t0).count();
 }
 // The particles of set `ps`: its lattice, or its list (then `volume` is unused: each
-// particle has its own mass or volume) with LS-DYNA's spacing (lattice.hpp).
-Lattice set_points(const ParticleSetConfig& ps, int dimensions) {
+// particle has its own mass or volume) with LS-DYNA's spacing (lattice.hpp); `notes` gains
+// what the user should know of it.
+Lattice set_points(const ParticleSetConfig& ps, int dimensions, std::vector<std::string>& notes) {
   if (ps.list) {
+    const SourceLocation& h_at = ps.smoothing_where.file.empty() ? ps.where : ps.smoothing_where;
     if (dimensions != 3)
       throw InputError(ps.where, "particles given one by one need a three-dimensional model");
     Lattice out;
@@ -35,10 +37,33 @@ Lattice set_points(const ParticleSetConfig& ps, int dimensions) {
     if (out.points.empty())
       throw InputError(ps.where, fmt::format("particle set '{}' holds no particle", ps.name));
     if (c.spacing == 0 && !(ps.smoothing_length > 0))
-      throw InputError(ps.where, fmt::format("particle set '{}' holds a single particle, which "
-                                             "has no spacing to take its smoothing length "
-                                             "from: give the smoothing length",
-                                             ps.name));
+      throw InputError(h_at, fmt::format("particle set '{}' holds a single particle, which "
+                                         "has no spacing to take its smoothing length "
+                                         "from: give the smoothing length",
+                                         ps.name));
+    if (ps.smoothing_length > 0 && c.spacing > 0) {
+      const double ratio = ps.smoothing_length / c.spacing;
+      if (!(ratio >= 0.8 && ratio <= 3))
+        throw InputError(h_at, fmt::format("particle set '{}': the smoothing length {:.6g} m "
+                                           "is {:.3g} times the particles' spacing {:.6g} m "
+                                           "(the largest distance from a particle to its "
+                                           "nearest neighbour); it must be between 0.8 and 3 "
+                                           "times",
+                                           ps.name, ps.smoothing_length, ratio, c.spacing));
+    }
+    // One stray particle (a typo in a coordinate) sets the spacing, and h0, of the whole
+    // set by LS-DYNA's rule (QA round 32: one particle 1 m off made h0 1.18 m, every
+    // particle every other's neighbour).
+    if (c.spacing > 4 * c.median && !(ps.smoothing_length > 0)) {
+      const auto f = static_cast<std::size_t>(c.farthest);
+      notes.push_back(fmt::format(
+          "{}: particle set '{}': its spacing, the largest distance from a particle to its "
+          "nearest neighbour (LS-DYNA's rule for h0), is {:.6g} m, {:.3g} times the median "
+          "{:.6g} m, from particle {} at [{:g}, {:g}, {:g}]: a stray particle? h0 = {:.6g} m "
+          "for the whole set",
+          ps.where.str(), ps.name, c.spacing, c.spacing / c.median, c.median, ps.list->id[f],
+          out.points[f].x, out.points[f].y, out.points[f].z, ps.smoothing_ratio * c.spacing));
+    }
     out.spacing = c.spacing > 0 ? c.spacing : ps.smoothing_length / ps.smoothing_ratio;
     return out;
   }
@@ -82,7 +107,7 @@ SphPhase::SphPhase(const Config& config, const std::function<const Material*(int
   set_offsets_.assign(1, 0);
   for (std::size_t s = 0; s < psets.size(); ++s) {
     const ParticleSetConfig& ps = psets[s];
-    lattices.push_back(set_points(ps, config.sph.dimensions));
+    lattices.push_back(set_points(ps, config.sph.dimensions, notes_));
     set_offsets_.push_back(set_offsets_.back() +
                            static_cast<std::int64_t>(lattices.back().points.size()));
     const Material* m = material(static_cast<int>(s));
@@ -152,6 +177,19 @@ SphPhase::SphPhase(const Config& config, const std::function<const Material*(int
 
   // The first partition, and every particle to its box.
   redistribute();
+}
+
+double SphPhase::initial_step() const {
+  double dt = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < p_.size(); ++i) {
+    const SetParams& sp = sets_[static_cast<std::size_t>(p_.set[i])];
+    const double c = p_.wave_speed[i];
+    double d = courant * p_.h[i] / (c + 1.2 * sp.alpha * c);
+    const double v2 = p_.v[0][i] * p_.v[0][i] + p_.v[1][i] * p_.v[1][i] + p_.v[2][i] * p_.v[2][i];
+    if (v2 > 0) d = std::min(d, max_move * p_.h[i] / std::sqrt(v2));
+    dt = std::min(dt, d);
+  }
+  return comm_.min(dt);
 }
 
 void SphPhase::redistribute() {

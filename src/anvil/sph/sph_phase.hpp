@@ -25,6 +25,7 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -81,6 +82,12 @@ public:
   std::int64_t global_count() const { return global_count_; }
   // First global id of each set, and the total at the end.
   const std::vector<std::int64_t>& set_offsets() const { return set_offsets_; }
+  // What the setup found that the user should know (warnings, the same on every rank).
+  const std::vector<std::string>& notes() const { return notes_; }
+  // The step the particles take at their first cycle if no pair approaches (Monaghan's
+  // bound at rest, and 0.3 h / |v|), the least over all of them (collective): what
+  // `anvil check` estimates the cycles with.
+  double initial_step() const;
   // Local index of a particle by global id, or -1 if this rank does not hold it.
   int find(std::int64_t gid) const;
   // Partitions afresh by RCB at the particles' current positions and moves each particle
@@ -131,6 +138,7 @@ private:
   double hmax_ = 0; // largest smoothing length over all particles, this cycle
   std::int64_t global_count_ = 0;
   std::vector<std::int64_t> set_offsets_;
+  std::vector<std::string> notes_;
 
   // Ghost copies of this cycle: local particle and destination rank per copy.
   std::vector<int> ghost_src_, ghost_dest_;
