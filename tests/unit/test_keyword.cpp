@@ -1451,6 +1451,54 @@ TEST(Keyword, SphParticleErrors) {
                {"*ELEMENT_SPH.NID", "10 characters wide here"});
 }
 
+// *INITIAL_VELOCITY_NODE: per-node velocities, the nodes of one velocity one initial
+// condition (a node's last card wins within the keyword); *PART_CONTACT: a *PART whose
+// contact card anvil does not use (said when it sets anything).
+TEST(Keyword, NodeVelocitiesAndPartContact) {
+  const std::string cards = R"(*INITIAL_VELOCITY_NODE
+         9       0.0       0.0     -10.0
+        10       0.0       0.0     -10.0
+        11       1.0       0.0       0.0
+         9       0.0       0.0     -20.0       1.0
+*END)";
+  const Config c = kw(with(good, "*END", cards));
+  // (good's *INITIAL_VELOCITY_GENERATION first, then the three velocities of the keyword.)
+  ASSERT_EQ(c.initial_conditions.size(), 4u);
+  const Mesh m = build_mesh(c);
+  std::map<std::string, Vec3> by_set;
+  for (std::size_t i = 1; i < 4; ++i)
+    by_set[c.initial_conditions[i].nodes.name] = c.initial_conditions[i].velocity;
+  int seen = 0;
+  for (const auto& [name, v] : by_set) {
+    const auto& nodes = m.node_sets.at(name);
+    std::vector<std::int64_t> expected; // node positions (ids 10, 11, 9)
+    if (v == Vec3{0, 0, -10}) expected = {9};
+    if (v == Vec3{1, 0, 0}) expected = {10};
+    if (v == Vec3{0, 0, -20}) expected = {8};
+    EXPECT_EQ(nodes, expected) << name;
+    seen += expected.empty() ? 0 : 1;
+  }
+  EXPECT_EQ(seen, 3);
+  ASSERT_EQ(c.warnings.size(), 1u); // VXR of node 9
+  EXPECT_NE(c.warnings[0].find("VXR, VYR, VZR are ignored"), std::string::npos) << c.warnings[0];
+  expect_error(with(good, "*END", "*INITIAL_VELOCITY_NODE\n        99       1.0\n*END"),
+               {"model.k:", "*INITIAL_VELOCITY_NODE.NID", "node 99"});
+
+  // *PART_CONTACT.
+  const std::string part = "*PART\nsteel\n         1         1         1\n";
+  ASSERT_NE(good.find(part), std::string::npos);
+  const Config quiet =
+      kw(with(good, part, "*PART_CONTACT\nsteel\n         1         1         1\n\n"));
+  EXPECT_TRUE(quiet.warnings.empty());
+  ASSERT_EQ(quiet.parts.size(), 1u);
+  const Config said =
+      kw(with(good, part, "*PART_CONTACT\nsteel\n         1         1         1\n       0.3\n"));
+  ASSERT_EQ(said.warnings.size(), 1u);
+  EXPECT_NE(said.warnings[0].find("*PART_CONTACT: part 1's contact properties are not used"),
+            std::string::npos)
+      << said.warnings[0];
+}
+
 // *DATABASE_BINARY_D3DUMP and *DATABASE_BINARY_RUNRSF: checkpoints every CYCL cycles, the
 // smaller of the two.
 TEST(Keyword, RestartDumpsAreCheckpoints) {
@@ -1506,13 +1554,14 @@ TEST(Keyword, ACardMoreThanAKeywordTakesIsAnError) {
 
 // keyword.md: ignored keywords "are listed in one warning ... Read that warning before
 // trusting a run". It was lost when an error stopped the read, though the ignored
-// *PART_CONTACT was the cause of the error (QA round 5, item 4).
+// *PART_CONTACT was the cause of the error (QA round 5, item 4; *PART_CONTACT is read since
+// 2026-11-24, *PART_COMPOSITE, a shell part, is not).
 TEST(Keyword, TheIgnoredKeywordsWarningComesWithAnError) {
-  const std::string text = with(with(good, "*END", "*PART_CONTACT\nother\n2,1,1\n0.2\n*END"),
+  const std::string text = with(with(good, "*END", "*PART_COMPOSITE\nother\n2,1\n0.2\n*END"),
                                 "       2       1       5", "       2       2       5");
   expect_error(text, {"model.k:31: *ELEMENT_SOLID.PID: element 2 belongs to part 2",
                       "\nanvil: warning: model.k: 1 keyword is not supported by anvil and "
-                      "ignored: *PART_CONTACT (1x, first at model.k:"});
+                      "ignored: *PART_COMPOSITE (1x, first at model.k:"});
   try {
     kw(text);
   } catch (const InputError& e) {

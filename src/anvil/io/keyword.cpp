@@ -724,8 +724,11 @@ struct SegmentSet {
 };
 
 struct VelocityGen {
-  int styp; // 1 part set, 2 part, 3 node set, 0: all parts (*INITIAL_VELOCITY with NSID 0)
+  int styp; // 1 part set, 2 part, 3 node set, 0: all parts (*INITIAL_VELOCITY with NSID 0),
+            // 4: the nodes `nodes` (*INITIAL_VELOCITY_NODE cards of one velocity)
   std::int64_t id;
+  std::vector<std::int64_t> nodes; // node ids (styp 4)
+  std::vector<Where> node_at;      // their cards
   Vec3 velocity, angular, center;
   bool mass_center = false; // *INITIAL_VELOCITY_RIGID_BODY: about the part's centre of mass
   Where at;
@@ -803,7 +806,7 @@ private:
     if (starts_with(n, "INCLUDE_")) return include_variant(b);
     if (n == "NODE") return node(b);
     if (n == "ELEMENT_SOLID") return element_solid(b);
-    if (n == "PART") return part(b);
+    if (n == "PART" || n == "PART_CONTACT") return part(b);
     if (n == "SET_NODE" || n == "SET_NODE_LIST" || n == "SET_NODE_TITLE" ||
         n == "SET_NODE_LIST_TITLE")
       return id_set(b, node_sets_, false);
@@ -876,6 +879,7 @@ private:
     }
     if (n == "INITIAL_VELOCITY_GENERATION") return velocity_generation(b);
     if (n == "INITIAL_VELOCITY") return initial_velocity(b);
+    if (n == "INITIAL_VELOCITY_NODE") return initial_velocity_node(b);
     if (n == "INITIAL_VELOCITY_RIGID_BODY") return initial_velocity_rigid_body(b);
     if (contact_form(n)) return contact(b);
     if (n == "CONTROL_CONTACT") return control_contact(b);
@@ -1059,6 +1063,25 @@ private:
         if (q.pid == p.pid)
           card.fail("PID",
                     fmt::format("part {} is defined twice (first at {})", p.pid, q.at.str()));
+      // *PART_CONTACT: a card of the part's contact properties (FS, FD, DC, VC, OPTT, SFT,
+      // SSF, CPARM8), which LS-DYNA's contacts use where they ask for part values (FS = -1,
+      // SFT, SSF): anvil's one contact takes its own, so any set is said not to be used.
+      if (b.name == "PART_CONTACT" && !mesh_only_) {
+        const Line lc = c.next();
+        const Card cc(b, lc, {10, 10, 10, 10, 10, 10, 10, 10});
+        static const char* const fields[] = {"FS",   "FD",  "DC",  "VC",
+                                             "OPTT", "SFT", "SSF", "CPARM8"};
+        for (int i = 0; i < 8; ++i)
+          if (!cc.blank(i) && cc.real(i, fields[i]) != 0) {
+            warnings_.push_back(fmt::format("{}: *PART_CONTACT: part {}'s contact properties "
+                                            "are not used: anvil's contact takes the friction "
+                                            "and penalty scale of its *CONTACT_ card",
+                                            where_of(lc).str(), p.pid));
+            break;
+          }
+      } else if (b.name == "PART_CONTACT") {
+        c.next();
+      }
       parts_.push_back(std::move(p));
     }
   }
@@ -2625,6 +2648,43 @@ private:
     }
   }
 
+  // *INITIAL_VELOCITY_NODE: any number of cards NID, VX, VY, VZ, VXR, VYR, VZR. The nodes
+  // of one velocity are one initial condition (a node given twice in the keyword takes its
+  // last card's), at the keyword's place among the others.
+  void initial_velocity_node(const Block& b) {
+    Cursor c(b);
+    std::map<std::int64_t, std::pair<Vec3, Where>> last; // node id -> its velocity
+    bool rotations = false;
+    while (auto l = c.next_record()) {
+      const Card card(b, *l, {10, 10, 10, 10, 10, 10, 10});
+      const std::int64_t nid = card.integer(0, "NID", 0);
+      if (nid <= 0) card.fail("NID", fmt::format("NID must be a positive node id, found {}", nid));
+      last[nid] = {Vec3{card.real(1, "VX"), card.real(2, "VY"), card.real(3, "VZ")}, where_of(*l)};
+      rotations = rotations || card.real(4, "VXR") != 0 || card.real(5, "VYR") != 0 ||
+                  card.real(6, "VZR") != 0;
+    }
+    if (rotations)
+      warnings_.push_back(fmt::format("{}: *INITIAL_VELOCITY_NODE: the rotational velocities "
+                                      "VXR, VYR, VZR are ignored (solid nodes and particles "
+                                      "have no rotations)",
+                                      where_of(b.head).str()));
+    std::map<std::array<double, 3>, VelocityGen> groups; // by velocity
+    for (const auto& [nid, vw] : last) {
+      auto [it, fresh] =
+          groups.try_emplace(std::array<double, 3>{vw.first.x, vw.first.y, vw.first.z});
+      VelocityGen& v = it->second;
+      if (fresh) {
+        v.styp = 4;
+        v.velocity = vw.first;
+        v.at = vw.second;
+        v.keyword = b.name;
+      }
+      v.nodes.push_back(nid);
+      v.node_at.push_back(vw.second);
+    }
+    for (auto& [vel, v] : groups) velocities_.push_back(std::move(v));
+  }
+
   // PID, VX, VY, VZ, VXR, VYR, VZR, LCID (LS-DYNA manual, *INITIAL_VELOCITY_RIGID_BODY):
   // the translational and rotational velocities of a rigid part at its centre of mass,
   // anvil's initial condition on the part about `center: mass_center`.
@@ -3621,10 +3681,22 @@ Config KeywordReader::config(const std::string& deck_file) {
 
   // Initial velocities, in deck order (later ones override earlier ones on shared nodes,
   // as in the YAML deck).
+  int velocity_groups = 0; // *INITIAL_VELOCITY_NODE's sets velocity_nodes_N
   for (const auto& v : velocities_) {
     const std::string key = "*" + v.keyword;
     std::vector<Selection> targets;
-    if (v.styp == 3) {
+    if (v.styp == 4) {
+      Selection s;
+      s.name = fmt::format("velocity_nodes_{}", ++velocity_groups);
+      std::vector<std::int64_t> positions;
+      for (std::size_t i = 0; i < v.nodes.size(); ++i)
+        positions.push_back(
+            node_position(v.nodes[i], v.node_at[i], key + ".NID", "the initial velocity"));
+      std::sort(positions.begin(), positions.end());
+      mesh.node_sets[s.name] = std::move(positions);
+      s.where = v.at.loc(key);
+      targets.push_back(s);
+    } else if (v.styp == 3) {
       Selection s;
       s.name = node_set_name(v.id, v.at, key + (v.keyword == "INITIAL_VELOCITY" ? ".NSID" : ".ID"));
       s.where = v.at.loc(key);
@@ -3908,7 +3980,7 @@ InputError KeywordReader::with_ignored_keywords(const InputError& e,
   const std::string w = ignored_keywords(deck_file);
   if (w.empty()) return e;
   // The warning goes on a line of its own after the error, as `anvil` prints warnings:
-  // an ignored keyword (a *PART_CONTACT) is often the cause of the error (its part "not
+  // an ignored keyword (a *PART_COMPOSITE) is often the cause of the error (its part "not
   // defined"), and the warning is otherwise lost with the Config.
   const std::string what = e.what(), prefix = e.where().str() + ": ";
   const std::string note = "\nanvil: warning: " + w;
