@@ -868,7 +868,7 @@ shell part
          2         2         2
 *SECTION_SHELL
          2
-*MAT_NULL
+*MAT_HONEYCOMB
          2    7850.0
 *END)"));
   std::vector<std::string> about_keywords;
@@ -881,7 +881,7 @@ shell part
   // A curve no prescribed motion names is not read (its card here is not even in LS-DYNA's
   // columns) and changes nothing: not listed.
   EXPECT_EQ(w.find("*DEFINE_CURVE"), std::string::npos) << w;
-  EXPECT_NE(w.find("*MAT_NULL (1x"), std::string::npos) << w;
+  EXPECT_NE(w.find("*MAT_HONEYCOMB (1x"), std::string::npos) << w;
   EXPECT_NE(w.find("*SECTION_SHELL (1x"), std::string::npos) << w;
   // The part without solid elements is left out, with a warning of its own.
   EXPECT_EQ(c.parts.size(), 1u);
@@ -937,8 +937,8 @@ TEST(Keyword, ErrorsNameFileLineAndField) {
                {"model.k:36: *BOUNDARY_SPC_SET.NSID", "node set 8 is not defined"});
   expect_error(with(good, "         7         0         1", "         7         5         1"),
                {"*BOUNDARY_SPC_SET.CID"});
-  expect_error(with(good, "*MAT_ELASTIC\n", "*MAT_NULL\n"),
-               {"*PART.MID", "*MAT_NULL", "anvil does not have"});
+  expect_error(with(good, "*MAT_ELASTIC\n", "*MAT_HONEYCOMB\n"),
+               {"*PART.MID", "*MAT_HONEYCOMB", "anvil does not have"});
   expect_error(with(good, "    7850.0", "     &dens"), {"*MAT_ELASTIC.RO", "parameter"});
   expect_error(with(good, "       1             0.0", "       1\t0.0"), {"*NODE", "tab"});
   expect_error(with(good, "*SECTION_SOLID\n         1", "*SECTION_SOLID\n         2"),
@@ -1497,6 +1497,38 @@ TEST(Keyword, NodeVelocitiesAndPartContact) {
   EXPECT_NE(said.warnings[0].find("*PART_CONTACT: part 1's contact properties are not used"),
             std::string::npos)
       << said.warnings[0];
+}
+
+// *MAT_NULL on SPH particles (water in LS-DYNA's SPH decks): anvil's fluid, its pressure
+// from the part's *EOS_GRUNEISEN and K = rho C^2; on solids, or without an EOS, an error.
+TEST(Keyword, NullMaterialParticlesAreAFluid) {
+  const std::string water = "*MAT_NULL\n         3    1000.0       0.0    0.001\n";
+  const std::string cards = with(sph_cards, "ball\n         2         2         1         2\n",
+                                 "ball\n         2         2         3         2\n" + water);
+  const Config c = kw(with_sph(cards));
+  ASSERT_EQ(c.particles.size(), 1u);
+  const MaterialConfig* m = c.material(c.particles[0].material);
+  ASSERT_NE(m, nullptr);
+  EXPECT_EQ(m->model, "fluid");
+  EXPECT_EQ(m->params.at("density"), 1000.0);
+  EXPECT_EQ(m->params.at("viscosity"), 0.001);
+  EXPECT_EQ(m->params.at("bulk_modulus"), 1000.0 * 3940.0 * 3940.0);
+  EXPECT_EQ(m->eos_model, "mie_gruneisen");
+  EXPECT_TRUE(c.warnings.empty()) << c.warnings.front();
+  const Comm world = Comm::world();
+  Simulation sim(c, world);
+  for (int i = 0; i < 3; ++i) sim.step();
+  // PC set: warned of (no cutoff).
+  const Config pc = kw(with_sph(with(cards, "    1000.0       0.0", "    1000.0   -1.0e+5")));
+  ASSERT_EQ(pc.warnings.size(), 1u);
+  EXPECT_NE(pc.warnings[0].find("PC (a pressure cutoff) is not modelled"), std::string::npos);
+  // Without an EOS; on the bricks.
+  expect_error(with_sph(with(cards, "ball\n         2         2         3         2\n",
+                             "ball\n         2         2         3\n")),
+               {"*PART.EOSID", "*MAT_NULL", "give the part an *EOS_GRUNEISEN"});
+  expect_error(with(with_sph(cards), "steel\n         1         1         1\n",
+                    "steel\n         1         1         3\n"),
+               {"*PART.MID", "fluids with SPH particles only"});
 }
 
 // *DATABASE_BINARY_D3DUMP and *DATABASE_BINARY_RUNRSF: checkpoints every CYCL cycles, the

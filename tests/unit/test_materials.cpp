@@ -46,6 +46,49 @@ TEST(Materials, ElasticHydrostaticAndWaveSpeed) {
   EXPECT_NEAR(pt.c, std::sqrt((K + 4 * G / 3) / 7850), 1e-9);
 }
 
+// The fluid (LS-DYNA's *MAT_NULL): hydrostatic compression p = -K tr(eps) as the elastic
+// model's; a shear rate gives the Newtonian stress 2 mu D' at once (no memory of the shear
+// strain); wave speed sqrt(K / rho). With an equation of state (make_material), the EOS's
+// pressure replaces K's. Tolerance 1e-12 relative (round-off).
+TEST(Materials, FluidPressureAndViscousStress) {
+  const ParamValues p{{"density", 1000}, {"bulk_modulus", 2.2e9}, {"viscosity", 1e-3}};
+  const auto m = find_material_model("fluid")->make(p, {});
+  Point pt;
+  pt.rho = 1000;
+  for (int k = 0; k < 3; ++k) pt.d[k] = -1.0;
+  for (int n = 0; n < 100; ++n) pt.step(*m, 1e-5);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(pt.s[k], 2.2e9 * 3 * -1e-3, 1e-12 * 6.6e6);
+  EXPECT_NEAR(pt.c, std::sqrt(2.2e9 / 1000), 1e-9);
+  // Shear: D_xy = 50 /s for 10 steps; the stress is 2 mu D, not its integral.
+  Point sh;
+  sh.rho = 1000;
+  sh.d[3] = 50;
+  for (int n = 0; n < 10; ++n) sh.step(*m, 1e-5);
+  EXPECT_NEAR(sh.s[3], 2 * 1e-3 * 50, 1e-15);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(sh.s[k], 0.0);
+  // With Mie-Gruneisen: at rho = 1.01 rho0 and e = 0, p = rho0 c0^2 mu (1 + (1 - g/2) mu) /
+  // (1 - (s - 1) mu)^2, mu = 0.01.
+  const auto w =
+      make_material("fluid", p, {}, "mie_gruneisen", {{"c0", 1480}, {"s", 1.92}, {"gamma0", 0.1}});
+  Point q;
+  q.rho = 1010;
+  double e = 0;
+  MaterialBatch b;
+  b.n = 1;
+  b.dt = 1e-6;
+  for (int k = 0; k < 6; ++k) {
+    b.d[k] = &q.d[k];
+    b.stress[k] = &q.s[k];
+  }
+  b.density = &q.rho;
+  b.wave_speed = &q.c;
+  b.energy = &e;
+  w->update(b);
+  const double mu = 0.01, pexp = 1000 * 1480.0 * 1480.0 * mu * (1 + (1 - 0.05) * mu) /
+                                 ((1 - 0.92 * mu) * (1 - 0.92 * mu));
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(q.s[k], -pexp, 1e-12 * pexp);
+}
+
 // Simple shear of J2 with linear hardening: tau = G gamma until tau = Y0/sqrt(3), then
 // tau = (Y0 + H gamma / sqrt(3)) / (sqrt(3) + H / (sqrt(3) G)) (von Mises, gamma_p =
 // sqrt(3) ep). Radial return is exact for this proportional path; tolerance 1e-10.

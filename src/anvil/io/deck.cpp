@@ -842,6 +842,12 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
       if (!mat)
         pn.child("material")
             .fail(fmt::format("material '{}' is not defined under materials", p.material));
+      // A fluid has no shear stiffness for the hexahedra's hourglass control.
+      if (mat->model == "fluid")
+        pn.child("material")
+            .fail(fmt::format("material '{}' is a fluid (no shear stiffness): it is available "
+                              "to particles only",
+                              p.material));
       // The hexahedra do not track specific internal energy (docs/sph.md).
       if (mat->model == "ideal_gas" || !mat->eos_model.empty())
         pn.child("material")

@@ -853,6 +853,8 @@ private:
     if (n == "MAT_PIECEWISE_LINEAR_PLASTICITY" || n == "MAT_024" ||
         n == "MAT_PIECEWISE_LINEAR_PLASTICITY_TITLE" || n == "MAT_024_TITLE")
       return mat_piecewise_linear_plasticity(b);
+    if (n == "MAT_NULL" || n == "MAT_009" || n == "MAT_NULL_TITLE" || n == "MAT_009_TITLE")
+      return mat_null(b);
     if (starts_with(n, "MAT_")) return other_material(b);
     if (starts_with(n, "EOS_")) return eos(b);
     if (n == "HOURGLASS" || n == "HOURGLASS_TITLE") return hourglass(b);
@@ -1379,6 +1381,35 @@ private:
     const std::int64_t mid = material_id(card);
     MaterialCard m = material_card(b, "elastic", l);
     elastic_fields(card, m.params, 1, 2, 3);
+    add_material(card, mid, std::move(m));
+  }
+
+  // *MAT_NULL: MID, RO, PC, MU, TEROD, CEROD, YM, PR: anvil's `fluid` (particles only),
+  // density RO, viscosity MU; its bulk modulus and pressure come from the part's
+  // *EOS_GRUNEISEN (config()). PC, TEROD, CEROD: warned of when set; YM, PR (the contact
+  // stiffness of null shells and beams) not read.
+  void mat_null(const Block& b) {
+    Cursor c(b);
+    skip_title(b, c);
+    const Line l = c.next();
+    const Card card(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
+    const std::int64_t mid = material_id(card);
+    MaterialCard m = material_card(b, "fluid", l);
+    const double rho = card.real(1, "RO");
+    if (!(rho > 0)) card.fail("RO", fmt::format("RO must be positive, found {}", rho));
+    m.params["density"] = rho;
+    const double mu = card.real(3, "MU");
+    if (mu < 0) card.fail("MU", fmt::format("MU must not be negative, found {}", mu));
+    m.params["viscosity"] = mu;
+    m.params["bulk_from_eos"] = 1; // completed per part in config()
+    if (card.real(2, "PC") != 0)
+      m.notes.push_back(fmt::format("{}: material {}: PC (a pressure cutoff) is not modelled: "
+                                    "anvil's fluid carries tension",
+                                    where_of(l).str(), mid));
+    if (card.real(4, "TEROD") != 0 || card.real(5, "CEROD") != 0)
+      m.notes.push_back(fmt::format("{}: material {}: TEROD, CEROD (erosion) are not used: "
+                                    "anvil's particles do not erode",
+                                    where_of(l).str(), mid));
     add_material(card, mid, std::move(m));
   }
 
@@ -3516,9 +3547,16 @@ Config KeywordReader::config(const std::string& deck_file) {
                        fmt::format("part {}: material {} is a *{} (at {}), which anvil does not "
                                    "have (supported: *MAT_ELASTIC, *MAT_PLASTIC_KINEMATIC, "
                                    "*MAT_PIECEWISE_LINEAR_PLASTICITY, *MAT_JOHNSON_COOK, "
-                                   "*MAT_SIMPLIFIED_JOHNSON_COOK, *MAT_RIGID)",
+                                   "*MAT_SIMPLIFIED_JOHNSON_COOK, *MAT_RIGID; *MAT_NULL for "
+                                   "particles)",
                                    p.pid, p.mid, mc.keyword, mc.at.str()));
     std::string mname = fmt::format("mat{}", p.mid);
+    if (mc.model == "fluid" && !particles)
+      throw InputError(p.at.loc("*PART.MID"),
+                       fmt::format("part {} has solid elements and material {} is a *{} (at "
+                                   "{}): anvil models fluids with SPH particles only "
+                                   "(*ELEMENT_SPH)",
+                                   p.pid, p.mid, mc.keyword, mc.at.str()));
     if (particles && mc.rigid)
       throw InputError(p.at.loc("*PART.MID"),
                        fmt::format("part {}: SPH particles cannot be rigid (*{} at {})", p.pid,
@@ -3572,6 +3610,17 @@ Config KeywordReader::config(const std::string& deck_file) {
             "from its linear elastic bulk modulus (E, PR) instead",
             p.at.str(), p.pid, e->second.keyword, p.eosid, p.mid));
       }
+    }
+    // *MAT_NULL: the part's *EOS_GRUNEISEN gives the pressure, and K = rho C^2 the sound
+    // speed at rest.
+    if (params.erase("bulk_from_eos")) {
+      if (eos.empty())
+        throw InputError(p.at.loc("*PART.EOSID"),
+                         fmt::format("part {}: material {} is a *{} (at {}), whose pressure "
+                                     "comes from an equation of state: give the part an "
+                                     "*EOS_GRUNEISEN (EOSID)",
+                                     p.pid, p.mid, mc.keyword, mc.at.str()));
+      params["bulk_modulus"] = params["density"] * eos["c0"] * eos["c0"];
     }
     if (material_names.insert(mname).second) {
       MaterialConfig m{mname,

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "anvil/material/elastic.hpp"
+#include "anvil/material/fluid.hpp"
 #include "anvil/material/ideal_gas.hpp"
 #include "anvil/material/j2_plasticity.hpp"
 #include "anvil/material/johnson_cook.hpp"
@@ -45,8 +46,8 @@ std::unique_ptr<Eos> make_eos(const ParamValues& p) {
   return std::make_unique<E>(p);
 }
 
-const std::array<MaterialModel, 5>& models() {
-  static const std::array<MaterialModel, 5> list = {{
+const std::array<MaterialModel, 6>& models() {
+  static const std::array<MaterialModel, 6> list = {{
       {"elastic", Elastic::params(), {}, &make<Elastic>, "hypoelastic isotropic solid"},
       {"j2_plasticity",
        J2Plasticity::params(),
@@ -68,6 +69,12 @@ const std::array<MaterialModel, 5>& models() {
        {},
        &make<IdealGas>,
        "ideal gas p = (gamma - 1) rho e (particles only)"},
+      {"fluid",
+       Fluid::params(),
+       {},
+       &make<Fluid>,
+       "fluid: Newtonian viscosity, pressure from K or an equation of state (particles only; "
+       "LS-DYNA MAT_NULL)"},
   }};
   return list;
 }

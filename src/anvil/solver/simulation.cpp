@@ -319,7 +319,9 @@ void Simulation::warn_of_setup(const Mesh& mesh) {
       for (std::size_t s = 0; s < spun.size(); ++s) {
         const ParticleSetConfig& ps = config_.particles[s];
         const MaterialConfig* mat = config_.material(ps.material);
-        if (spun[s] == 0 || ps.corrected_gradient || (mat && mat->model == "ideal_gas")) continue;
+        if (spun[s] == 0 || ps.corrected_gradient ||
+            (mat && (mat->model == "ideal_gas" || mat->model == "fluid")))
+          continue;
         warnings_.push_back(fmt::format(
             "{}: particle set '{}' is given an angular velocity with the plain SPH gradient, "
             "which does not reproduce a rigid rotation near a free surface: the spin turns "
