@@ -598,8 +598,21 @@ TEST(Keyword, RigidMaterial) {
   const std::string rigid = with(good, elastic, "*MAT_RIGID\n1,7850.0,2.0E+11,0.3\n\n\n");
   expect_error(with(rigid, "*END", curve + "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n1,4,0,9\n*END"),
                {"*BOUNDARY_PRESCRIBED_MOTION_RIGID.DOF", "not supported"});
+  // VAD 2 on a rotation: the angle about x, from the curve's change (its value at t = 0
+  // must be 0: the body starts at its angle).
   expect_error(with(rigid, "*END", curve + "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n1,5,2,9\n*END"),
-               {"*BOUNDARY_PRESCRIBED_MOTION_RIGID.VAD", "DOF 5 (a rotation)"});
+               {"*BOUNDARY_PRESCRIBED_MOTION_RIGID.LCID", "value at t = 0 must be 0"});
+  const Config angle = kw(with(rigid, "*END",
+                               "*DEFINE_CURVE\n8\n0.0,0.0\n1.0,0.5\n"
+                               "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n1,5,2,8,2.0\n*END"));
+  ASSERT_FALSE(angle.boundary_conditions.empty());
+  const BoundaryCondition& turn = angle.boundary_conditions.back();
+  EXPECT_EQ(turn.motion, BoundaryCondition::Motion::displacement);
+  EXPECT_EQ(turn.spin, (Vec3{2.0, 0, 0}));
+  EXPECT_EQ(turn.spin_components, (std::array<bool, 3>{true, false, false}));
+  EXPECT_EQ(turn.components, (std::array<bool, 3>{false, false, false}));
+  expect_error(with(rigid, "*END", curve + "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n1,5,1,9\n*END"),
+               {"*BOUNDARY_PRESCRIBED_MOTION_RIGID.VAD", "VAD = 1 is not supported"});
   expect_error(
       with(rigid, "*END", curve + "*BOUNDARY_PRESCRIBED_MOTION_RIGID\n1,3,0,9,1.0,1.0e-3\n*END"),
       {"*BOUNDARY_PRESCRIBED_MOTION_RIGID.VID"});

@@ -1012,22 +1012,33 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
 
   if (top.has("boundary_conditions")) {
     for (const auto& n : top.child("boundary_conditions").items()) {
-      n.check_keys({"set", "part", "fix", "velocity", "displacement", "angular_velocity", "curve",
-                    "components", "birth", "death"});
+      n.check_keys({"set", "part", "fix", "velocity", "displacement", "angular_velocity",
+                    "rotation", "curve", "components", "birth", "death"});
       BoundaryCondition bc;
       bc.where = n.where();
       parse_window(n, bc.birth, bc.death);
       bc.nodes = parse_target(n);
-      const bool spun = n.has("angular_velocity");
+      // The spin of a rigid part: its rate (`angular_velocity`, with a velocity), or its
+      // angle (`rotation`, radians about the global axes, with a displacement: the body
+      // turns by the curve's change each step).
+      const bool turned = n.has("rotation");
+      const bool spun = n.has("angular_velocity") || turned;
+      const char* spin_key = turned ? "rotation" : "angular_velocity";
       if (n.has("velocity") && n.has("displacement"))
         n.fail("give exactly one of 'fix', 'velocity' or 'displacement'");
-      if (n.has("displacement") && spun)
+      if (turned && n.has("angular_velocity"))
+        n.child("rotation").fail("give angular_velocity (a rate) or rotation (an angle), not both");
+      if (n.has("displacement") && n.has("angular_velocity"))
         n.child("angular_velocity")
-            .fail("angular_velocity goes with velocity (a rotation is not prescribed as an "
-                  "angle)");
+            .fail("angular_velocity goes with velocity; with a displacement, give the angle: "
+                  "rotation");
+      if (n.has("velocity") && turned)
+        n.child("rotation")
+            .fail("rotation (an angle) goes with displacement; with a velocity, give the rate: "
+                  "angular_velocity");
       if (int(n.has("fix")) + int(n.has("velocity") || n.has("displacement") || spun) != 1)
         n.fail("give exactly one of 'fix', 'velocity' (and/or 'angular_velocity' for a rigid "
-               "part) or 'displacement'");
+               "part) or 'displacement' (and/or 'rotation')");
       if (n.has("fix")) {
         const auto held = n.child("fix").components(bc.rotations);
         for (std::size_t i = 0; i < 3; ++i) {
@@ -1040,13 +1051,14 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
                 "{} goes with velocity or displacement; list fixed components under fix", key));
       } else {
         bc.prescribed = true;
-        const bool moved = n.has("displacement");
-        const bool moving = moved || n.has("velocity");
+        const bool moved = n.has("displacement") || turned;
         bc.motion =
             moved ? BoundaryCondition::Motion::displacement : BoundaryCondition::Motion::velocity;
-        if (moving) bc.value = n.child(moved ? "displacement" : "velocity").vec3();
+        // Whether a translation (of the nodes, or of a rigid body's centre) is given.
+        const bool moving = n.has("displacement") || n.has("velocity");
+        if (moving) bc.value = n.child(n.has("displacement") ? "displacement" : "velocity").vec3();
         if (spun) {
-          bc.spin = n.child("angular_velocity").vec3();
+          bc.spin = n.child(spin_key).vec3();
           bc.rotations = true;
         }
         if (n.has("components")) {
@@ -1062,7 +1074,8 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
                                     "xyz"[i]));
             if (held[3 + i] && !spun)
               n.child("components")
-                  .fail(fmt::format("r{} is listed, but no angular_velocity is given", "xyz"[i]));
+                  .fail(fmt::format("r{} is listed, but no angular_velocity or rotation is given",
+                                    "xyz"[i]));
           }
         } else {
           bc.components = {moving, moving, moving};
@@ -1072,19 +1085,20 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
         // meant to move along x that holds only z would stand still in x (QA round 24).
         for (std::size_t i = 0; i < 3; ++i) {
           if (moving && !bc.components[i] && bc.value[static_cast<int>(i)] != 0)
-            n.child(moved ? "displacement" : "velocity")
+            n.child(n.has("displacement") ? "displacement" : "velocity")
                 .fail(fmt::format("{} on {}, which `components` leaves out: list {} there, or "
                                   "give 0",
                                   bc.value[static_cast<int>(i)], "xyz"[i], "xyz"[i]));
           if (spun && !bc.spin_components[i] && bc.spin[static_cast<int>(i)] != 0)
-            n.child("angular_velocity")
-                .fail(fmt::format("{} about {}, which `components` leaves out: list r{} there, "
-                                  "or give 0",
-                                  bc.spin[static_cast<int>(i)], "xyz"[i], "xyz"[i]));
+            n.child(spin_key).fail(
+                fmt::format("{} about {}, which `components` leaves out: list r{} there, "
+                            "or give 0",
+                            bc.spin[static_cast<int>(i)], "xyz"[i], "xyz"[i]));
         }
         if (n.has("curve")) bc.curve = parse_curve(n.child("curve"));
         if (moved && !bc.curve)
-          n.fail("a displacement needs its time history: add curve: [[t0, 0], [t1, 1], ...]");
+          n.fail(fmt::format("a {} needs its time history: add curve: [[t0, 0], [t1, 1], ...]",
+                             turned && !n.has("displacement") ? "rotation" : "displacement"));
         if (bc.curve) {
           const double amplitude =
               std::max({std::abs(bc.value.x), std::abs(bc.value.y), std::abs(bc.value.z),

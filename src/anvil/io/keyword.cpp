@@ -2467,15 +2467,13 @@ private:
                                      dof));
       m.rotation = dof >= 5;
       m.dof = static_cast<int>(m.rotation ? dof - 5 : dof - 1);
+      // VAD 2 on DOF 5-7: the angle (radians) about the global axis, the body turned by
+      // the curve's change each step.
       const auto vad = card.integer(2, "VAD", 0);
-      if (m.rotation && vad != 0)
-        card.fail("VAD", fmt::format("VAD = {} is not supported for DOF {} (a rotation): anvil "
-                                     "prescribes a rigid body's spin as an angular velocity "
-                                     "(VAD 0)",
-                                     vad, dof));
       if (vad != 0 && vad != 2)
         card.fail("VAD", fmt::format("VAD = {} is not supported: anvil prescribes a velocity "
-                                     "(VAD 0) or a displacement (VAD 2)",
+                                     "(VAD 0) or a displacement (VAD 2; of DOF 5-7, the angle "
+                                     "in radians)",
                                      vad));
       card.integer(5, "VID", 0); // (a vector's id, unused for DOF 1-3 and 5-7: an id all the same)
       m.displacement = vad == 2;

@@ -522,8 +522,9 @@ void Simulation::apply_boundary_conditions(const Mesh& mesh) {
     const auto& bc = bcs[b];
     if (rigid_body_of(bc) >= 0) continue;
     if (bc.rotations)
-      throw InputError(bc.where, "rotations (rx, ry, rz, angular_velocity) are a rigid body's: "
-                                 "give `part:` a rigid part (nodes have no rotations)");
+      throw InputError(bc.where,
+                       "rotations (rx, ry, rz, angular_velocity, rotation) are a rigid body's: "
+                       "give `part:` a rigid part (nodes have no rotations)");
     const auto ids = selected_nodes(mesh, bc.nodes);
     warn_if_outside_model(ids, bc.nodes.where);
     for (std::size_t n = 0; n < nn; ++n) {
