@@ -219,9 +219,9 @@ parts:
   expect_error(base + "    rigid: true\n", "every part is rigid");
   // Rotations hold a rigid body only; a body is held whole (its part), not by a box of it.
   expect_error(base + "boundary_conditions:\n  - {set: b.zmin, fix: [z, rx]}\n",
-               "rotations (rx, ry, rz, angular_velocity) are a rigid body's");
+               "rotations (rx, ry, rz, angular_velocity, rotation) are a rigid body's");
   expect_error(base + "boundary_conditions:\n  - {part: b, angular_velocity: [0, 0, 1.0]}\n",
-               "rotations (rx, ry, rz, angular_velocity) are a rigid body's");
+               "rotations (rx, ry, rz, angular_velocity, rotation) are a rigid body's");
   expect_error(base + "boundary_conditions:\n  - {set: {part: a, box: {min: [-1, -1, -1], "
                       "max: [1, 1, 1]}}, fix: all}\n",
                "a rigid body is held or driven whole (`part: a`");
