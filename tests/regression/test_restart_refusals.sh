@@ -7,6 +7,7 @@
 #    the ranks holding that part only: this hung on 2 ranks);
 #  - of a deck without the thick shell, or whose termination comes before the checkpoint;
 #  - of another mesh with the same numbers of nodes and elements;
+#  - at the end of the deck's run (a finished run's final checkpoint: nothing to continue);
 # and a checkpoint or a field piece that cannot be written stops the run with exit 2 and
 # a failed summary.
 set -euo pipefail
@@ -110,4 +111,18 @@ if grep -q 'step_000001' piece/results.pvd; then echo "results.pvd names the fai
 # The checkpoint itself still continues the run.
 run 2 "$anvil" run deck.yaml -o first -q --restart first/checkpoint.anvil
 grep -q '"status": "completed"' first/summary.json
+
+# The final checkpoint of a finished run has nothing left to run with the same deck: it is
+# refused, and the finished run's outputs are not rewritten (QA round 33: its summary.json
+# was rewritten with time 0 and the initial kinetic energy).
+sed -e 's/termination: {cycles: 60}/termination: {cycles: 60}\ncheckpoint: {cycles: 25}/' deck.yaml > done.yaml
+run 2 "$anvil" run done.yaml -o done -q
+cp done/summary.json done/summary.before
+refused done.yaml done/checkpoint.anvil "nothing to continue"
+set +e
+run 2 "$anvil" run done.yaml -o done -q --restart done/checkpoint.anvil 2>/dev/null
+status=$?
+set -e
+[ "$status" -eq 2 ] || { echo "an in-place restart at the end: exit $status"; exit 1; }
+cmp -s done/summary.json done/summary.before || { echo "the refused restart rewrote summary.json"; exit 1; }
 echo "damaged and mismatched checkpoints refused with exit 2 on 2 ranks"

@@ -1454,7 +1454,7 @@ TEST(Keyword, SphParticleErrors) {
   const Config c2 = kw(with_sph(with(sph_cards, "                   1\n*SECTION",
                                      "                   1\n         1\n*SECTION")));
   ASSERT_EQ(c2.warnings.size(), 1u);
-  EXPECT_NE(c2.warnings[0].find("*CONTROL_SPH card 2 sets fields anvil does not read"),
+  EXPECT_NE(c2.warnings[0].find("*CONTROL_SPH card 2 sets CONT, which anvil does not read"),
             std::string::npos)
       << c2.warnings[0];
   // A blank id in the I10 format is told its own width.

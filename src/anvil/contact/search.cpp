@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 
 #include "anvil/contact/geometry.hpp"
 #include "anvil/core/simd.hpp"
@@ -426,97 +425,6 @@ void queue_candidates(const std::vector<ContactNodeItem>& nodes, const FaceBoxes
   w.query_start[w.active.size()] = static_cast<int>(w.query_face.size());
 }
 
-namespace {
-// The dead zone of a concave vertex or edge for a node without faces of its own (an SPH
-// particle): under a point load the dimple tilts the faces round the vertex under the
-// particle, its foot falls outside each of them, and once the face it tracked left its
-// candidates it could not pair with the face beside it either, not having come through
-// that one: it passed through (QA round 32: the lone leading particle of an SPH ball sank
-// through half a plate). Where no face passed the detailed check, such a node pairs with,
-// in this order: the face it touched last cycle, still behind it; a face whose foot is
-// inside, if it slid across to it (the face it touched last cycle faces the same way,
-// normals within 60 degrees: not the side of a plate round the edge); a face whose foot is
-// outside, if it is also behind another face that faces the same way (concave) and it
-// slid across to it or came through it; of these,
-// the face its foot is least outside of, ties to the lower face id; the foot clamped onto
-// the face. Never while it is also behind a face facing the other way (normals more than
-// 120 degrees apart: the far side of a thin wall), nor with the foot more than a quarter of
-// the face outside (|xi| or |eta| > 1.5). Mesh nodes keep the detailed check alone (their
-// own faces tell the side, and the can crush's creases are verified with it).
-template <class CameThrough>
-std::optional<ContactPair> dead_zone_pair(const std::vector<ContactNodeItem>& nodes,
-                                          const std::vector<ContactFaceItem>& faces,
-                                          const SearchWorkspace& w, std::size_t k, double tol,
-                                          const CameThrough& came_through) {
-  const auto n = static_cast<std::size_t>(w.active[k]);
-  const auto& nd = nodes[n];
-  constexpr int most = 16;
-  int behind[most]; // queued faces the node is behind, no deeper than a tracked pair goes
-  int count = 0;
-  for (int j = w.query_start[k]; j < w.query_start[k + 1] && count < most; ++j) {
-    const auto& fc = faces[static_cast<std::size_t>(w.query_face[static_cast<std::size_t>(j)])];
-    const QuadProjection& q = w.feet[static_cast<std::size_t>(j)];
-    if (q.converged && q.gap < 0 && -q.gap <= 2 * fc.depth) behind[count++] = j;
-  }
-  // The mean-plane normal of the face the node touched last cycle, looked up when needed
-  // (a node that has just lost its pair: rare), zero if no face here is that face.
-  bool looked = false;
-  Vec3 last{0, 0, 0};
-  auto last_normal = [&]() {
-    if (!looked)
-      for (const auto& fc : faces)
-        if (fc.gid == nd.last_face) {
-          last = Vec3{fc.normal[0], fc.normal[1], fc.normal[2]};
-          break;
-        }
-    looked = true;
-    return last;
-  };
-  int pick = -1;
-  double pick_out = 0;
-  std::int64_t pick_gid = 0;
-  bool pick_tracked = false;
-  for (int a = 0; a < count; ++a) {
-    const int j = behind[a];
-    const QuadProjection& q = w.feet[static_cast<std::size_t>(j)];
-    const auto& fc = faces[static_cast<std::size_t>(w.query_face[static_cast<std::size_t>(j)])];
-    const bool was = fc.gid == nd.last_face, touching = nd.last_face >= 0;
-    const double out = std::max(std::abs(q.xi), std::abs(q.eta));
-    if (out > 1.5 || (!was && !(-q.gap < fc.depth))) continue;
-    bool concave = false, opposed = false;
-    for (int b = 0; b < count; ++b) {
-      if (b == a) continue;
-      const double c = dot(q.normal, w.feet[static_cast<std::size_t>(behind[b])].normal);
-      concave = concave || c > 0.5;
-      opposed = opposed || c < -0.5;
-    }
-    if (opposed) continue;
-    // Slid across from the face it touched last cycle: one that faces the same way.
-    const bool slid = touching && dot(q.normal, last_normal()) > 0.5;
-    const bool eligible =
-        out <= tol ? (was || slid) : concave && (was || slid || came_through(fc, nd));
-    if (!eligible) continue;
-    if (pick >= 0 &&
-        (pick_tracked || (!was && (out > pick_out || (out == pick_out && fc.gid > pick_gid)))))
-      continue;
-    pick = j;
-    pick_out = out;
-    pick_gid = fc.gid;
-    pick_tracked = was;
-  }
-  if (pick < 0) return std::nullopt;
-  const QuadProjection& q = w.feet[static_cast<std::size_t>(pick)];
-  const int f = w.query_face[static_cast<std::size_t>(pick)];
-  return ContactPair{static_cast<int>(n),
-                     f,
-                     std::clamp(q.xi, -1.0, 1.0),
-                     std::clamp(q.eta, -1.0, 1.0),
-                     q.gap,
-                     q.normal,
-                     pick_tracked ? std::min(nd.allowance, -q.gap) : -q.gap};
-}
-} // namespace
-
 void check_queued(const std::vector<ContactNodeItem>& nodes,
                   const std::vector<ContactFaceItem>& faces, const SearchOptions& opt,
                   SearchWorkspace& w, std::vector<ContactPair>& pairs) {
@@ -539,28 +447,6 @@ void check_queued(const std::vector<ContactNodeItem>& nodes,
   // Pass 2: the feet of the normals, `simd::width` at a time.
   w.feet.resize(w.queries.size());
   project_on_quads(w.queries, w.feet);
-  // A new pair needs the node to have come through the face this step: at the start of
-  // the step (x - dt v for node and face alike) it was in front of the face's mean plane.
-  // A node found behind a face it never crossed is on the far side of the same wall, or
-  // came round an edge, and is not in contact with this face. (A face erosion has just
-  // exposed: the node may have been behind it already, in the element that eroded; it
-  // pairs with its depth as allowance.)
-  auto came_through = [&](const ContactFaceItem& fc, const ContactNodeItem& nd) {
-    if (!(opt.dt > 0) || fc.exposed != 0) return true;
-    Vec3 c0,
-        n0 = cross(Vec3{(fc.x[2][0] - opt.dt * fc.v[2][0]) - (fc.x[0][0] - opt.dt * fc.v[0][0]),
-                        (fc.x[2][1] - opt.dt * fc.v[2][1]) - (fc.x[0][1] - opt.dt * fc.v[0][1]),
-                        (fc.x[2][2] - opt.dt * fc.v[2][2]) - (fc.x[0][2] - opt.dt * fc.v[0][2])},
-                   Vec3{(fc.x[3][0] - opt.dt * fc.v[3][0]) - (fc.x[1][0] - opt.dt * fc.v[1][0]),
-                        (fc.x[3][1] - opt.dt * fc.v[3][1]) - (fc.x[1][1] - opt.dt * fc.v[1][1]),
-                        (fc.x[3][2] - opt.dt * fc.v[3][2]) - (fc.x[1][2] - opt.dt * fc.v[1][2])});
-    for (int a = 0; a < 4; ++a)
-      for (int i = 0; i < 3; ++i) c0[i] += 0.25 * (fc.x[a][i] - opt.dt * fc.v[a][i]);
-    const Vec3 p0{nd.x[0] - opt.dt * nd.v[0], nd.x[1] - opt.dt * nd.v[1],
-                  nd.x[2] - opt.dt * nd.v[2]};
-    const double len0 = norm(n0);
-    return !(len0 > 0 && dot(p0 - c0, n0) < -(fc.warp + 1e-3 * fc.depth) * len0);
-  };
   // Pass 3, node by node: the detailed check of its queued faces, in their order.
   for (std::size_t k = 0; k < w.active.size(); ++k) {
     const auto n = static_cast<std::size_t>(w.active[k]);
@@ -578,7 +464,28 @@ void check_queued(const std::vector<ContactNodeItem>& nodes,
                    std::min(nd.allowance, -q.gap)};
         have_tracked = true;
       }
-      if (!(-q.gap < fc.depth) || !came_through(fc, nd)) continue;
+      if (!(-q.gap < fc.depth)) continue;
+      // A new pair needs the node to have come through the face this step: at the start
+      // of the step (x - dt v for node and face alike) it was in front of the face's mean
+      // plane. A node found behind a face it never crossed is on the far side of the same
+      // wall, or came round an edge, and is not in contact with this face.
+      // (A face erosion has just exposed: the node may have been behind it already, in
+      // the element that eroded; it pairs with its depth as allowance.)
+      if (opt.dt > 0 && fc.exposed == 0) {
+        Vec3 c0, n0 = cross(
+                     Vec3{(fc.x[2][0] - opt.dt * fc.v[2][0]) - (fc.x[0][0] - opt.dt * fc.v[0][0]),
+                          (fc.x[2][1] - opt.dt * fc.v[2][1]) - (fc.x[0][1] - opt.dt * fc.v[0][1]),
+                          (fc.x[2][2] - opt.dt * fc.v[2][2]) - (fc.x[0][2] - opt.dt * fc.v[0][2])},
+                     Vec3{(fc.x[3][0] - opt.dt * fc.v[3][0]) - (fc.x[1][0] - opt.dt * fc.v[1][0]),
+                          (fc.x[3][1] - opt.dt * fc.v[3][1]) - (fc.x[1][1] - opt.dt * fc.v[1][1]),
+                          (fc.x[3][2] - opt.dt * fc.v[3][2]) - (fc.x[1][2] - opt.dt * fc.v[1][2])});
+        for (int a = 0; a < 4; ++a)
+          for (int i = 0; i < 3; ++i) c0[i] += 0.25 * (fc.x[a][i] - opt.dt * fc.v[a][i]);
+        const Vec3 p0{nd.x[0] - opt.dt * nd.v[0], nd.x[1] - opt.dt * nd.v[1],
+                      nd.x[2] - opt.dt * nd.v[2]};
+        const double len0 = norm(n0);
+        if (len0 > 0 && dot(p0 - c0, n0) < -(fc.warp + 1e-3 * fc.depth) * len0) continue;
+      }
       // Least penetration wins; equal penetrations go to the lower face id.
       if (!found || q.gap > best.gap || (q.gap == best.gap && fc.gid < best_gid)) {
         best = {static_cast<int>(n), f, q.xi, q.eta, q.gap, q.normal, -q.gap};
@@ -590,9 +497,6 @@ void check_queued(const std::vector<ContactNodeItem>& nodes,
       pairs.push_back(tracked);
     else if (found)
       pairs.push_back(best);
-    else if (w.own_start[k] == w.list_start[k + 1]) // a node without faces: a particle
-      if (const auto dead = dead_zone_pair(nodes, faces, w, k, tol, came_through))
-        pairs.push_back(*dead);
   }
 }
 

@@ -1241,25 +1241,26 @@ private:
     Cursor c(b);
     const Line l = c.next();
     const Card card(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
-    // Cards 2 and 3 (CONT, DERIV, INI, ISHOW, IEROD, ICONT, IAVIS, ISYMP; ITHK, ISTAB, QL,
-    // ...): taken; any field set is said not to be read (CONT = 1, IEROD, IAVIS change the
-    // run in LS-DYNA).
+    // Cards 2 and on (CONT, DERIV, INI, ISHOW, IEROD, ICONT, IAVIS, ISYMP; then card 3's,
+    // named by place): taken; the fields set are said not to be read (CONT = 1, IEROD,
+    // IAVIS change the run in LS-DYNA).
     sph_control_notes_.clear();
     static const char* const card2[] = {"CONT",  "DERIV", "INI",   "ISHOW",
                                         "IEROD", "ICONT", "IAVIS", "ISYMP"};
     for (int k = 2; !c.done(); ++k) {
       const Line lk = c.next();
       const Card ck(b, lk, {10, 10, 10, 10, 10, 10, 10, 10}, Card::Extra::keep);
-      for (int i = 0; i < ck.size(); ++i)
-        if (!ck.blank(i) &&
-            ck.real(i, k == 2 && i < 8 ? std::string(card2[i])
-                                       : fmt::format("card{}.field{}", k, i + 1)) != 0) {
-          sph_control_notes_.push_back(fmt::format(
-              "{}: *CONTROL_SPH card {} sets fields anvil does not read (its particles interact "
-              "with every particle set, are not eroded, and take the Monaghan viscosity)",
-              where_of(lk).str(), k));
-          break;
-        }
+      std::string set; // the fields this card sets
+      for (int i = 0; i < ck.size(); ++i) {
+        const std::string name =
+            k == 2 && i < 8 ? std::string(card2[i]) : fmt::format("card{}.field{}", k, i + 1);
+        if (!ck.blank(i) && ck.real(i, name) != 0) set += (set.empty() ? "" : ", ") + name;
+      }
+      if (!set.empty())
+        sph_control_notes_.push_back(fmt::format(
+            "{}: *CONTROL_SPH card {} sets {}, which anvil does not read (its particle sets all "
+            "interact, are not eroded, and take the Monaghan viscosity)",
+            where_of(lk).str(), k, set));
     }
     control_sph_at_ = where_of(l);
     const std::int64_t idim = card.integer(3, "IDIM", 0);
@@ -2813,8 +2814,17 @@ private:
     const Card c1(b, l, {10, 10, 10, 10, 10, 10, 10, 10});
     ContactCard k{};
     k.two_surface = contact_form(b.name) == 2;
-    contact_side(c1, 0, "SSID", 2, "SSTYP", k.two_surface, k.ssid, k.sstyp);
-    if (k.two_surface) contact_side(c1, 1, "MSID", 3, "MSTYP", true, k.msid, k.mstyp);
+    try {
+      contact_side(c1, 0, "SSID", 2, "SSTYP", k.two_surface, k.ssid, k.sstyp);
+      if (k.two_surface) contact_side(c1, 1, "MSID", 3, "MSTYP", true, k.msid, k.mstyp);
+    } catch (const InputError& e) {
+      if (!options.mpp) throw;
+      // An _MPP contact whose MPP card is missing reads card 1 as it (QA round 33).
+      const std::string what = e.what(), prefix = e.where().str() + ": ";
+      throw InputError(e.where(), (what.rfind(prefix, 0) == 0 ? what.substr(prefix.size()) : what) +
+                                      " (an _MPP contact has its MPP card before card 1, after "
+                                      "the _ID card: is it missing?)");
+    }
     if (c1.integer(4, "SBOXID", 0) != 0)
       c1.fail("SBOXID", "a box restriction (SBOXID) is not supported");
     if (k.two_surface && c1.integer(5, "MBOXID", 0) != 0)

@@ -6,6 +6,8 @@
 #include <limits>
 #include <optional>
 
+#include <fmt/format.h>
+
 #include "anvil/io/checkpoint.hpp"
 #include "anvil/io/outputs.hpp"
 #include "anvil/solver/simulation.hpp"
@@ -58,6 +60,15 @@ int run(const Config& config, const RunOptions& options, const Comm& comm) {
   if (!options.restart.empty()) {
     restored = read_checkpoint(options.restart); // every rank reads it
     sim.restore(*restored);
+    // A checkpoint at the end of the run this deck asks for (the final one a finished run
+    // writes) has nothing left to run: continuing "zero steps" would rewrite the outputs
+    // from a state whose energies no step has computed (QA round 33: a finished run's
+    // summary.json rewritten with time 0 and the initial kinetic energy).
+    if (sim.finished())
+      throw InputError(fmt::format(
+          "checkpoint '{}' is at the end of the run this deck asks for (t = {:.9g} s, cycle "
+          "{}): nothing to continue; give a later termination to run on",
+          options.restart, sim.clock().time, sim.clock().cycle));
   }
   Outputs out(sim, {options.output_dir, options.progress});
   const std::string checkpoint_path = options.output_dir + "/checkpoint.anvil";
