@@ -1544,6 +1544,44 @@ TEST(Keyword, NullMaterialParticlesAreAFluid) {
                {"*PART.MID", "fluids with SPH particles only"});
 }
 
+// *SET_NODE_ADD and *SET_PART_ADD: sets that unite sets (their members' members, any
+// depth); a set that includes itself, or an undefined member, is an error at DSID.
+TEST(Keyword, SetsThatUniteSets) {
+  const std::string cards = R"(*SET_NODE_LIST
+         8
+        12
+*SET_NODE_ADD
+         9
+         7         8
+*BOUNDARY_SPC_SET
+         9         0         1         0         0
+*SET_PART_LIST
+         4
+         1
+*SET_PART_ADD
+         5
+         4
+*INITIAL_VELOCITY_GENERATION
+         5         1       0.0       3.0
+       0.0       0.0       0.0       0.0       0.0       0.0
+*END)";
+  const Config c = kw(with(good, "*END", cards));
+  const Mesh m = build_mesh(c);
+  // Node set 7 (nodes 1-4: positions 0-3) and node 12 (position 11).
+  EXPECT_EQ(m.node_sets.at("nodeset_9"), (std::vector<std::int64_t>{0, 1, 2, 3, 11}));
+  ASSERT_EQ(c.initial_conditions.size(), 2u);
+  EXPECT_EQ(c.initial_conditions[1].nodes.part, std::optional<std::string>("part1"));
+  EXPECT_EQ(c.initial_conditions[1].velocity, (Vec3{3.0, 0, 0}));
+  expect_error(with(good, "*END",
+                    "*SET_NODE_ADD\n         9\n        77\n*BOUNDARY_SPC_SET\n"
+                    "         9         0         1\n*END"),
+               {"*SET_NODE_ADD.DSID", "node set 77, which is not defined"});
+  expect_error(with(good, "*END",
+                    "*SET_NODE_ADD\n         9\n         9\n*BOUNDARY_SPC_SET\n"
+                    "         9         0         1\n*END"),
+               {"*SET_NODE_ADD.DSID", "includes itself"});
+}
+
 // *DATABASE_BINARY_D3DUMP and *DATABASE_BINARY_RUNRSF: checkpoints every CYCL cycles, the
 // smaller of the two.
 TEST(Keyword, RestartDumpsAreCheckpoints) {

@@ -649,7 +649,9 @@ struct HourglassCard {
 struct IdSet {
   std::vector<std::int64_t> ids;                             // listed ids
   std::vector<std::pair<std::int64_t, std::int64_t>> ranges; // _GENERATE ranges
+  std::vector<std::int64_t> sets;                            // _ADD: the sets it unites
   Where at;
+  std::string keyword; // the keyword that defined it (for messages)
 };
 
 struct Spc {
@@ -809,15 +811,19 @@ private:
     if (n == "PART" || n == "PART_CONTACT") return part(b);
     if (n == "SET_NODE" || n == "SET_NODE_LIST" || n == "SET_NODE_TITLE" ||
         n == "SET_NODE_LIST_TITLE")
-      return id_set(b, node_sets_, false);
+      return id_set(b, node_sets_, SetForm::list);
     if (n == "SET_NODE_LIST_GENERATE" || n == "SET_NODE_LIST_GENERATE_TITLE")
-      return id_set(b, node_sets_, true);
+      return id_set(b, node_sets_, SetForm::generate);
+    if (n == "SET_NODE_ADD" || n == "SET_NODE_ADD_TITLE")
+      return id_set(b, node_sets_, SetForm::add);
     if (mesh_only_) return;
     if (n == "SET_PART" || n == "SET_PART_LIST" || n == "SET_PART_TITLE" ||
         n == "SET_PART_LIST_TITLE")
-      return id_set(b, part_sets_, false);
+      return id_set(b, part_sets_, SetForm::list);
     if (n == "SET_PART_LIST_GENERATE" || n == "SET_PART_LIST_GENERATE_TITLE")
-      return id_set(b, part_sets_, true);
+      return id_set(b, part_sets_, SetForm::generate);
+    if (n == "SET_PART_ADD" || n == "SET_PART_ADD_TITLE")
+      return id_set(b, part_sets_, SetForm::add);
     if (n == "SECTION_SOLID" || n == "SECTION_SOLID_TITLE") return section_solid(b);
     if (n == "SECTION_SPH" || n == "SECTION_SPH_TITLE") return section_sph(b);
     if (n == "ELEMENT_SPH" || n == "ELEMENT_SPH_VOLUME") return element_sph(b);
@@ -1088,7 +1094,9 @@ private:
     }
   }
 
-  void id_set(const Block& b, std::map<std::int64_t, IdSet>& sets, bool generate) {
+  enum class SetForm { list, generate, add };
+  void id_set(const Block& b, std::map<std::int64_t, IdSet>& sets, SetForm form) {
+    const bool generate = form == SetForm::generate;
     Cursor c(b);
     skip_title(b, c);
     const Line l = c.next();
@@ -1097,9 +1105,14 @@ private:
     if (sid <= 0) head.fail("SID", fmt::format("SID must be a positive set id, found {}", sid));
     IdSet s;
     s.at = where_of(l);
+    s.keyword = b.name;
     while (auto r = c.next_record()) {
       const Card card(b, *r, {10, 10, 10, 10, 10, 10, 10, 10}, Card::Extra::keep);
-      if (generate) {
+      if (form == SetForm::add) {
+        for (int k = 0; k < card.size(); ++k)
+          if (const auto id = card.id(k, fmt::format("DSID{}", k + 1)); id != 0)
+            s.sets.push_back(id);
+      } else if (generate) {
         for (int k = 0; k < card.size(); k += 2) {
           const auto lo = card.id(k, fmt::format("B{}BEG", k / 2 + 1));
           const auto hi = card.id(k + 1, fmt::format("B{}END", k / 2 + 1));
@@ -3085,8 +3098,21 @@ private:
   }
 
   // Node positions of a *SET_NODE_LIST (sorted, unique); every id must be a node.
-  std::vector<std::int64_t> resolve_node_set(std::int64_t sid, const IdSet& s) const {
+  std::vector<std::int64_t> resolve_node_set(std::int64_t sid, const IdSet& s,
+                                             int depth = 0) const {
     std::vector<std::int64_t> out;
+    for (const auto member : s.sets) { // *SET_NODE_ADD
+      const auto it = node_sets_.find(member);
+      if (it == node_sets_.end())
+        throw InputError(
+            s.at.loc("*" + s.keyword + ".DSID"),
+            fmt::format("node set {} unites node set {}, which is not defined", sid, member));
+      if (depth > 64)
+        throw InputError(s.at.loc("*" + s.keyword + ".DSID"),
+                         fmt::format("node set {} includes itself (through *SET_NODE_ADD)", sid));
+      const auto more = resolve_node_set(member, it->second, depth + 1);
+      out.insert(out.end(), more.begin(), more.end());
+    }
     for (const auto id : s.ids)
       out.push_back(node_position(id, s.at, "*SET_NODE_LIST", fmt::format("node set {}", sid)));
     if (!s.ranges.empty())
@@ -3163,16 +3189,34 @@ private:
   }
 
   // The parts of a part set, those anvil keeps (parts with solid elements).
+  // The part ids of part set sid (listed, in ranges, and of the sets it unites).
+  std::vector<std::int64_t> part_set_ids(std::int64_t sid, const IdSet& s, int depth) const {
+    std::vector<std::int64_t> pids = s.ids;
+    for (const auto& p : parts_)
+      for (const auto& [lo, hi] : s.ranges)
+        if (p.pid >= lo && p.pid <= hi) pids.push_back(p.pid);
+    for (const auto member : s.sets) { // *SET_PART_ADD
+      const auto it = part_sets_.find(member);
+      if (it == part_sets_.end())
+        throw InputError(
+            s.at.loc("*" + s.keyword + ".DSID"),
+            fmt::format("part set {} unites part set {}, which is not defined", sid, member));
+      if (depth > 64)
+        throw InputError(s.at.loc("*" + s.keyword + ".DSID"),
+                         fmt::format("part set {} includes itself (through *SET_PART_ADD)", sid));
+      const auto more = part_set_ids(member, it->second, depth + 1);
+      pids.insert(pids.end(), more.begin(), more.end());
+    }
+    return pids;
+  }
+
   std::vector<std::string> part_set(std::int64_t sid, const Where& at, const std::string& key,
                                     const std::set<std::int64_t>& kept) const {
     const auto it = part_sets_.find(sid);
     if (it == part_sets_.end())
       throw InputError(at.loc(key),
                        fmt::format("part set {} is not defined (*SET_PART_LIST)", sid));
-    std::vector<std::int64_t> pids = it->second.ids;
-    for (const auto& p : parts_)
-      for (const auto& [lo, hi] : it->second.ranges)
-        if (p.pid >= lo && p.pid <= hi) pids.push_back(p.pid);
+    const std::vector<std::int64_t> pids = part_set_ids(sid, it->second, 0);
     std::vector<std::string> out;
     for (const auto pid : pids) {
       if (std::none_of(parts_.begin(), parts_.end(),
