@@ -390,17 +390,9 @@ initial_conditions:
   EXPECT_LT(norm(v - V), 1e-12 * norm(V));
 }
 
-// 5. A held rotation's moment (history.csv bcN.mx, my, mz): a free rigid box whose
-//    rotations a condition fixes, pushed by a constant force F at one corner. Statics of
-//    the rigid body: its centre accelerates as F / M and it does not turn, so the held
-//    rotations take the moment -(r x F) about the centre of mass, r the corner's offset
-//    from it (which the body's translation keeps). Tolerance: 1e-12 of |r x F| at every
-//    sample; the translation's reaction (bcN.fx, fy, fz) 0 (nothing holds it).
-TEST(RigidBody, HeldRotationsTakeTheMomentOfTheLoads) {
-  const Comm world = Comm::world();
-  const Config config = test::deck(R"(
-termination: {cycles: 100}
-materials:
+// Tests 5 and 6: a rigid steel box 30 x 10 x 5 mm at the origin, and a deformable cube far
+// away (a model of rigid parts only is refused).
+const char* const box_and_far = R"(materials:
   steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
 parts:
   body:
@@ -410,7 +402,18 @@ parts:
   far:
     mesh: {generate: box, min: [1, 1, 1], max: [1.01, 1.01, 1.01], divisions: [1, 1, 1]}
     material: steel
-node_sets:
+)";
+
+// 5. A held rotation's moment (history.csv bcN.mx, my, mz): a free rigid box whose
+//    rotations a condition fixes, pushed by a constant force F at one corner. Statics of
+//    the rigid body: its centre accelerates as F / M and it does not turn, so the held
+//    rotations take the moment -(r x F) about the centre of mass, r the corner's offset
+//    from it (which the body's translation keeps). Tolerance: 1e-12 of |r x F| at every
+//    sample; the translation's reaction (bcN.fx, fy, fz) 0 (nothing holds it).
+TEST(RigidBody, HeldRotationsTakeTheMomentOfTheLoads) {
+  const Comm world = Comm::world();
+  const Config config = test::deck("termination: {cycles: 100}\n" + std::string(box_and_far) +
+                                   R"(node_sets:
   corner: {part: body, box: {min: [0.029, 0.009, 0.004], max: [0.031, 0.011, 0.006]}}
 loads:
   - {set: corner, force: [100.0, -250.0, 400.0]}
@@ -448,19 +451,8 @@ boundary_conditions:
 //    the corner's distance from the centre.
 TEST(RigidBody, RotationPrescribedAsAnAngle) {
   const Comm world = Comm::world();
-  const Config config = test::deck(R"(
-termination: {time: 2.0e-5}
-materials:
-  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
-parts:
-  body:
-    mesh: {generate: box, min: [0, 0, 0], max: [0.03, 0.01, 0.005], divisions: [6, 2, 1]}
-    material: steel
-    rigid: true
-  far:
-    mesh: {generate: box, min: [1, 1, 1], max: [1.01, 1.01, 1.01], divisions: [1, 1, 1]}
-    material: steel
-boundary_conditions:
+  const Config config = test::deck("termination: {time: 2.0e-5}\n" + std::string(box_and_far) +
+                                   R"(boundary_conditions:
   - {part: body, fix: [x, y, z, rx, ry]}
   - {part: body, rotation: [0, 0, 1.3], curve: [[0, 0], [5.0e-6, 0.1], [2.0e-5, 1]]}
 probes:

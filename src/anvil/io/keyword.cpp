@@ -3097,20 +3097,30 @@ private:
     return it->second;
   }
 
+  // Member set `member` of the _ADD set `sid` (s) among `sets` (of `kind`, "node" or
+  // "part"), `depth` sets down: an undefined member, or a chain deeper than any deck's (a
+  // set that includes itself), is an error at DSID.
+  static const IdSet& united(const std::map<std::int64_t, IdSet>& sets, const char* kind,
+                             std::int64_t sid, const IdSet& s, std::int64_t member, int depth) {
+    const auto it = sets.find(member);
+    if (it == sets.end())
+      throw InputError(
+          s.at.loc("*" + s.keyword + ".DSID"),
+          fmt::format("{} set {} unites {} set {}, which is not defined", kind, sid, kind, member));
+    if (depth > 64)
+      throw InputError(
+          s.at.loc("*" + s.keyword + ".DSID"),
+          fmt::format("{} set {} includes itself (through *{})", kind, sid, s.keyword));
+    return it->second;
+  }
+
   // Node positions of a *SET_NODE_LIST (sorted, unique); every id must be a node.
   std::vector<std::int64_t> resolve_node_set(std::int64_t sid, const IdSet& s,
                                              int depth = 0) const {
     std::vector<std::int64_t> out;
     for (const auto member : s.sets) { // *SET_NODE_ADD
-      const auto it = node_sets_.find(member);
-      if (it == node_sets_.end())
-        throw InputError(
-            s.at.loc("*" + s.keyword + ".DSID"),
-            fmt::format("node set {} unites node set {}, which is not defined", sid, member));
-      if (depth > 64)
-        throw InputError(s.at.loc("*" + s.keyword + ".DSID"),
-                         fmt::format("node set {} includes itself (through *SET_NODE_ADD)", sid));
-      const auto more = resolve_node_set(member, it->second, depth + 1);
+      const auto more =
+          resolve_node_set(member, united(node_sets_, "node", sid, s, member, depth), depth + 1);
       out.insert(out.end(), more.begin(), more.end());
     }
     for (const auto id : s.ids)
@@ -3188,7 +3198,6 @@ private:
     return part_name(pid);
   }
 
-  // The parts of a part set, those anvil keeps (parts with solid elements).
   // The part ids of part set sid (listed, in ranges, and of the sets it unites).
   std::vector<std::int64_t> part_set_ids(std::int64_t sid, const IdSet& s, int depth) const {
     std::vector<std::int64_t> pids = s.ids;
@@ -3196,20 +3205,14 @@ private:
       for (const auto& [lo, hi] : s.ranges)
         if (p.pid >= lo && p.pid <= hi) pids.push_back(p.pid);
     for (const auto member : s.sets) { // *SET_PART_ADD
-      const auto it = part_sets_.find(member);
-      if (it == part_sets_.end())
-        throw InputError(
-            s.at.loc("*" + s.keyword + ".DSID"),
-            fmt::format("part set {} unites part set {}, which is not defined", sid, member));
-      if (depth > 64)
-        throw InputError(s.at.loc("*" + s.keyword + ".DSID"),
-                         fmt::format("part set {} includes itself (through *SET_PART_ADD)", sid));
-      const auto more = part_set_ids(member, it->second, depth + 1);
+      const auto more =
+          part_set_ids(member, united(part_sets_, "part", sid, s, member, depth), depth + 1);
       pids.insert(pids.end(), more.begin(), more.end());
     }
     return pids;
   }
 
+  // The parts of a part set, those anvil keeps (parts with solid elements or particles).
   std::vector<std::string> part_set(std::int64_t sid, const Where& at, const std::string& key,
                                     const std::set<std::int64_t>& kept) const {
     const auto it = part_sets_.find(sid);

@@ -27,6 +27,17 @@ ElasticConstants ElasticConstants::from(const ParamValues& p) {
   return c;
 }
 
+ElasticConstants ElasticConstants::no_shear(double density, double bulk) {
+  ElasticConstants c;
+  c.density = density;
+  c.bulk = bulk;
+  c.lambda = bulk;
+  c.shear = 0;
+  c.youngs_modulus = 0;
+  c.poissons_ratio = 0.5;
+  return c;
+}
+
 std::string elastic_wave_problem(const ParamValues& p) {
   const ElasticConstants c = ElasticConstants::from(p);
   const double speed = std::sqrt(c.plane_wave_modulus() / c.density);

@@ -12,24 +12,15 @@ constexpr ParamSpec fluid_params[] = {
     {"viscosity", "Pa s", false, 0, 0, 1e300, false, false, "dynamic viscosity mu"},
 };
 
-// The fluid's stiffness where a solid's are asked for: K, no shear.
-ElasticConstants fluid_constants(const ParamValues& p) {
-  ElasticConstants c;
-  c.density = p.at("density");
-  c.bulk = p.at("bulk_modulus");
-  c.lambda = c.bulk;
-  c.shear = 0;
-  c.youngs_modulus = 0;
-  c.poissons_ratio = 0.5;
-  return c;
-}
 } // namespace
 
 std::span<const ParamSpec> Fluid::params() {
   return fluid_params;
 }
 
-Fluid::Fluid(const ParamValues& p) : Material(fluid_constants(p)), viscosity_(p.at("viscosity")) {}
+Fluid::Fluid(const ParamValues& p)
+    : Material(ElasticConstants::no_shear(p.at("density"), p.at("bulk_modulus"))),
+      viscosity_(p.at("viscosity")) {}
 
 void Fluid::update(const MaterialBatch& b) const {
   const double K = elastic().bulk, mu2 = 2 * viscosity_, dt = b.dt;

@@ -13,17 +13,10 @@ constexpr ParamSpec gas_params[] = {
      "initial specific internal energy"},
 };
 
-// Constants standing for the gas's stiffness where a solid's are asked for (penalty
-// stiffness, reporting): the adiabatic bulk modulus gamma p0, no shear.
+// The gas's stiffness: the adiabatic bulk modulus gamma p0, no shear.
 ElasticConstants gas_constants(const ParamValues& p) {
-  ElasticConstants c;
-  c.density = p.at("density");
-  c.bulk = p.at("gamma") * (p.at("gamma") - 1) * p.at("density") * p.at("specific_energy");
-  c.lambda = c.bulk;
-  c.shear = 0;
-  c.youngs_modulus = 0;
-  c.poissons_ratio = 0.5;
-  return c;
+  return ElasticConstants::no_shear(p.at("density"), p.at("gamma") * (p.at("gamma") - 1) *
+                                                         p.at("density") * p.at("specific_energy"));
 }
 } // namespace
 

@@ -71,6 +71,9 @@ struct ElasticConstants {
   double bulk = 0;   // K, Pa
   double lambda = 0; // Lame's first parameter, Pa
   static ElasticConstants from(const ParamValues& p);
+  // The constants that stand for a fluid's stiffness where a solid's are asked for
+  // (penalty stiffness, wave speed, reporting): the bulk modulus K, no shear.
+  static ElasticConstants no_shear(double density, double bulk);
   double plane_wave_modulus() const { return lambda + 2 * shear; } // M = K + 4G/3
 };
 
