@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -119,12 +120,30 @@ int check(const std::string& deck, const anvil::Comm& comm) {
   }
   const std::vector<std::int64_t> load_targets = sim.load_targets();
   const std::vector<double> pressed_area = sim.pressed_area();
+  // Elements by shape (hexahedra, wedges, pyramids, tetrahedra: mesh.hpp's Shape order).
+  std::array<std::int64_t, 4> shapes{};
+  for (const auto& b : sim.blocks())
+    for (std::size_t e = 0; e < static_cast<std::size_t>(b.size()); ++e) {
+      anvil::Hex h;
+      for (int a = 0; a < 8; ++a) h[a] = b.conn[a][e];
+      ++shapes[static_cast<std::size_t>(anvil::shape_of(h))];
+    }
+  comm.sum(std::span<std::int64_t>(shapes));
   if (comm.rank() != 0) return 0;
   std::printf("deck        %s%s\n", deck.c_str(),
               config.title.empty() ? "" : fmt::format("  ({})", config.title).c_str());
   std::printf("ranks       %d\n", comm.size());
   std::printf("nodes       %lld\n", static_cast<long long>(sim.global_nodes()));
-  std::printf("elements    %lld\n", static_cast<long long>(sim.global_elements()));
+  std::string by_shape; // "(250 wedges, 720 tetrahedra)" unless all are hexahedra
+  if (shapes[0] < sim.global_elements())
+    for (const anvil::Shape k : {anvil::Shape::hexahedron, anvil::Shape::wedge,
+                                 anvil::Shape::pyramid, anvil::Shape::tetrahedron})
+      if (const auto n = shapes[static_cast<std::size_t>(k)]; n > 0)
+        by_shape +=
+            fmt::format("{}{} {}", by_shape.empty() ? " (" : ", ", n, anvil::shape_name(k, n != 1));
+  if (!by_shape.empty()) by_shape += ")";
+  std::printf("elements    %lld%s\n", static_cast<long long>(sim.global_elements()),
+              by_shape.c_str());
   for (std::size_t i = 0; i < config.parts.size(); ++i) {
     const double added = sim.part_added_masses()[i];
     std::printf("  part %-16s material %-16s mass %.6g kg%s%s\n", config.parts[i].name.c_str(),

@@ -931,6 +931,45 @@ TEST(Keyword, Includes) {
   fs::remove_all(dir);
 }
 
+// LS-DYNA's degenerate solids: the tetrahedron N1 N2 N3 N4 N4 N4 N4 N4 becomes anvil's
+// a b c c d d d d (mesh.hpp), the pentahedron N1 N2 N3 N4 N5 N5 N6 N6 a wedge; a
+// triangular segment N1 N2 N3 N3 presses a face of the tetrahedron.
+TEST(Keyword, DegenerateSolidsAndTriangularSegments) {
+  std::string text =
+      with(good, "       2       1       5       6       7       8       9      10      11      12",
+           "       2       1       5       6       7       9       9       9       9       9");
+  text =
+      with(text, "*BOUNDARY_SPC_SET",
+           "*DEFINE_CURVE\n         3\n                 0.0                 1.0\n                 "
+           "1.0                 1.0\n"
+           "*LOAD_SEGMENT\n         3     1.0E6       0.0         5         6         9         9\n"
+           "*BOUNDARY_SPC_SET");
+  text = with(text, "*DATABASE_HISTORY_NODE\n        12", "*DATABASE_HISTORY_NODE\n         9");
+  const Config c = kw(text);
+  const Mesh& m = *c.parts[0].mesh.embedded;
+  EXPECT_EQ(m.blocks[0].elements[1], tetrahedron_hex(4, 5, 6, 8));
+  EXPECT_EQ(shape_of(m.blocks[0].elements[1]), Shape::tetrahedron);
+  const auto sides = resolve_surface(m, c, c.loads.at(0).target);
+  ASSERT_EQ(sides.size(), 1u);
+  EXPECT_EQ(sides[0].element, 1);
+  EXPECT_EQ(face_key(m.blocks[0].elements[1], sides[0].face), (FaceKey{-1, 4, 5, 8}));
+  const Comm self = Comm::self();
+  Simulation sim(c, self); // it runs: positive volume
+  EXPECT_EQ(sim.load_targets(), (std::vector<std::int64_t>{1}));
+  // ELFORM 10 (one-point tetrahedra): anvil's element is that on a part of tetrahedra,
+  // not on a part with a hexahedron.
+  const std::string elform10 =
+      with(text, "*SECTION_SOLID\n         1         1", "*SECTION_SOLID\n         1        10");
+  const auto warned = [](const Config& k) {
+    return std::any_of(k.warnings.begin(), k.warnings.end(),
+                       [](const std::string& w) { return w.find("ELFORM 10") != w.npos; });
+  };
+  EXPECT_TRUE(warned(kw(elform10)));
+  EXPECT_FALSE(warned(kw(with(
+      elform10, "       1       1       1       2       3       4       5       6       7       8",
+      "       1       1       1       2       3       5       5       5       5       5"))));
+}
+
 TEST(Keyword, ErrorsNameFileLineAndField) {
   expect_error("*NODE\n", {"model.k:1", "starts with *KEYWORD"});
   expect_error(with(good, "    7850.0", "    78x0.0"), {"model.k:14: *MAT_ELASTIC.RO", "78x0.0"});
@@ -941,7 +980,7 @@ TEST(Keyword, ErrorsNameFileLineAndField) {
   expect_error(with(good, "      11      12\n", "      11      13\n"),
                {"*ELEMENT_SOLID.N8", "element 2", "node 13"});
   expect_error(with(good, "      11      12\n", "      11      11\n"),
-               {"model.k:31: *ELEMENT_SOLID.N8", "degenerate"});
+               {"model.k:31: *ELEMENT_SOLID.N8", "element 2 repeats nodes", "N7 = N8"});
   expect_error(with(good, "      11      12\n", "      11\n"), {"has 7 nodes"});
   expect_error(with(good, "       2       1       5", "       2       9       5"),
                {"model.k:31: *ELEMENT_SOLID.PID", "part 9"});

@@ -317,8 +317,12 @@ TEST(Keyword, NodeAndSegmentLoads) {
   const std::string seg = "*LOAD_SEGMENT\n         3     2.0E6       0.0";
   EXPECT_TRUE(has(keyword_error(seg + "         1         2         7         8\n"),
                   "model.k:35: *LOAD_SEGMENT.N1: segment (1, 2, 7, 8) is not a face"));
+  // A triangle N1 N2 N3 N3 is a face of a wedge, pyramid or tetrahedron only.
   EXPECT_TRUE(has(keyword_error(seg + "         1         2         6         6\n"),
-                  "*LOAD_SEGMENT.N4: segment (1, 2, 6, 6) repeats a node: triangular"));
+                  "*LOAD_SEGMENT.N1: segment (1, 2, 6, 6) is not a face"));
+  EXPECT_TRUE(has(keyword_error(seg + "         1         6         1         6\n"),
+                  "*LOAD_SEGMENT.N4: segment (1, 6, 1, 6) repeats a node other than as a "
+                  "triangle"));
   EXPECT_TRUE(has(keyword_error(seg + "         1         6         2         5\n"),
                   "does not go round its face in order"));
   EXPECT_TRUE(has(keyword_error(seg + "         1         2         6        99\n"),

@@ -20,6 +20,7 @@
 #include <fmt/format.h>
 
 #include "anvil/core/error.hpp"
+#include "anvil/fe/hex8.hpp"
 #include "anvil/mesh/mesh.hpp"
 #include "anvil/mesh/read_exodus.hpp"
 #include "anvil/mesh/read_gmsh.hpp"
@@ -71,6 +72,18 @@ std::array<Vec3, 8> corners(const Mesh& m, const Hex& h) {
 
 // The box [0,2] x [0,1] x [0,3] in 2x2x2 hexahedra: counts, positive volumes summing to
 // the box's.
+// Two readings of one mesh: the same blocks (names, connectivity, ids), nodes and node sets.
+void expect_same_mesh(const Mesh& a, const Mesh& b) {
+  ASSERT_EQ(a.blocks.size(), b.blocks.size());
+  for (std::size_t i = 0; i < a.blocks.size(); ++i) {
+    EXPECT_EQ(a.blocks[i].name, b.blocks[i].name);
+    EXPECT_EQ(a.blocks[i].elements, b.blocks[i].elements);
+    EXPECT_EQ(a.blocks[i].ids, b.blocks[i].ids);
+  }
+  EXPECT_EQ(a.nodes, b.nodes);
+  EXPECT_EQ(a.node_sets, b.node_sets);
+}
+
 void expect_box(const Mesh& m) {
   ASSERT_EQ(m.num_nodes(), 27);
   ASSERT_EQ(m.num_elements(), 8);
@@ -112,6 +125,52 @@ Vec3 face_normal(const Mesh& m, const SideEntry& s) {
   const Vec3 a = m.nodes[h[f[2]]] - m.nodes[h[f[0]]];
   const Vec3 b = m.nodes[h[f[3]]] - m.nodes[h[f[1]]];
   return cross(a, b);
+}
+
+// Sorted distinct nodes of a list.
+std::vector<std::int64_t> distinct(std::vector<std::int64_t> v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+  return v;
+}
+
+// The outward normal of face f of h (not normalised), by the right-hand rule over
+// face_nodes(h, f), as contact and pressure read it: cross(x2 - x0, x3 - x1).
+Vec3 face_nodes_normal(const Mesh& m, const Hex& h, int f) {
+  const auto q = face_nodes(h, f);
+  return cross(m.nodes[q[2]] - m.nodes[q[0]], m.nodes[q[3]] - m.nodes[q[1]]);
+}
+
+// A solid in canonical form: its shape, its volume both exact (trilinear map) and as the
+// one-point element computes it (hex8: for a canonical degenerate hexahedron the solid's
+// own volume), a positive Jacobian at the centre, and every face of hex_faces that is a
+// face (4 for a tetrahedron, 5 for a wedge or a pyramid, 6 for a hexahedron) pointing out
+// of the solid: its normal away from the centroid of the solid's corners.
+void expect_solid(const Mesh& m, const Hex& h, Shape shape, double volume) {
+  EXPECT_EQ(shape_of(h), shape) << shape_name(shape_of(h));
+  const auto x = corners(m, h);
+  EXPECT_NEAR(hex_volume(x), volume, 1e-12);
+  double xa[8][3], B[8][3];
+  for (int a = 0; a < 8; ++a)
+    for (int i = 0; i < 3; ++i) xa[a][i] = x[a][i];
+  hex8::gradient(xa, B);
+  EXPECT_NEAR(hex8::volume(xa, B), volume, 1e-12);
+  EXPECT_GT(hex8::centre_jacobian(xa), 0);
+  const auto nodes = distinct({h.begin(), h.end()});
+  Vec3 c{};
+  for (auto n : nodes) c += m.nodes[n] * (1.0 / static_cast<double>(nodes.size()));
+  int faces = 0;
+  for (int f = 0; f < 6; ++f) {
+    if (!is_face(face_key(h, f))) continue;
+    ++faces;
+    const auto q = face_nodes(h, f);
+    const auto on_face = distinct({q.begin(), q.end()});
+    Vec3 fc{};
+    for (auto n : on_face) fc += m.nodes[n] * (1.0 / static_cast<double>(on_face.size()));
+    EXPECT_GT(dot(face_nodes_normal(m, h, f), fc - c), 0) << "face " << f;
+  }
+  const int expected[4] = {6, 5, 5, 4}; // hexahedron, wedge, pyramid, tetrahedron
+  EXPECT_EQ(faces, expected[static_cast<int>(shape)]);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -174,13 +233,7 @@ TEST(ReadExodus, ClassicAndNetcdf4FilesReadTheSame) {
     SCOPED_TRACE(f);
     const Mesh m = read_exodus(data(f));
     expect_box(m);
-    ASSERT_EQ(m.blocks.size(), ref.blocks.size());
-    for (std::size_t b = 0; b < m.blocks.size(); ++b) {
-      EXPECT_EQ(m.blocks[b].name, ref.blocks[b].name);
-      EXPECT_EQ(m.blocks[b].elements, ref.blocks[b].elements);
-      EXPECT_EQ(m.blocks[b].ids, ref.blocks[b].ids);
-    }
-    EXPECT_EQ(m.node_sets, ref.node_sets);
+    expect_same_mesh(m, ref);
     EXPECT_EQ(m.side_sets.size(), ref.side_sets.size());
   }
 }
@@ -209,17 +262,161 @@ void expect_exodus_error(const std::string& path, const std::vector<std::string>
   }
 }
 
+// Tetrahedra, wedges and pyramids (and a wedge written as LS-DYNA writes one, in a HEX8
+// block) mixed with a hexahedron, one block each (tests/data/meshes/make_exodus.cpp,
+// write_mixed): each is its canonical degenerate hexahedron, of the right volume with
+// its faces pointing out, and the side set's sides are the faces with the side's nodes.
+TEST(ReadExodus, MixedSolidsAsCanonicalHexahedra) {
+  const Mesh m = read_exodus(data("mixed_solids.exo"));
+  EXPECT_EQ(m.num_nodes(), 24); // the TETRA10's mid-edge nodes stay, unused
+  ASSERT_EQ(m.num_elements(), 5);
+  ASSERT_EQ(m.blocks.size(), 5u);
+  EXPECT_EQ(m.blocks[0].name, "hex");
+  EXPECT_EQ(m.blocks[1].name, "block_2");
+  const Hex expected[5] = {
+      {0, 1, 2, 3, 4, 5, 6, 7},         // HEX8 1-8
+      {1, 8, 2, 2, 5, 9, 6, 6},         // wedge (lower case) 2 9 3 6 10 7: a b c c d e f f
+      {5, 9, 6, 6, 10, 10, 10, 10},     // TETRA10 6 10 7 11 (+ 6 mid-edge): a b c c d d d d
+      {4, 5, 6, 7, 11, 11, 11, 11},     // PYRAMID 5 6 7 8 12: a b c d e e e e
+      {18, 22, 19, 19, 21, 23, 20, 20}, // HEX8 19 20 21 22 23 23 24 24 (LS-DYNA's wedge)
+  };
+  const Shape shapes[5] = {Shape::hexahedron, Shape::wedge, Shape::tetrahedron, Shape::pyramid,
+                           Shape::wedge};
+  const double volumes[5] = {1.0, 0.5, 1.0 / 6.0, 1.0 / 3.0, 0.5};
+  for (std::size_t b = 0; b < 5; ++b) {
+    SCOPED_TRACE(b);
+    ASSERT_EQ(m.blocks[b].elements.size(), 1u);
+    EXPECT_EQ(m.blocks[b].elements[0], expected[b]);
+    EXPECT_EQ(m.blocks[b].ids, std::vector<std::int64_t>{10 * static_cast<std::int64_t>(b + 1)});
+    expect_solid(m, m.blocks[b].elements[0], shapes[b], volumes[b]);
+  }
+  EXPECT_EQ(m.node_sets.at("apex"), std::vector<std::int64_t>{11});
+
+  // Each side: (element, face), the side's nodes (0-based) and its outward direction.
+  struct Side {
+    std::int64_t element;
+    int face;
+    std::vector<std::int64_t> nodes;
+    Vec3 out;
+  };
+  const std::vector<Side> sides = {
+      {0, 5, {4, 5, 6, 7}, {0, 0, 1}},      // hexahedron side 6: top
+      {1, 0, {1, 5, 8, 9}, {0, -1, 0}},     // wedge side 1 (1 2 5 4): y = 0
+      {1, 1, {2, 6, 8, 9}, {1, 1, 0}},      // side 2 (2 3 6 5): the slanted quadrilateral
+      {1, 3, {1, 2, 5, 6}, {-1, 0, 0}},     // side 3 (1 4 6 3): x = 1, shared with the cube
+      {1, 4, {1, 2, 8}, {0, 0, -1}},        // side 4 (1 3 2): bottom triangle
+      {1, 5, {5, 6, 9}, {0, 0, 1}},         // side 5 (4 5 6): top triangle
+      {2, 0, {5, 9, 10}, {0, -1, 0}},       // tetrahedron side 1 (1 2 4): y = 0
+      {2, 1, {6, 9, 10}, {1, 1, 1}},        // side 2 (2 3 4): the slanted one
+      {2, 3, {5, 6, 10}, {-1, 0, 0}},       // side 3 (1 4 3): x = 1
+      {2, 4, {5, 6, 9}, {0, 0, -1}},        // side 4 (1 3 2): z = 1, on the wedge
+      {3, 0, {4, 5, 11}, {0, -1, 0}},       // pyramid side 1 (1 2 5)
+      {3, 1, {5, 6, 11}, {1, 0, 0}},        // side 2 (2 3 5)
+      {3, 2, {6, 7, 11}, {0, 1, 0}},        // side 3 (3 4 5)
+      {3, 3, {4, 7, 11}, {-1, 0, 0}},       // side 4 (1 5 4)
+      {3, 4, {4, 5, 6, 7}, {0, 0, -1}},     // side 5 (1 4 3 2): the base, on the cube
+      {4, 3, {18, 19, 20, 21}, {0, 0, -1}}, // LS-DYNA wedge side 5 (1 4 3 2): z = 0
+      {4, 4, {18, 19, 22}, {0, -1, 0}},     // side 1 (1 2 6 5, N5 = N6): y = 0
+  };
+  const auto& faces = m.side_sets.at("faces");
+  ASSERT_EQ(faces.size(), sides.size());
+  for (std::size_t i = 0; i < sides.size(); ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(faces[i].element, sides[i].element);
+    EXPECT_EQ(faces[i].face, sides[i].face);
+    const Hex& h = element(m, faces[i].element);
+    const auto key = face_key(h, faces[i].face);
+    ASSERT_TRUE(is_face(key));
+    EXPECT_EQ(distinct({key.begin(), key.end()}).size() - (key[0] < 0 ? 1 : 0),
+              sides[i].nodes.size());
+    const auto q = face_nodes(h, faces[i].face);
+    EXPECT_EQ(distinct({q.begin(), q.end()}), sides[i].nodes);
+    EXPECT_GT(dot(face_nodes_normal(m, h, faces[i].face), sides[i].out), 0);
+  }
+}
+
+// One element of the given Exodus type in a file of its own (nodes: the unit cube's
+// corners, then (0.5, 0.5, 2)), with a side set "s" of the given sides of it.
+void write_one_element(const std::string& path, const char* type, int npe,
+                       const std::vector<std::int64_t>& conn,
+                       const std::vector<std::int64_t>& sides = {}) {
+  int cws = 8, iows = 8;
+  const int id = ex_create(path.c_str(), EX_CLOBBER | EX_ALL_INT64_API, &cws, &iows);
+  ASSERT_GE(id, 0);
+  ASSERT_EQ(ex_put_init(id, "one element", 3, 9, 1, 1, 0, sides.empty() ? 0 : 1), 0);
+  const std::vector<double> x{0, 1, 1, 0, 0, 1, 1, 0, 0.5}, y{0, 0, 1, 1, 0, 0, 1, 1, 0.5},
+      z{0, 0, 0, 0, 1, 1, 1, 1, 2};
+  ASSERT_EQ(ex_put_coord(id, x.data(), y.data(), z.data()), 0);
+  ASSERT_EQ(ex_put_block(id, EX_ELEM_BLOCK, 1, type, 1, npe, 0, 0, 0), 0);
+  ASSERT_EQ(ex_put_conn(id, EX_ELEM_BLOCK, 1, conn.data(), nullptr, nullptr), 0);
+  if (!sides.empty()) {
+    const std::vector<std::int64_t> elems(sides.size(), 1);
+    ASSERT_EQ(ex_put_set_param(id, EX_SIDE_SET, 1, static_cast<std::int64_t>(sides.size()), 0), 0);
+    ASSERT_EQ(ex_put_set(id, EX_SIDE_SET, 1, elems.data(), sides.data()), 0);
+    ASSERT_EQ(ex_put_name(id, EX_SIDE_SET, 1, "s"), 0);
+  }
+  ex_close(id);
+}
+
+// Other element types, solids naming a node twice, and sides a solid does not have are
+// InputErrors naming the block or set, the element and what is wrong.
+TEST(ReadExodus, UnsupportedTypesAndBadSolidsAreRefused) {
+  TempDir dir;
+  write_one_element(dir.file("shell.exo"), "SHELL4", 4, {1, 2, 3, 4});
+  expect_exodus_error(dir.file("shell.exo"), {"element block 'block_1' (id 1)",
+                                              "type SHELL4 with 4 nodes", "solids only"});
+  write_one_element(dir.file("hexshell.exo"), "HEXSHELL", 12, {1, 2, 3, 4, 5, 6, 7, 8, 1, 2, 3, 4});
+  expect_exodus_error(dir.file("hexshell.exo"), {"type HEXSHELL with 12 nodes", "solids only"});
+  write_one_element(dir.file("tet5.exo"), "TETRA5", 5, {1, 2, 4, 5, 9});
+  expect_exodus_error(dir.file("tet5.exo"), {"type TETRA5 with 5 nodes", "solids only"});
+  write_one_element(dir.file("flat_tet.exo"), "TETRA4", 4, {1, 2, 4, 2});
+  expect_exodus_error(dir.file("flat_tet.exo"),
+                      {"block_1", "element 1 (tetrahedron of type TETRA4) uses node 2 twice "
+                                  "(corners 2 and 4)"});
+  write_one_element(dir.file("wedge_side.exo"), "WEDGE6", 6, {1, 2, 4, 5, 6, 8}, {1, 6});
+  expect_exodus_error(dir.file("wedge_side.exo"),
+                      {"side set 's'", "side 6 of element 1", "a wedge has sides 1 to 5"});
+  write_one_element(dir.file("pyramid_side.exo"), "PYRAMID5", 5, {5, 6, 7, 8, 9}, {0});
+  expect_exodus_error(dir.file("pyramid_side.exo"), {"side 0 of element 1", "sides 1 to 5"});
+  // A tetrahedron written as a hexahedron has no side 6 (its nodes collapse to a point).
+  write_one_element(dir.file("collapsed.exo"), "HEX8", 8, {1, 2, 4, 4, 5, 5, 5, 5}, {4, 6});
+  expect_exodus_error(dir.file("collapsed.exo"),
+                      {"side set 's'", "side 6 of element 1",
+                       "a tetrahedron written as a hexahedron", "none of its faces"});
+  // The same tetrahedron as LS-DYNA writes it (N4 = ... = N8) is rewritten, and its sides
+  // follow its nodes: side 1 (N1 N2 N6 N5 = 1 2 5 5) is the face a b d d of a b c c d d
+  // d d, side 2 (N2 N3 N7 N6 = 2 4 5 5) the face b c d d. Its side 5 (N1 N4 N3 N2 =
+  // 1 5 4 2) spans two faces.
+  write_one_element(dir.file("dyna_tet.exo"), "HEX8", 8, {1, 2, 4, 5, 5, 5, 5, 5}, {1, 2});
+  const Mesh m = read_exodus(dir.file("dyna_tet.exo"));
+  const Hex& h = m.blocks[0].elements[0];
+  EXPECT_EQ(h, (Hex{0, 1, 3, 3, 4, 4, 4, 4}));
+  expect_solid(m, h, Shape::tetrahedron, 1.0 / 6.0);
+  const auto& s = m.side_sets.at("s");
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_EQ(s[0].face, 0);
+  EXPECT_LT(face_nodes_normal(m, h, s[0].face)[1], 0); // y = 0
+  EXPECT_EQ(s[1].face, 1);
+  EXPECT_GT(dot(face_nodes_normal(m, h, s[1].face), Vec3{1, 1, 1}), 0);
+  write_one_element(dir.file("dyna_tet_5.exo"), "HEX8", 8, {1, 2, 4, 5, 5, 5, 5, 5}, {5});
+  expect_exodus_error(dir.file("dyna_tet_5.exo"),
+                      {"side 5 of element 1", "a tetrahedron written as a hexahedron"});
+}
+
 TEST(ReadExodus, BadContentNamesWhatIsWrong) {
-  expect_exodus_error(data("bad_tet_block.exo"), {"block_20", "id 20", "TETRA", "hexahedra only"});
+  // Block 20 is TETRA (4 nodes of each hexahedron, read as tetrahedra), whose elements the
+  // side set "top" names by side 6.
+  expect_exodus_error(data("bad_tet_block.exo"),
+                      {"side set 'top'", "side 6 of element 5", "a tetrahedron has sides 1 to 4"});
   expect_exodus_error(data("bad_node_range.exo"), {"block_20", "element 5", "node 28", "1 to 27"});
   expect_exodus_error(data("bad_nodeset_range.exo"), {"node set 'bottom'", "node 0"});
   expect_exodus_error(data("bad_side_range.exo"), {"side set 'top'", "side 7", "sides 1 to 6"});
   expect_exodus_error(data("bad_elem_range.exo"), {"side set 'top'", "element 9", "1 to 8"});
   expect_exodus_error(data("bad_2d.exo"), {"2-dimensional"});
-  // A repeated node is refused as in .k and .msh files, naming the element's id.
+  // Nodes repeated as no solid repeats them are refused as in .k and .msh files, naming
+  // the element's id.
   expect_exodus_error(data("bad_degenerate_hex.exo"),
-                      {"element block 'lower'", "element 500 uses node 13 twice (N7 and N8)",
-                       "degenerate hexahedra"});
+                      {"element block 'lower'", "element 500 repeats nodes", "N7 = N8", "node 13"});
 }
 
 // Defects the Exodus library does not survive by itself (it writes past fixed-size
@@ -412,12 +609,8 @@ TEST(ReadGmsh, Box22ReadsLike41) {
   const Mesh b = read_gmsh(data("box_2x2x2_v22.msh"));
   expect_box(b);
   ASSERT_EQ(b.blocks.size(), 2u);
-  for (std::size_t i = 0; i < 2; ++i) {
-    EXPECT_EQ(b.blocks[i].name, a.blocks[i].name);
-    EXPECT_EQ(b.blocks[i].elements, a.blocks[i].elements);
-  }
+  expect_same_mesh(a, b);
   expect_gmsh_box_sets(b);
-  EXPECT_EQ(a.node_sets, b.node_sets);
 }
 
 // Gmsh's hexahedron is Exodus's: every face of hex_faces has its normal pointing out of
@@ -434,6 +627,80 @@ TEST(ReadGmsh, HexNodeOrderMatchesHexFaces) {
       EXPECT_GT(dot(face_normal(m, {e, f}), fc - c), 0) << "element " << e << " face " << f;
     }
   }
+}
+
+// A hexahedron, a prism, a pyramid and a tetrahedron sharing faces (tests/data/meshes/
+// mixed_solids.msh, written by hand): the unit cube, the prism on its face x = 1, the
+// pyramid on its top, the tetrahedron on the prism; physical volumes "lower" (cube and
+// prism) and "upper" (pyramid and tetrahedron, in that order in the file), a physical
+// surface "front" (a quadrangle on the prism). Each solid is its canonical degenerate
+// hexahedron in Gmsh's node order, of the right volume with its faces pointing out.
+void expect_mixed_gmsh(const Mesh& m) {
+  ASSERT_EQ(m.num_nodes(), 12);
+  ASSERT_EQ(m.num_elements(), 4);
+  ASSERT_EQ(m.blocks.size(), 2u);
+  EXPECT_EQ(m.blocks[0].name, "lower");
+  EXPECT_EQ(m.blocks[1].name, "upper");
+  EXPECT_EQ(m.blocks[0].ids, (std::vector<std::int64_t>{1, 2}));
+  EXPECT_EQ(m.blocks[1].ids, (std::vector<std::int64_t>{4, 3}));
+  const std::vector<Hex> lower = {
+      {0, 1, 2, 3, 4, 5, 6, 7}, // hexahedron 1-8
+      {1, 8, 2, 2, 5, 9, 6, 6}, // prism 2 9 3 6 10 7: a b c c d e f f
+  };
+  const std::vector<Hex> upper = {
+      {4, 5, 6, 7, 11, 11, 11, 11}, // pyramid 5 6 7 8 12: a b c d e e e e
+      {5, 9, 6, 6, 10, 10, 10, 10}, // tetrahedron 6 10 7 11: a b c c d d d d
+  };
+  EXPECT_EQ(m.blocks[0].elements, lower);
+  EXPECT_EQ(m.blocks[1].elements, upper);
+  expect_solid(m, m.blocks[0].elements[0], Shape::hexahedron, 1.0);
+  expect_solid(m, m.blocks[0].elements[1], Shape::wedge, 0.5);         // 1/2 base x height
+  expect_solid(m, m.blocks[1].elements[0], Shape::pyramid, 1.0 / 3.0); // 1/3 base x height
+  expect_solid(m, m.blocks[1].elements[1], Shape::tetrahedron, 1.0 / 6.0);
+  EXPECT_EQ(m.node_sets.at("front"), (std::vector<std::int64_t>{1, 5, 8, 9}));
+  EXPECT_EQ(m.node_sets.at("lower"), (std::vector<std::int64_t>{0, 1, 2, 3, 4, 5, 6, 7, 8, 9}));
+  EXPECT_EQ(m.node_sets.at("upper"), (std::vector<std::int64_t>{4, 5, 6, 7, 9, 10, 11}));
+}
+
+TEST(ReadGmsh, MixedSolidsAsCanonicalHexahedra) {
+  SCOPED_TRACE("4.1");
+  expect_mixed_gmsh(read_gmsh(data("mixed_solids.msh")));
+}
+
+TEST(ReadGmsh, MixedSolidsMsh22ReadsLike41) {
+  const Mesh a = read_gmsh(data("mixed_solids.msh"));
+  const Mesh b = read_gmsh(data("mixed_solids_v22.msh"));
+  expect_mixed_gmsh(b);
+  expect_same_mesh(a, b);
+}
+
+// Higher orders by their corners (Gmsh numbers the vertices first): a 10-node tetrahedron
+// (type 11), a 15-node prism (type 18) and a 13-node pyramid (type 19), with their other
+// nodes anywhere, read as the linear ones.
+TEST(ReadGmsh, HigherOrderSolidsByTheirCorners) {
+  std::string nodes;
+  const double corner[9][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1},    {1, 0, 1},
+                               {0, 1, 1}, {1, 1, 0}, {1, 1, 1}, {0.5, 0.5, 3}};
+  for (int i = 0; i < 9; ++i)
+    nodes += fmt::format("{} {} {} {}\n", i + 1, corner[i][0], corner[i][1], corner[i][2]);
+  for (int i = 10; i <= 30; ++i) nodes += fmt::format("{} 9 9 {}\n", i, i); // the others
+  // tetrahedron 1 2 3 4; prism 1 2 3 and 4 5 6 above; pyramid base 4 5 8 6, apex 9.
+  std::string tet = "1 11 2 1 1 1 2 3 4", prism = "2 18 2 1 1 1 2 3 4 5 6",
+              pyramid = "3 19 2 1 1 4 5 8 6 9";
+  for (int i = 0; i < 6; ++i) tet += fmt::format(" {}", 10 + i);
+  for (int i = 0; i < 9; ++i) prism += fmt::format(" {}", 10 + i);
+  for (int i = 0; i < 8; ++i) pyramid += fmt::format(" {}", 20 + i);
+  const std::string text = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n30\n" + nodes +
+                           "$EndNodes\n$Elements\n3\n" + tet + "\n" + prism + "\n" + pyramid +
+                           "\n$EndElements\n";
+  const Mesh m = parse_gmsh(text, "high.msh");
+  ASSERT_EQ(m.num_elements(), 3);
+  EXPECT_EQ(m.blocks[0].elements[0], (Hex{0, 1, 2, 2, 3, 3, 3, 3}));
+  EXPECT_EQ(m.blocks[0].elements[1], (Hex{0, 1, 2, 2, 3, 4, 5, 5}));
+  EXPECT_EQ(m.blocks[0].elements[2], (Hex{3, 4, 7, 5, 8, 8, 8, 8}));
+  expect_solid(m, m.blocks[0].elements[0], Shape::tetrahedron, 1.0 / 6.0);
+  expect_solid(m, m.blocks[0].elements[1], Shape::wedge, 0.5);
+  expect_solid(m, m.blocks[0].elements[2], Shape::pyramid, 2.0 / 3.0);
 }
 
 // A minimal MSH 4.1 file: one volume entity with the given physical tags (space
@@ -555,13 +822,17 @@ std::vector<Case> malformed_gmsh() {
        replace("3 1 5 4\n12 ", "3 1 5 4\n1x2 "),
        {"$Elements", "element tag must be an integer"}},
       {"unknown element type", replace("3 1 5 4", "3 1 99 4"), {"unknown element type 99"}},
-      {"tetrahedra in a volume",
-       replace("3 2 5 4\n16 5 17 26 20 9 21 27 24", "3 2 4 4\n16 5 17 26 20"),
-       {"m.msh:169:", "volume 2 (physical volume 'upper')", "4-node tetrahedron", "type 4"}},
+      {"tetrahedron naming a node twice",
+       replace("3 2 5 4\n16 5 17 26 20 9 21 27 24", "3 2 4 4\n16 5 17 26 26"),
+       {"m.msh:170:", "element 16 (4-node tetrahedron, type 4) uses node 26 twice (corners 3 "
+                      "and 4)"}},
+      {"unknown 3-D element type",
+       replace("3 2 5 4\n16 5 17 26 20 9 21 27 24", "3 2 33 4\n16 5 17 26 20 9 21 27 24"),
+       {"m.msh:169:", "unknown element type 33"}},
       {"hexahedron in a surface", replace("2 1 3 4", "2 1 5 4"), {"type 5) in surface 1"}},
       {"degenerate hexahedron",
        replace("12 1 13 25 16 5 17 26 20", "12 1 13 25 16 5 17 26 26"),
-       {"m.msh:", "$Elements", "element 12 uses node 26 twice (N7 and N8)", "degenerate"}},
+       {"m.msh:", "$Elements", "element 12 repeats nodes", "N7 = N8", "node 26"}},
       {"undefined node",
        replace("12 1 13 25 16 5 17 26 20", "12 1 13 25 16 5 17 26 99"),
        {"node 99 is not defined"}},
@@ -731,6 +1002,34 @@ TEST(ReadersDeck, CheckReadsExodusAndGmsh) {
   }
 }
 
+// Tetrahedra, prisms and pyramids mixed with hexahedra pass the setup: counts, and the
+// mass of the solids' volumes (2 m^3 in the Gmsh files, 2.5 in the Exodus one).
+TEST(ReadersDeck, CheckReadsMixedSolids) {
+  TempDir dir;
+  struct File {
+    const char* name;
+    const char* set; // a node set of the file, fixed
+    const char* elements;
+    const char* mass;
+  };
+  for (const File& f : {File{"mixed_solids.msh", "box.front",
+                             "4 (1 hexahedron, 1 wedge, 1 pyramid, 1 tetrahedron)", "15700"},
+                        File{"mixed_solids_v22.msh", "box.front",
+                             "4 (1 hexahedron, 1 wedge, 1 pyramid, 1 tetrahedron)", "15700"},
+                        File{"mixed_solids.exo", "box.apex",
+                             "5 (1 hexahedron, 2 wedges, 1 pyramid, 1 tetrahedron)", "19625"}}) {
+    SCOPED_TRACE(f.name);
+    fs::copy_file(data(f.name), dir.path / f.name);
+    write(dir.path / "deck.yaml", deck_for(f.name, f.set));
+    const CheckRun r = anvil_check(dir.file("deck.yaml"));
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find(fmt::format("elements    {}\n", f.elements)), std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find(fmt::format("mass {} kg", f.mass)), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("deck and mesh are valid"), std::string::npos) << r.output;
+  }
+}
+
 // A set a file part does not have: the error lists the sets its file gave it (QA round
 // 16: it listed none, where a generated part's error lists its own).
 TEST(ReadersDeck, UnknownSetOfAFilePartListsItsSets) {
@@ -802,15 +1101,15 @@ TEST(ReadersDeck, BadMeshFilesExitWithStatusTwo) {
   std::mt19937 rng(11);
   for (auto& c : garbage) c = static_cast<char>(rng());
   const std::vector<BadFile> files = {
-      {"tet.exo", slurp(data("bad_tet_block.exo")), "TETRA"},
+      {"tet.exo", slurp(data("bad_tet_block.exo")), "a tetrahedron has sides 1 to 4"},
       {"nodes.exo", slurp(data("bad_node_range.exo")), "node 28"},
       {"truncated.exo", slurp(data("box_2x2x2.exo")).substr(0, 1500), "truncated.exo"},
       {"garbage.exo", garbage, "garbage.exo"},
       {"empty.msh", "", "empty"},
       {"garbage.msh", garbage, "garbage.msh:"},
       {"truncated.msh", good.substr(0, good.size() / 2), "truncated?"},
-      {"tet.msh", good.substr(0, good.find("3 1 5 4")) + "3 1 4 1\n12 1 13 25 16\n$EndElements\n",
-       "tetrahedron"},
+      {"tet.msh", good.substr(0, good.find("3 1 5 4")) + "3 1 4 1\n12 1 13 25 25\n$EndElements\n",
+       "tetrahedron, type 4) uses node 25 twice"},
       {"model.k", "*KEYWORD\n*NODE\n1 x\n", "model.k:3: *NODE.NID"},
       {"model.inp", "*HEADING\n", "unknown format"},
   };

@@ -6,9 +6,11 @@ namespace anvil {
 
 ExteriorFaces exterior_faces(const Mesh& mesh, const std::vector<bool>& selected,
                              const std::vector<bool>& erodible) {
-  // Sort every face of every element by its sorted node ids; a key seen once is exterior.
+  // Sort every face of every element by its key (face_key); a key seen once is exterior.
+  // (The faces of wedges, pyramids and tetrahedra that collapsed to an edge or a point
+  // are no faces.)
   struct Key {
-    std::array<std::int64_t, 4> sorted;
+    FaceKey sorted;
     std::int64_t element;
     int side;
   };
@@ -17,12 +19,8 @@ ExteriorFaces exterior_faces(const Mesh& mesh, const std::vector<bool>& selected
   std::int64_t e = 0;
   for (const auto& b : mesh.blocks)
     for (const auto& h : b.elements) {
-      for (int s = 0; s < 6; ++s) {
-        Key k{
-            {h[hex_faces[s][0]], h[hex_faces[s][1]], h[hex_faces[s][2]], h[hex_faces[s][3]]}, e, s};
-        std::sort(k.sorted.begin(), k.sorted.end());
-        keys.push_back(k);
-      }
+      for (int s = 0; s < 6; ++s)
+        if (const FaceKey k = face_key(h, s); is_face(k)) keys.push_back({k, e, s});
       ++e;
     }
   std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
@@ -67,8 +65,7 @@ ExteriorFaces exterior_faces(const Mesh& mesh, const std::vector<bool>& selected
     out.element.push_back(el);
     out.side.push_back(s);
     out.behind.push_back(behind);
-    out.nodes.push_back(
-        {h[hex_faces[s][0]], h[hex_faces[s][1]], h[hex_faces[s][2]], h[hex_faces[s][3]]});
+    out.nodes.push_back(face_nodes(h, s));
     for (int a = 0; a < 4; ++a) out.contact_nodes.push_back(out.nodes.back()[a]);
   }
   std::sort(out.contact_nodes.begin(), out.contact_nodes.end());

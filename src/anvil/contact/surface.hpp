@@ -1,5 +1,6 @@
-// Contact surfaces: the exterior quadrilateral faces of hexahedral parts (faces that
-// belong to exactly one element of the whole mesh) and the nodes on them.
+// Contact surfaces: the exterior faces of the solid parts (faces that belong to exactly
+// one element of the whole mesh; quadrilaterals, and the triangles of wedges, pyramids
+// and tetrahedra) and the nodes on them.
 #pragma once
 
 #include <array>
@@ -12,7 +13,8 @@ namespace anvil {
 
 struct ExteriorFaces {
   // Face f: element `element[f]` (global id), its side `side[f]` (index into hex_faces),
-  // nodes `nodes[f]` (global ids, counter-clockwise seen from outside). Ordered by
+  // nodes `nodes[f]` (global ids, counter-clockwise seen from outside; a triangle's third
+  // node twice, at places 2 and 3, as face_nodes() gives them). Ordered by
   // (element, side): the position is the face's global id.
   std::vector<std::int64_t> element;
   std::vector<int> side;
@@ -26,7 +28,7 @@ struct ExteriorFaces {
 };
 
 // Exterior faces of the blocks with `selected[b]` true. A face is exterior when no other
-// element of the whole mesh (any block) has the same four nodes. With `erodible` (per
+// element of the whole mesh (any block) has the same nodes (face_key). With `erodible` (per
 // block; empty: none), also the faces between two elements of which one is erodible:
 // the faces erosion may expose (LS-DYNA's eroding contact), `behind` their neighbour.
 ExteriorFaces exterior_faces(const Mesh& mesh, const std::vector<bool>& selected,

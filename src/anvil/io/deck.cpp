@@ -400,7 +400,10 @@ MaterialConfig parse_material(const std::string& name, const Node& n) {
 double generated_elements(const MeshConfig& mc) {
   switch (mc.kind) {
   case MeshConfig::Kind::box:
-    return 1.0 * mc.box.divisions[0] * mc.box.divisions[1] * mc.box.divisions[2];
+    return (mc.box.shape == Shape::tetrahedron ? 6.0
+            : mc.box.shape == Shape::wedge     ? 2.0
+                                               : 1.0) *
+           mc.box.divisions[0] * mc.box.divisions[1] * mc.box.divisions[2];
   case MeshConfig::Kind::cylinder: {
     const double c = std::max(1, mc.cylinder.divisions[0] / 2), n = 2 * c;
     const double ring = mc.cylinder.divisions[0] - c;
@@ -435,11 +438,22 @@ MeshConfig parse_mesh(const Node& n, const std::string& base_dir) {
   }
   const std::string gen = n.required("generate").str();
   if (gen == "box") {
-    n.check_keys({"generate", "min", "max", "divisions"});
+    n.check_keys({"generate", "min", "max", "divisions", "elements"});
     mc.kind = MeshConfig::Kind::box;
     mc.box.min = n.required("min").vec3();
     mc.box.max = n.required("max").vec3();
     mc.box.divisions = n.required("divisions").positive_ints<3>();
+    if (n.has("elements")) {
+      const std::string e = n.child("elements").str();
+      if (e == "wedges")
+        mc.box.shape = Shape::wedge;
+      else if (e == "tetrahedra")
+        mc.box.shape = Shape::tetrahedron;
+      else if (e != "hexahedra")
+        n.child("elements")
+            .fail(
+                fmt::format("unknown elements '{}' (expected hexahedra, wedges or tetrahedra)", e));
+    }
     for (int i = 0; i < 3; ++i)
       if (!(mc.box.max[i] > mc.box.min[i]))
         n.child("max").fail("max must exceed min in every direction");

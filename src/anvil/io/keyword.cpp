@@ -1030,15 +1030,16 @@ private:
       }
       if (!one_line && (nc.integer(8, "N9", 0) != 0 || nc.integer(9, "N10", 0) != 0))
         nc.fail("N9", fmt::format("element {} has more than 8 nodes; anvil reads 8-node "
-                                  "hexahedra only",
+                                  "solids only (no 10-node tetrahedra)",
                                   e.eid));
       if (given < 8)
         nc.fail(fmt::format("N{}", given + 1),
-                fmt::format("element {} has {} nodes; anvil reads 8-node hexahedra only (no "
-                            "tetrahedra or other solids)",
+                fmt::format("element {} has {} nodes; anvil reads 8-node solids (write a "
+                            "tetrahedron N1 N2 N3 N4 N4 N4 N4 N4, a pentahedron N1 N2 N3 N4 N5 "
+                            "N5 N6 N6, as LS-DYNA does)",
                             e.eid, given));
       int corner = 0;
-      if (const std::string why = degenerate_hex(e.nodes, e.eid, &corner); !why.empty())
+      if (const std::string why = canonical_hex(e.nodes, e.eid, &corner); !why.empty())
         nc.fail(fmt::format("N{}", corner + 1), why);
       const auto [it, fresh] = element_index_.emplace(e.eid, elements_.size());
       if (!fresh)
@@ -2128,46 +2129,42 @@ private:
     }
     if (segment_loads_.empty()) return;
 
-    // Every face of every element, by its sorted node positions, for the segments' lookup.
-    struct FaceKey {
-      std::array<std::int64_t, 4> sorted;
+    // Every face of every element, by its face_key, for the segments' lookup.
+    struct Face {
+      FaceKey sorted;
       std::int64_t element;
       int face;
     };
-    std::vector<FaceKey> faces;
+    std::vector<Face> faces;
     std::int64_t gid = 0;
     for (const auto& blk : mesh.blocks)
       for (const auto& h : blk.elements) {
-        for (int f = 0; f < 6; ++f) {
-          FaceKey k{{}, gid, f};
-          for (int a = 0; a < 4; ++a) k.sorted[a] = h[hex_faces[f][a]];
-          std::sort(k.sorted.begin(), k.sorted.end());
-          faces.push_back(k);
-        }
+        for (int f = 0; f < 6; ++f)
+          if (const FaceKey k = face_key(h, f); is_face(k)) faces.push_back({k, gid, f});
         ++gid;
       }
-    std::sort(faces.begin(), faces.end(), [](const FaceKey& a, const FaceKey& b) {
+    std::sort(faces.begin(), faces.end(), [](const Face& a, const Face& b) {
       return std::tie(a.sorted, a.element, a.face) < std::tie(b.sorted, b.element, b.face);
     });
     const auto offsets = mesh.block_offsets();
     // The face a segment is (of the lowest element that has it), and whether the segment
-    // runs the other way round.
+    // runs the other way round. A triangle is N1 N2 N3 N3 (LS-DYNA's triangular segment),
+    // a triangular face of a wedge, pyramid or tetrahedron.
     auto face_of = [&](const std::array<std::int64_t, 4>& ids, const Where& at,
                        const std::string& key) -> std::pair<SideEntry, bool> {
       std::array<std::int64_t, 4> pos{};
       for (int a = 0; a < 4; ++a)
         pos[a] = node_position(ids[a], at, fmt::format("{}.N{}", key, a + 1), "the segment");
-      std::array<std::int64_t, 4> sorted = pos;
-      std::sort(sorted.begin(), sorted.end());
-      if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
+      const FaceKey sorted = face_key(pos);
+      const std::array<std::int64_t, 4> seg = face_nodes(pos);
+      if (!is_face(sorted) || (sorted[0] < 0 && seg[2] != seg[3]))
         throw InputError(at.loc(key + ".N4"),
-                         fmt::format("segment ({}, {}, {}, {}) repeats a node: triangular "
-                                     "segments are not supported (anvil's faces are the "
-                                     "quadrilaterals of hexahedra)",
+                         fmt::format("segment ({}, {}, {}, {}) repeats a node other than as a "
+                                     "triangle N1 N2 N3 N3",
                                      ids[0], ids[1], ids[2], ids[3]));
-      const auto it = std::lower_bound(
-          faces.begin(), faces.end(), sorted,
-          [](const FaceKey& f, const std::array<std::int64_t, 4>& k) { return f.sorted < k; });
+      const auto it =
+          std::lower_bound(faces.begin(), faces.end(), sorted,
+                           [](const Face& f, const FaceKey& k) { return f.sorted < k; });
       if (it == faces.end() || it->sorted != sorted)
         throw InputError(at.loc(key + ".N1"),
                          fmt::format("segment ({}, {}, {}, {}) is not a face of a solid "
@@ -2176,11 +2173,12 @@ private:
       const auto b = static_cast<std::size_t>(
           std::upper_bound(offsets.begin(), offsets.end(), it->element) - offsets.begin() - 1);
       const Hex& h = mesh.blocks[b].elements[static_cast<std::size_t>(it->element - offsets[b])];
-      std::array<std::int64_t, 4> face{};
-      for (int a = 0; a < 4; ++a) face[a] = h[hex_faces[it->face][a]];
-      const auto k = std::find(face.begin(), face.end(), pos[0]) - face.begin();
-      const bool same = face[(k + 1) % 4] == pos[1] && face[(k + 2) % 4] == pos[2];
-      const bool reversed = face[(k + 3) % 4] == pos[1] && face[(k + 2) % 4] == pos[2];
+      // Both go round their corners (3 or 4) the same way, or the other way round.
+      const std::array<std::int64_t, 4> face = face_nodes(h, it->face);
+      const int n = sorted[0] < 0 ? 3 : 4;
+      const auto k = std::find(face.begin(), face.begin() + n, seg[0]) - face.begin();
+      const bool same = face[(k + 1) % n] == seg[1] && face[(k + 2) % n] == seg[2];
+      const bool reversed = face[(k + n - 1) % n] == seg[1] && face[(k + n - 2) % n] == seg[2];
       if (!same && !reversed)
         throw InputError(at.loc(key + ".N1"),
                          fmt::format("segment ({}, {}, {}, {}) does not go round its face in "
@@ -3739,7 +3737,13 @@ Config KeywordReader::config(const std::string& deck_file) {
                             p.pid, p.secid, other->second.keyword, other->second.at.str())
               : fmt::format("part {}: section {} is not defined (*SECTION_SOLID)", p.pid, p.secid));
     }
-    if (sec->second.elform != 1 && sec->second.elform != 0)
+    // ELFORM 10 (LS-DYNA's one-point tetrahedron) on tetrahedra is what anvil's element is
+    // on a tetrahedron (element.md): no warning.
+    const bool tetrahedra = std::all_of(elements_.begin(), elements_.end(), [&](const auto& e) {
+      return e.pid != p.pid || shape_of(e.nodes) == Shape::tetrahedron;
+    });
+    if (sec->second.elform != 1 && sec->second.elform != 0 &&
+        !(sec->second.elform == 10 && tetrahedra))
       warnings.push_back(fmt::format("{}: section {} asks for ELFORM {}; anvil uses its one-point "
                                      "hexahedron with hourglass control (ELFORM 1) for part {}",
                                      sec->second.at.str(), p.secid, sec->second.elform, p.pid));

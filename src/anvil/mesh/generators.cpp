@@ -83,14 +83,35 @@ Mesh generate_box(const BoxSpec& s) {
         m.nodes[id(i, j, k)] = {lerp(s.min.x, s.max.x, nx, i), lerp(s.min.y, s.max.y, ny, j),
                                 lerp(s.min.z, s.max.z, nz, k)};
       }
+  require(s.shape != Shape::pyramid, "a box is cut into hexahedra, wedges or tetrahedra");
   ElementBlock b{"box", {}, {}};
   b.elements.reserve(static_cast<std::size_t>(nx) * ny * nz);
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i)
-        b.elements.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
-                              id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
-                              id(i, j + 1, k + 1)});
+      for (int i = 0; i < nx; ++i) {
+        const Hex c = {
+            id(i, j, k),     id(i + 1, j, k),     id(i + 1, j + 1, k),     id(i, j + 1, k),
+            id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)};
+        if (s.shape == Shape::hexahedron) {
+          b.elements.push_back(c);
+        } else if (s.shape == Shape::wedge) {
+          b.elements.push_back(wedge_hex(c[0], c[1], c[2], c[4], c[5], c[6]));
+          b.elements.push_back(wedge_hex(c[0], c[2], c[3], c[4], c[6], c[7]));
+        } else {
+          // From corner 0 to corner 6 along the edges, x, y, z in each order: the corners
+          // one and two steps along.
+          constexpr int path[6][2] = {{1, 2}, {1, 5}, {3, 2}, {3, 7}, {4, 5}, {4, 7}};
+          for (const auto& q : path) {
+            const Vec3 a = m.nodes[c[0]], e1 = m.nodes[c[q[0]]] - a, e2 = m.nodes[c[q[1]]] - a,
+                       e3 = m.nodes[c[6]] - a;
+            // a b c counter-clockwise seen from d.
+            if (dot(cross(e1, e2), e3) > 0)
+              b.elements.push_back(tetrahedron_hex(c[0], c[q[0]], c[q[1]], c[6]));
+            else
+              b.elements.push_back(tetrahedron_hex(c[0], c[q[1]], c[q[0]], c[6]));
+          }
+        }
+      }
   m.blocks.push_back(std::move(b));
   for (int k = 0; k <= nz; ++k)
     for (int j = 0; j <= ny; ++j)

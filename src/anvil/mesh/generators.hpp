@@ -8,11 +8,15 @@
 
 namespace anvil {
 
-// Axis-aligned box from `min` to `max` with `divisions` elements per direction.
+// Axis-aligned box from `min` to `max` with `divisions` cells per direction, each cell a
+// hexahedron, or (`shape`) two wedges cut by the plane through its edges along z at
+// (min x, min y) and (max x, max y), or six tetrahedra around its diagonal from
+// (min x, min y, min z) (Kuhn's subdivision: neighbours share whole faces).
 // Node sets: xmin, xmax, ymin, ymax, zmin, zmax.
 struct BoxSpec {
   Vec3 min, max;
   std::array<int, 3> divisions{1, 1, 1};
+  Shape shape = Shape::hexahedron;
 };
 Mesh generate_box(const BoxSpec& spec);
 

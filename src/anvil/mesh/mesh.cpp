@@ -86,16 +86,176 @@ void Mesh::translate(const Vec3& d) {
   for (auto& p : nodes) p += d;
 }
 
-std::string degenerate_hex(const Hex& nodes, std::int64_t id, int* corner) {
-  for (int a = 0; a < 8; ++a)
+Hex tetrahedron_hex(std::int64_t a, std::int64_t b, std::int64_t c, std::int64_t d) {
+  return {a, b, c, c, d, d, d, d};
+}
+
+Hex pyramid_hex(std::int64_t a, std::int64_t b, std::int64_t c, std::int64_t d, std::int64_t e) {
+  return {a, b, c, d, e, e, e, e};
+}
+
+Hex wedge_hex(std::int64_t a, std::int64_t b, std::int64_t c, std::int64_t d, std::int64_t e,
+              std::int64_t f) {
+  return {a, b, c, c, d, e, f, f};
+}
+
+Hex solid_hex(Shape s, const std::int64_t* v) {
+  switch (s) {
+  case Shape::tetrahedron:
+    return tetrahedron_hex(v[0], v[1], v[2], v[3]);
+  case Shape::wedge:
+    return wedge_hex(v[0], v[1], v[2], v[3], v[4], v[5]);
+  case Shape::pyramid:
+    return pyramid_hex(v[0], v[1], v[2], v[3], v[4]);
+  case Shape::hexahedron:
+    break;
+  }
+  return {v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]};
+}
+
+int corner_count(Shape s) {
+  switch (s) {
+  case Shape::tetrahedron:
+    return 4;
+  case Shape::pyramid:
+    return 5;
+  case Shape::wedge:
+    return 6;
+  case Shape::hexahedron:
+    break;
+  }
+  return 8;
+}
+
+namespace {
+
+// For each corner, the first corner with the same node.
+std::array<int, 8> repeats(const Hex& h) {
+  std::array<int, 8> rep{};
+  for (int a = 0; a < 8; ++a) {
+    rep[a] = a;
     for (int k = 0; k < a; ++k)
-      if (nodes[a] == nodes[k]) {
-        if (corner) *corner = a;
-        return fmt::format("element {} uses node {} twice (N{} and N{}): degenerate hexahedra "
-                           "(wedges and tetrahedra written as hexahedra) are not supported",
-                           id, nodes[a], k + 1, a + 1);
+      if (h[a] == h[k]) {
+        rep[a] = k;
+        break;
       }
-  return {};
+  }
+  return rep;
+}
+
+constexpr std::array<int, 8> hexahedron_pattern = {0, 1, 2, 3, 4, 5, 6, 7};
+constexpr std::array<int, 8> tetrahedron_pattern = {0, 1, 2, 2, 4, 4, 4, 4};
+constexpr std::array<int, 8> pyramid_pattern = {0, 1, 2, 3, 4, 4, 4, 4};
+constexpr std::array<int, 8> wedge_pattern = {0, 1, 2, 2, 4, 5, 6, 6};
+// LS-DYNA's forms (*ELEMENT_SOLID): tetrahedron N1 N2 N3 N4 N4 N4 N4 N4, pentahedron
+// N1 N2 N3 N4 N5 N5 N6 N6 (a wedge lying on its quadrilateral N1-N4; its triangles are
+// N1 N2 N5 and N4 N3 N6).
+constexpr std::array<int, 8> dyna_tetrahedron_pattern = {0, 1, 2, 3, 3, 3, 3, 3};
+constexpr std::array<int, 8> dyna_pentahedron_pattern = {0, 1, 2, 3, 4, 4, 6, 6};
+
+} // namespace
+
+Shape shape_of(const Hex& h) {
+  const auto rep = repeats(h);
+  if (rep == tetrahedron_pattern) return Shape::tetrahedron;
+  if (rep == pyramid_pattern) return Shape::pyramid;
+  if (rep == wedge_pattern) return Shape::wedge;
+  return Shape::hexahedron;
+}
+
+const char* shape_name(Shape s, bool plural) {
+  switch (s) {
+  case Shape::wedge:
+    return plural ? "wedges" : "wedge";
+  case Shape::pyramid:
+    return plural ? "pyramids" : "pyramid";
+  case Shape::tetrahedron:
+    return plural ? "tetrahedra" : "tetrahedron";
+  case Shape::hexahedron:
+    break;
+  }
+  return plural ? "hexahedra" : "hexahedron";
+}
+
+int vtk_cell(const Hex& h, std::array<std::int64_t, 8>& out, int& n) {
+  switch (shape_of(h)) {
+  case Shape::tetrahedron:
+    n = 4;
+    out = {h[0], h[1], h[2], h[4]};
+    return 10;
+  case Shape::pyramid:
+    n = 5;
+    out = {h[0], h[1], h[2], h[3], h[4]};
+    return 14;
+  case Shape::wedge:
+    n = 6;
+    out = {h[0], h[2], h[1], h[4], h[6], h[5]};
+    return 13;
+  case Shape::hexahedron:
+    break;
+  }
+  n = 8;
+  out = h;
+  return 12;
+}
+
+std::string canonical_hex(Hex& n, std::int64_t id, int* corner) {
+  const auto rep = repeats(n);
+  if (rep == hexahedron_pattern || rep == tetrahedron_pattern || rep == pyramid_pattern ||
+      rep == wedge_pattern)
+    return {};
+  if (rep == dyna_tetrahedron_pattern) {
+    n = tetrahedron_hex(n[0], n[1], n[2], n[3]);
+    return {};
+  }
+  if (rep == dyna_pentahedron_pattern) {
+    // Seen from outside the triangle N1 N2 N5 runs counter-clockwise, so from inside
+    // (from N4 N3 N6) N1 N5 N2 does.
+    n = wedge_hex(n[0], n[4], n[1], n[3], n[6], n[2]);
+    return {};
+  }
+  std::string equal;
+  int first = -1;
+  for (int a = 0; a < 8; ++a)
+    if (rep[a] != a) {
+      if (first < 0) first = a;
+      equal += fmt::format("{}N{} = N{}", equal.empty() ? "" : ", ", rep[a] + 1, a + 1);
+    }
+  if (corner) *corner = first;
+  return fmt::format("element {} repeats nodes as no solid anvil reads does ({}; node {}): a "
+                     "tetrahedron is N4 = N5 = N6 = N7 = N8 (or N3 = N4 and N5 = N6 = N7 = N8), "
+                     "a pyramid N5 = N6 = N7 = N8, a pentahedron N5 = N6 and N7 = N8 (or N3 = N4 "
+                     "and N7 = N8)",
+                     id, equal, n[static_cast<std::size_t>(first)]);
+}
+
+FaceKey face_key(std::array<std::int64_t, 4> k) {
+  std::sort(k.begin(), k.end());
+  const auto end = std::unique(k.begin(), k.end());
+  const auto distinct = end - k.begin();
+  std::rotate(k.begin(), end, k.end()); // the distinct ones last
+  std::fill(k.begin(), k.begin() + (4 - distinct), -1);
+  return k;
+}
+
+FaceKey face_key(const Hex& h, int f) {
+  const auto& q = hex_faces[static_cast<std::size_t>(f)];
+  return face_key({h[q[0]], h[q[1]], h[q[2]], h[q[3]]});
+}
+
+std::array<std::int64_t, 4> face_nodes(const std::array<std::int64_t, 4>& q) {
+  for (int k = 0; k < 4; ++k)
+    if (q[k] == q[(k + 1) % 4]) { // a triangle (or less): its repeat to places 2 and 3
+      std::array<std::int64_t, 4> r;
+      for (int m = 0; m < 4; ++m) r[m] = q[(k + 2 + m) % 4];
+      return r;
+    }
+  return q;
+}
+
+std::array<std::int64_t, 4> face_nodes(const Hex& h, int f) {
+  const auto& q = hex_faces[static_cast<std::size_t>(f)];
+  return face_nodes({h[q[0]], h[q[1]], h[q[2]], h[q[3]]});
 }
 
 std::uint64_t mesh_fingerprint(const Mesh& mesh) {
@@ -222,20 +382,13 @@ void orient_thickness_zeta(Mesh& mesh, std::size_t b) {
   // turned by the mesh, not by their sizes: a cube's three sizes tie, and round-off in
   // its corners would pick the thickness (QA round 7: on a wall of 2 mm cubes some
   // elements bent through their hourglass modes, 40% of the work).
-  using FaceKey = std::array<std::int64_t, 4>;
-  auto key = [](const Hex& h, int f) {
-    FaceKey k;
-    for (int m = 0; m < 4; ++m) k[m] = h[hex_faces[f][m]];
-    std::sort(k.begin(), k.end());
-    return k;
-  };
   std::vector<FaceKey> faces;
   faces.reserve(6 * mesh.blocks[b].elements.size());
   for (const Hex& h : mesh.blocks[b].elements)
-    for (int f = 0; f < 6; ++f) faces.push_back(key(h, f));
+    for (int f = 0; f < 6; ++f) faces.push_back(face_key(h, f));
   std::sort(faces.begin(), faces.end());
   auto is_free = [&](const Hex& h, int f) {
-    const auto [lo, hi] = std::equal_range(faces.begin(), faces.end(), key(h, f));
+    const auto [lo, hi] = std::equal_range(faces.begin(), faces.end(), face_key(h, f));
     return hi - lo == 1;
   };
   // Natural direction d's two faces (hex_faces: xi -+ 3, 1; eta -+ 0, 2; zeta -+ 4, 5).

@@ -74,11 +74,54 @@ struct Mesh {
   void translate(const Vec3& d);
 };
 
-// Why a hexahedron that names a node twice is refused, or an empty string when its eight
-// nodes differ: "element 2 uses node 11 twice (N7 and N8): degenerate hexahedra ... are
-// not supported". `nodes` and `id` are numbered as in the file; `corner` (if given) gets
-// the 0-based corner of the repeat. Every mesh reader checks its elements with it.
-std::string degenerate_hex(const Hex& nodes, std::int64_t id, int* corner = nullptr);
+// Solids with fewer than eight corners are hexahedra whose nodes repeat (LS-DYNA's
+// degenerate hexahedra), kept in one canonical form each, whose faces (hex_faces) are the
+// solid's own: a triangle has its repeated node at places 2 and 3 once rotated by
+// face_nodes(), and a face that collapses to an edge or a point is no face (face_key).
+//   tetrahedron a b c d (a b c counter-clockwise seen from d):         a b c c d d d d
+//   pyramid     base a b c d (counter-clockwise seen from apex e):     a b c d e e e e
+//   wedge       a b c, d e f above them (a b c counter-clockwise seen
+//               from d e f; edges a-d, b-e, c-f):                      a b c c d e f f
+enum class Shape : std::uint8_t { hexahedron, wedge, pyramid, tetrahedron };
+Hex tetrahedron_hex(std::int64_t a, std::int64_t b, std::int64_t c, std::int64_t d);
+Hex pyramid_hex(std::int64_t a, std::int64_t b, std::int64_t c, std::int64_t d, std::int64_t e);
+Hex wedge_hex(std::int64_t a, std::int64_t b, std::int64_t c, std::int64_t d, std::int64_t e,
+              std::int64_t f);
+// The canonical hexahedron of a solid from its corners `v` in the letters' order above
+// (Exodus's and Gmsh's order; a hexahedron's 8 as they are), and their number.
+Hex solid_hex(Shape s, const std::int64_t* v);
+int corner_count(Shape s);
+// The shape of a hexahedron in canonical form.
+Shape shape_of(const Hex& h);
+const char* shape_name(Shape s, bool plural = false); // "wedge", "wedges"
+// The solid's own corners in VTK's order, into out[0..n), and its VTK cell type:
+// hexahedron 12 (8 corners), wedge 13 (6: VTK's first triangle runs counter-clockwise
+// seen from outside, so a c b, d f e), pyramid 14 (5), tetrahedron 10 (4).
+int vtk_cell(const Hex& h, std::array<std::int64_t, 8>& out, int& n);
+
+// Reads the eight nodes of a solid element as a mesh file gives them: eight different
+// nodes are a hexahedron; repeated ones must follow one of LS-DYNA's patterns
+// (tetrahedron N4 = N5 = ... = N8, pyramid N5 = ... = N8, pentahedron N5 = N6 and
+// N7 = N8) or anvil's canonical forms above, and are rewritten into the canonical form.
+// Returns why the element is refused (empty when it is read): "element 2 repeats nodes as
+// no solid does (N3 = N7): ...". `id` is the file's element id for the message; `corner`
+// (if given) gets the 0-based corner of the first repeat that does not fit.
+std::string canonical_hex(Hex& nodes, std::int64_t id, int* corner = nullptr);
+
+// Face f of h by its sorted distinct nodes, the missing ones -1 in front: two elements
+// share a face when their keys are equal. is_face() is false for a face that collapsed
+// to an edge or a point (fewer than 3 distinct nodes).
+using FaceKey = std::array<std::int64_t, 4>;
+FaceKey face_key(const Hex& h, int f);
+FaceKey face_key(std::array<std::int64_t, 4> nodes); // of four nodes in any order
+inline bool is_face(const FaceKey& k) {
+  return k[1] >= 0;
+}
+// Face f of h, counter-clockwise seen from outside, in the order contact and pressure
+// read it: a quadrilateral as hex_faces gives it, a triangle turned so that its repeated
+// node is at places 2 and 3.
+std::array<std::int64_t, 4> face_nodes(const Hex& h, int f);
+std::array<std::int64_t, 4> face_nodes(const std::array<std::int64_t, 4>& q); // q in order
 
 // A hash of the nodes' coordinates (their bits) and of every block's connectivity, in
 // global id order: equal for equal meshes, whoever computes it. A checkpoint carries it.

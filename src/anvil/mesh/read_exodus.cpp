@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -13,11 +14,13 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <new>
 #include <optional>
 #include <stdexcept>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include <exodusII.h>
@@ -299,13 +302,64 @@ std::vector<std::int64_t> entity_ids(const ExodusFile& f, ex_entity_type type, s
   return ids;
 }
 
-// Hexahedra by their corners: the first 8 nodes of HEX20 and HEX27 are the corners in
-// the same order as HEX8 (Exodus II manual, element topologies).
-bool is_hex(const std::string& type, std::int64_t nodes_per_element) {
+// The solids anvil reads, by their corners: the first nodes of every higher-order form
+// are the corners in the order of the linear one (Exodus II manual, element topologies).
+// The type is known by its first three letters, as the Exodus library knows it (HEX8 and
+// HEXAHEDRON, TETRA4 and TET4), in any case; the node count tells the form.
+std::optional<Shape> solid_of(const std::string& type, std::int64_t nodes_per_element) {
   std::string t;
-  for (char c : type) t += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  if (t.rfind("HEX", 0) != 0) return false;
-  return nodes_per_element == 8 || nodes_per_element == 20 || nodes_per_element == 27;
+  for (char c : type.substr(0, 3))
+    t += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  const auto n = nodes_per_element;
+  if (t == "HEX" && (n == 8 || n == 20 || n == 27)) return Shape::hexahedron;
+  if (t == "TET" && (n == 4 || n == 8 || n == 10 || n == 14 || n == 15)) return Shape::tetrahedron;
+  if (t == "WED" && (n == 6 || n == 15 || n == 16 || n == 18)) return Shape::wedge;
+  if (t == "PYR" && (n == 5 || n == 13 || n == 14)) return Shape::pyramid;
+  return std::nullopt;
+}
+
+// Exodus's orders are anvil's (solid_hex): TETRA 1 2 3 counter-clockwise seen from 4
+// (side 4 is 1 3 2, outward); WEDGE 1 2 3 counter-clockwise seen from 4 5 6 (side 4 is
+// 1 3 2, side 5 is 4 5 6, both outward), edges 1-4, 2-5, 3-6; PYRAMID base 1 2 3 4
+// counter-clockwise seen from the apex 5 (side 5 is 1 4 3 2, outward).
+
+// The number of Exodus sides of a solid.
+int side_count(Shape s) {
+  return s == Shape::hexahedron ? 6 : s == Shape::tetrahedron ? 4 : 5;
+}
+
+// The face (0..5, hex_faces) of a solid's canonical hexahedron that is Exodus side `side`
+// (1-based) of a tetrahedron, wedge or pyramid: the face with the side's nodes, found by
+// face_key on the canonical hexahedron of corners 0, 1, 2, ... The Exodus sides, by
+// 1-based corner (the Exodus library's side tables, ex_get_side_set_node_list):
+//   TETRA   1: 1 2 4, 2: 2 3 4, 3: 1 4 3, 4: 1 3 2
+//   WEDGE   1: 1 2 5 4, 2: 2 3 6 5, 3: 1 4 6 3, 4: 1 3 2, 5: 4 5 6
+//   PYRAMID 1: 1 2 5, 2: 2 3 5, 3: 3 4 5, 4: 1 5 4, 5: 1 4 3 2
+int side_face(Shape s, int side) {
+  using Sides = std::array<std::array<std::int64_t, 4>, 5>;
+  static constexpr Sides tetra = {{{1, 2, 4, 4}, {2, 3, 4, 4}, {1, 4, 3, 3}, {1, 3, 2, 2}, {}}};
+  static constexpr Sides wedge = {
+      {{1, 2, 5, 4}, {2, 3, 6, 5}, {1, 4, 6, 3}, {1, 3, 2, 2}, {4, 5, 6, 6}}};
+  static constexpr Sides pyramid = {
+      {{1, 2, 5, 5}, {2, 3, 5, 5}, {3, 4, 5, 5}, {1, 5, 4, 4}, {1, 4, 3, 2}}};
+  static const auto faces = [] {
+    std::array<std::array<int, 5>, 3> out{};
+    const std::int64_t corners[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+    const Sides* sides[3] = {&tetra, &wedge, &pyramid};
+    const Shape solids[3] = {Shape::tetrahedron, Shape::wedge, Shape::pyramid};
+    for (int k = 0; k < 3; ++k) {
+      const Hex h = solid_hex(solids[k], corners);
+      for (int i = 0; i < side_count(solids[k]); ++i) {
+        const FaceKey key = face_key((*sides[k])[i]);
+        out[k][i] = -1;
+        for (int f = 0; f < 6; ++f)
+          if (face_key(h, f) == key) out[k][i] = f;
+      }
+    }
+    return out;
+  }();
+  const int k = s == Shape::tetrahedron ? 0 : s == Shape::wedge ? 1 : 2;
+  return faces[k][side - 1];
 }
 
 // Throws unless every id of an id map is positive (Exodus ids are, and the outputs carry
@@ -383,6 +437,14 @@ Mesh read_all(const ExodusFile& f) {
     if (f.has("elem_num_map")) expect_positive_ids(f, element_ids, "elem_num_map", "element");
   }
   std::int64_t elements = 0;
+  // Each block's first element and solid, for the side sets; and the file's hexahedra
+  // that canonical_hex rewrote, by global element.
+  struct BlockSolid {
+    std::int64_t first;
+    Shape solid;
+  };
+  std::vector<BlockSolid> solids;
+  std::unordered_map<std::int64_t, Hex> rewritten;
   for (std::size_t b = 0; b < block_ids.size(); ++b) {
     const std::int64_t bid = block_ids[b];
     const std::string name = block_names[b].empty() ? fmt::format("block_{}", bid) : block_names[b];
@@ -398,11 +460,13 @@ Mesh read_all(const ExodusFile& f) {
     type.back() = '\0';
     const std::string type_name = type.data();
     if (count < 0 || npe < 0) f.fail(label + " has negative counts");
-    const bool hex = is_hex(type_name, npe);
-    if (!hex && count == 0) continue; // nothing to number, nothing to reject
-    if (!hex)
-      f.fail(fmt::format("{} has elements of type {} with {} nodes; anvil reads hexahedra "
-                         "only (HEX/HEX8, or HEX20/HEX27 by their corners)",
+    const auto solid = solid_of(type_name, npe);
+    if (!solid && count == 0) continue; // nothing to number, nothing to reject
+    if (!solid)
+      f.fail(fmt::format("{} has elements of type {} with {} nodes; anvil reads solids only: "
+                         "HEX/HEX8, TETRA/TETRA4, WEDGE/WEDGE6, PYRAMID/PYRAMID5 (and HEX20, "
+                         "HEX27, TETRA8, TETRA10, TETRA14, TETRA15, WEDGE15, WEDGE16, WEDGE18, "
+                         "PYRAMID13, PYRAMID14 by their corners)",
                          label, type_name.empty() ? "(none)" : type_name, npe));
     fits(count, "elements in " + label);
     fits(count * npe, "connectivity entries in " + label);
@@ -416,23 +480,43 @@ Mesh read_all(const ExodusFile& f) {
       std::vector<std::int64_t> conn(static_cast<std::size_t>(count * npe));
       f.check(ex_get_conn(f.id(), EX_ELEM_BLOCK, bid, conn.data(), nullptr, nullptr),
               "the connectivity of " + label);
-      eb.elements.resize(static_cast<std::size_t>(count));
+      const int nc = corner_count(*solid);
       for (std::int64_t e = 0; e < count; ++e)
-        for (int a = 0; a < 8; ++a) {
-          const std::int64_t n = conn[e * npe + a];
+        for (int a = 0; a < nc; ++a) {
+          std::int64_t& n = conn[e * npe + a];
           if (n < 1 || n > nn)
             f.fail(fmt::format("{}: element {} (element {} of the block) uses node {}, but the "
                                "file has nodes 1 to {}",
                                label, elements + e + 1, e + 1, n, nn));
-          eb.elements[e][a] = n - 1;
+          --n; // 0-based from here
         }
+      eb.elements.resize(static_cast<std::size_t>(count));
       for (std::int64_t e = 0; e < count; ++e) {
-        Hex numbers; // the file's node numbers, 1-based
-        for (int a = 0; a < 8; ++a) numbers[a] = eb.elements[e][a] + 1;
-        if (const std::string why = degenerate_hex(numbers, eb.ids[e]); !why.empty())
-          f.fail(label + ": " + why);
+        const std::int64_t* v = &conn[e * npe];
+        if (*solid == Shape::hexahedron) {
+          Hex numbers; // the file's node numbers, 1-based
+          for (int a = 0; a < 8; ++a) numbers[a] = v[a] + 1;
+          if (const std::string why = canonical_hex(numbers, eb.ids[e]); !why.empty())
+            f.fail(label + ": " + why);
+          const Hex given = solid_hex(Shape::hexahedron, v);
+          eb.elements[e] = given;
+          canonical_hex(eb.elements[e], eb.ids[e]); // the same repeats: the same rewrite
+          // A side of a rewritten hexahedron names a face of the file's hexahedron.
+          if (eb.elements[e] != given) rewritten.emplace(elements + e, given);
+          continue;
+        }
+        // A tetrahedron, wedge or pyramid names each of its corners once.
+        for (int a = 1; a < nc; ++a)
+          for (int c = 0; c < a; ++c)
+            if (v[a] == v[c])
+              f.fail(fmt::format("{}: element {} ({} of type {}) uses node {} twice (corners {} "
+                                 "and {})",
+                                 label, eb.ids[e], shape_name(*solid), type_name, v[a] + 1, c + 1,
+                                 a + 1));
+        eb.elements[e] = solid_hex(*solid, v);
       }
     }
+    solids.push_back({elements, *solid});
     elements += count;
     mesh.blocks.push_back(std::move(eb));
   }
@@ -490,10 +574,41 @@ Mesh read_all(const ExodusFile& f) {
       if (elems[i] < 1 || elems[i] > elements)
         f.fail(fmt::format("{} refers to element {}, but the file has elements 1 to {}", label,
                            elems[i], elements));
-      if (sides[i] < 1 || sides[i] > 6)
-        f.fail(fmt::format("{} refers to side {} of element {}; a hexahedron has sides 1 to 6",
-                           label, sides[i], elems[i]));
-      entries.push_back({elems[i] - 1, static_cast<int>(sides[i] - 1)});
+      const std::int64_t e = elems[i] - 1;
+      // The block holding e: the last to start at or before it (an empty block starts
+      // where the next one does).
+      const auto at = std::prev(
+          std::upper_bound(solids.begin(), solids.end(), e,
+                           [](std::int64_t g, const BlockSolid& bs) { return g < bs.first; }));
+      const Shape solid = at->solid;
+      if (sides[i] < 1 || sides[i] > side_count(solid))
+        f.fail(fmt::format("{} refers to side {} of element {}; a {} has sides 1 to {}", label,
+                           sides[i], elems[i], shape_name(solid), side_count(solid)));
+      const int side = static_cast<int>(sides[i]);
+      int face = side - 1;
+      if (solid != Shape::hexahedron) {
+        face = side_face(solid, side);
+      } else {
+        // A hexahedron with repeated nodes: its side must be a face of the solid it is,
+        // found by its nodes where canonical_hex renumbered the corners.
+        const Hex& h = mesh.blocks[static_cast<std::size_t>(at - solids.begin())]
+                           .elements[static_cast<std::size_t>(e - at->first)];
+        const auto it = rewritten.find(e);
+        if (it != rewritten.end()) {
+          const FaceKey key = face_key(it->second, side - 1);
+          face = -1;
+          for (int g = 0; g < 6 && is_face(key); ++g)
+            if (face_key(h, g) == key) face = g;
+        } else if (!is_face(face_key(h, face))) {
+          face = -1;
+        }
+        if (face < 0)
+          f.fail(fmt::format("{} refers to side {} of element {}, a {} written as a "
+                             "hexahedron, whose side {} is none of its faces (it collapses to "
+                             "an edge or a point, or spans two faces)",
+                             label, side, elems[i], shape_name(shape_of(h)), side));
+      }
+      entries.push_back({e, face});
     }
     if (!mesh.side_sets.emplace(name, std::move(entries)).second)
       f.fail(fmt::format("two side sets are named '{}'", name));

@@ -1,4 +1,4 @@
-// Exodus II reader: a hexahedral mesh file (.exo, .e, .g, .gen, .ex2) as a Mesh.
+// Exodus II reader: a mesh file of solids (.exo, .e, .g, .gen, .ex2) as a Mesh.
 #pragma once
 
 #include <string>
@@ -13,13 +13,22 @@ namespace anvil {
 //   InputError,
 // - one ElementBlock per element block, in file order, named from the file or
 //   "block_<id>"; elements keep the file's order, so global element e is the file's
-//   element e+1. HEX/HEX8 blocks are taken as they are; HEX20/HEX27 by their 8 corner
-//   nodes (mid-side nodes stay in `nodes` but no element uses them). Any other type in
-//   a non-empty block is an InputError naming the block and its type; empty blocks of
-//   other types are skipped.
+//   element e+1. HEX/HEX8 blocks are taken as they are (a hexahedron that repeats nodes
+//   is rewritten by canonical_hex, or refused); TETRA/TETRA4, WEDGE/WEDGE6 and
+//   PYRAMID/PYRAMID5 elements become their canonical degenerate hexahedra
+//   (tetrahedron_hex, wedge_hex, pyramid_hex in mesh.hpp), which may mix with hexahedra
+//   in a file. Higher orders are read by their corners (HEX20, HEX27, TETRA8, TETRA10,
+//   TETRA14, TETRA15, WEDGE15, WEDGE16, WEDGE18, PYRAMID13, PYRAMID14; mid-side nodes
+//   stay in `nodes` but no element uses them). The type is known by its first three
+//   letters in any case, as the Exodus library knows it. Any other type in a non-empty
+//   block is an InputError naming the block and its type; empty blocks of other types
+//   are skipped.
 // - node sets as sorted unique ids, named from the file or "nodeset_<id>",
-// - side sets as (element, face) with face = Exodus side - 1 (see hex_faces), in file
-//   order, named from the file or "sideset_<id>".
+// - side sets as (element, face), in file order, named from the file or "sideset_<id>":
+//   face = Exodus side - 1 for a hexahedron (see hex_faces); for a tetrahedron, wedge or
+//   pyramid, and a hexahedron that canonical_hex renumbered, the face of the canonical
+//   hexahedron with the side's nodes (face_key). A side beyond the solid's (a tetrahedron
+//   has 4, a wedge and a pyramid 5) or one that collapses is an InputError.
 // Every problem (not a regular file, unreadable file, not 3-D, ids out of range, duplicate
 // set names) is an InputError naming `path`; the file is closed on every path out.
 Mesh read_exodus(const std::string& path);

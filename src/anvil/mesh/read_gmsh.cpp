@@ -106,10 +106,48 @@ std::optional<ElementType> element_type(std::int64_t type) {
   }
 }
 
-// Hexahedra of any order start with their 8 corners in the order of type 5.
-bool is_hex(std::int64_t type) {
-  return type == 5 || type == 12 || type == 17 || type == 92 || type == 93;
+// The solids anvil reads, by their corners: Gmsh numbers an element's vertices first, in
+// the order of its first-order type, whatever its order (Gmsh reference manual, "Node
+// ordering"), so every order of a solid is read as its first-order form.
+std::optional<Shape> solid_of(std::int64_t type) {
+  switch (type) {
+  case 5:  // 8-node hexahedron
+  case 17: // 20-node
+  case 12: // 27-node
+  case 92: // 64-node
+  case 93: // 125-node
+    return Shape::hexahedron;
+  case 4:  // 4-node tetrahedron
+  case 11: // 10-node
+  case 29: // 20-node
+  case 30: // 35-node
+  case 31: // 56-node
+    return Shape::tetrahedron;
+  case 6:  // 6-node prism
+  case 18: // 15-node
+  case 13: // 18-node
+    return Shape::wedge;
+  case 7:  // 5-node pyramid
+  case 19: // 13-node
+  case 14: // 14-node
+    return Shape::pyramid;
+  default:
+    return std::nullopt;
+  }
 }
+
+// Gmsh's reference elements are anvil's forms as they stand (solid_hex): tetrahedron
+// (0,0,0) (1,0,0) (0,1,0) (0,0,1), the first three counter-clockwise seen from the
+// fourth; prism (0,0,-1) (1,0,-1) (0,1,-1) and the same at z = 1 (edges 0-3, 1-4, 2-5),
+// the bottom triangle counter-clockwise seen from the top one; pyramid base (-1,-1,0)
+// (1,-1,0) (1,1,0) (-1,1,0), counter-clockwise seen from the apex (0,0,1).
+
+// Every 3-D type of element_type() is a solid today; the message stays for any type
+// added there that is not.
+constexpr const char* solids_read =
+    "anvil reads hexahedra (type 5; 17, 12, 92, 93 by their corners), tetrahedra (type 4; "
+    "11, 29, 30, 31 by their corners), prisms (type 6; 18, 13 by their corners) and pyramids "
+    "(type 7; 19, 14 by their corners)";
 
 const char* dim_word(int dim) {
   static constexpr const char* words[4] = {"point", "curve", "surface", "volume"};
@@ -119,7 +157,7 @@ const char* dim_word(int dim) {
 using EntityKey = std::pair<int, std::int64_t>; // (dimension, tag)
 
 struct HexRecord {
-  Hex nodes;          // 0-based node positions
+  Hex nodes;          // 0-based node positions, the canonical hexahedron of any solid
   std::int64_t group; // 3-D physical tag of its block, 0 for none
   std::int64_t tag;   // the element's tag
 };
@@ -468,23 +506,35 @@ private:
                        dim_word(dim)));
     node_ids_.clear();
     for (int a = 0; a < info.nodes; ++a) node_ids_.push_back(node(tokens_[first + a]));
-    if (dim == 3 && !is_hex(type)) {
+    const std::optional<Shape> solid = solid_of(type);
+    if (dim == 3 && !solid) {
       std::string where;
       if (!phys.empty()) where = fmt::format(" in physical volume '{}'", group_name(3, phys[0]));
-      fail(fmt::format("element {}{} is a {} (type {}); anvil reads hexahedra only (type 5, or "
-                       "types 17 and 12 by their corners)",
-                       etag, where, info.name, type));
+      fail(fmt::format("element {}{} is a {} (type {}); {}", etag, where, info.name, type,
+                       solids_read));
     }
     for (const auto p : phys) {
       auto& set = set_nodes_[{dim, p}];
       set.insert(set.end(), node_ids_.begin(), node_ids_.end());
     }
     if (dim != 3) return;
-    Hex tags;
-    for (int a = 0; a < 8; ++a) tags[a] = integer(tokens_[first + a], "a node tag");
-    if (const std::string why = degenerate_hex(tags, etag); !why.empty()) fail(why);
     HexRecord h{{}, phys.empty() ? 0 : phys[0], etag};
-    std::copy_n(node_ids_.begin(), 8, h.nodes.begin());
+    if (solid == Shape::hexahedron) {
+      Hex tags;
+      for (int a = 0; a < 8; ++a) tags[a] = integer(tokens_[first + a], "a node tag");
+      if (const std::string why = canonical_hex(tags, etag); !why.empty()) fail(why);
+      std::copy_n(node_ids_.begin(), 8, h.nodes.begin());
+      canonical_hex(h.nodes, etag); // the same repeats as the tags': the same rewrite
+    } else {
+      // A tetrahedron, prism or pyramid names each of its corners once.
+      const int n = corner_count(*solid);
+      for (int a = 1; a < n; ++a)
+        for (int b = 0; b < a; ++b)
+          if (node_ids_[a] == node_ids_[b])
+            fail(fmt::format("element {} ({}, type {}) uses node {} twice (corners {} and {})",
+                             etag, info.name, type, tokens_[first + a], b + 1, a + 1));
+      h.nodes = solid_hex(*solid, node_ids_.data());
+    }
     // MSH 2 writes an element once per physical group it belongs to: the copies add set
     // membership (done above), not elements.
     if (dedupe && !hex_seen_.emplace(h.nodes, hexes_.size()).second) return;
@@ -514,13 +564,12 @@ private:
         fail(fmt::format("a block of {} elements (type {}) in {} {}: the element type's "
                          "dimension must be the entity's",
                          info->name, type, dim_word(dim), etag));
-      if (dim == 3 && !is_hex(type))
-        fail(fmt::format("a block of {} elements (type {}) in volume {}{}; anvil reads hexahedra "
-                         "only (type 5, or types 17 and 12 by their corners)",
-                         info->name, type, etag,
-                         phys.empty()
-                             ? std::string()
-                             : fmt::format(" (physical volume '{}')", group_name(3, phys[0]))));
+      if (dim == 3 && !solid_of(type))
+        fail(fmt::format(
+            "a block of {} elements (type {}) in volume {}{}; {}", info->name, type, etag,
+            phys.empty() ? std::string()
+                         : fmt::format(" (physical volume '{}')", group_name(3, phys[0])),
+            solids_read));
       const std::int64_t n = count(tokens_[3], "the number of elements in the block");
       seen += n;
       if (seen > total)
@@ -590,8 +639,8 @@ private:
 
   Mesh build(int end_line) {
     if (hexes_.empty())
-      fail_at(end_line, "the file has no hexahedra (element type 5): mesh the volumes with "
-                        "Transfinite and Recombine, and save them (Physical Volume or "
+      fail_at(end_line, "the file has no solid elements (no hexahedra, tetrahedra, prisms or "
+                        "pyramids): mesh the volumes and save them (Physical Volume or "
                         "Mesh.SaveAll)");
     Mesh mesh;
     mesh.nodes = std::move(nodes_);

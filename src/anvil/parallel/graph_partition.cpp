@@ -23,16 +23,24 @@ std::vector<int> partition_elements(const Mesh& mesh, int parts,
   std::vector<idx_t> eptr(static_cast<std::size_t>(ne) + 1), eind, vwgt;
   eind.reserve(static_cast<std::size_t>(ne) * 8);
   if (!block_weight.empty()) vwgt.reserve(static_cast<std::size_t>(ne));
+  // Each element's distinct nodes: wedges, pyramids and tetrahedra (hexahedra whose
+  // nodes repeat) share triangles, 3 nodes, with their neighbours; two elements that
+  // share 3 nodes share a face, since hexahedra share 4 or at most 2.
+  bool triangles = false;
   std::size_t e = 0;
   for (std::size_t b = 0; b < mesh.blocks.size(); ++b)
     for (const auto& h : mesh.blocks[b].elements) {
       eptr[e++] = static_cast<idx_t>(eind.size());
-      for (auto n : h) eind.push_back(static_cast<idx_t>(n));
+      for (int a = 0; a < 8; ++a)
+        if (std::find(h.begin(), h.begin() + a, h[a]) == h.begin() + a)
+          eind.push_back(static_cast<idx_t>(h[a]));
+        else
+          triangles = true;
       if (!block_weight.empty()) vwgt.push_back(static_cast<idx_t>(std::max(1, block_weight[b])));
     }
   eptr[e] = static_cast<idx_t>(eind.size());
   idx_t n_el = static_cast<idx_t>(ne), n_nodes = static_cast<idx_t>(mesh.num_nodes());
-  idx_t ncommon = 4, nparts = parts, objval = 0;
+  idx_t ncommon = triangles ? 3 : 4, nparts = parts, objval = 0;
   idx_t options[METIS_NOPTIONS];
   METIS_SetDefaultOptions(options);
   options[METIS_OPTION_NUMBERING] = 0;
@@ -50,15 +58,15 @@ std::vector<int> partition_elements(const Mesh& mesh, int parts,
 }
 
 long long partition_cut(const Mesh& mesh, const std::vector<int>& part) {
-  // Faces keyed by their sorted node ids; a face seen twice joins two elements.
-  std::map<std::array<std::int64_t, 4>, std::int64_t> faces;
+  // Faces by face_key; a face seen twice joins two elements.
+  std::map<FaceKey, std::int64_t> faces;
   long long cut = 0;
   std::int64_t e = 0;
   for (const auto& b : mesh.blocks)
     for (const auto& h : b.elements) {
-      for (const auto& f : hex_faces) {
-        std::array<std::int64_t, 4> k = {h[f[0]], h[f[1]], h[f[2]], h[f[3]]};
-        std::sort(k.begin(), k.end());
+      for (int f = 0; f < 6; ++f) {
+        const FaceKey k = face_key(h, f);
+        if (!is_face(k)) continue;
         auto [it, fresh] = faces.emplace(k, e);
         if (!fresh && part[it->second] != part[e]) ++cut;
       }

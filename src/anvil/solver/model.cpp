@@ -143,8 +143,18 @@ Mesh build_mesh(const Config& config) {
       }
     }
   }
-  for (std::size_t b = 0; b < config.parts.size(); ++b)
-    if (config.parts[b].thick_shell.enabled()) orient_thickness_zeta(mesh, b);
+  for (std::size_t b = 0; b < config.parts.size(); ++b) {
+    if (!config.parts[b].thick_shell.enabled()) continue;
+    const auto& elements = mesh.blocks[b].elements;
+    for (std::size_t e = 0; e < elements.size(); ++e)
+      if (const Shape shape = shape_of(elements[e]); shape != Shape::hexahedron)
+        throw InputError(config.parts[b].where,
+                         fmt::format("part {} is a thick shell, and its element {} is a {}: "
+                                     "thick shells are hexahedra",
+                                     config.parts[b].name, mesh.blocks[b].id(e),
+                                     shape_name(shape)));
+    orient_thickness_zeta(mesh, b);
+  }
   return mesh;
 }
 
@@ -177,18 +187,12 @@ std::vector<std::int64_t> elements_holding(const Mesh& mesh, std::span<const std
   if (elements == 0 || !(extent > 0) || points.empty()) return holder;
   // The faces of these blocks that bound them (one element's, not two): a point on such a
   // face touches the body; a point on a face between two elements is inside it.
-  auto face_key = [](const Hex& e, int f) {
-    std::array<std::int64_t, 4> k;
-    for (int a = 0; a < 4; ++a) k[a] = e[hex_faces[static_cast<std::size_t>(f)][a]];
-    std::sort(k.begin(), k.end());
-    return k;
-  };
-  std::vector<std::array<std::int64_t, 4>> faces;
+  std::vector<FaceKey> faces;
   for (std::size_t b : blocks)
     for (const Hex& e : mesh.blocks[b].elements)
       for (int f = 0; f < 6; ++f) faces.push_back(face_key(e, f));
   std::sort(faces.begin(), faces.end());
-  auto bounding = [&](const std::array<std::int64_t, 4>& k) {
+  auto bounding = [&](const FaceKey& k) {
     const auto [lo, hi] = std::equal_range(faces.begin(), faces.end(), k);
     return hi - lo == 1;
   };
@@ -217,7 +221,10 @@ std::vector<std::int64_t> elements_holding(const Mesh& mesh, std::span<const std
         const Vec3 n = cross(x[q[2]] - x[q[0]], x[q[3]] - x[q[1]]);
         const double len = norm(n);
         normal[f] = len > 0 ? n * (1 / len) : n;
-        margin[f] = bounding(face_key(e, f)) ? -tol : tol;
+        const FaceKey k = face_key(e, f); // (a collapsed face of a wedge, ...: no plane)
+        margin[f] = !is_face(k)   ? std::numeric_limits<double>::infinity()
+                    : bounding(k) ? -tol
+                                  : tol;
       }
       const std::int64_t l[3] = {key(bb.lo.x), key(bb.lo.y), key(bb.lo.z)};
       const std::int64_t h[3] = {key(bb.hi.x), key(bb.hi.y), key(bb.hi.z)};

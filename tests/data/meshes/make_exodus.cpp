@@ -139,6 +139,80 @@ void write_hex20(const std::string& path) {
   check(ex_close(id), "ex_close");
 }
 
+// Solids of every shape anvil reads, in blocks of their own, sharing nodes as a mixed
+// mesh does (tests/data/meshes/mixed_solids.msh is the same mesh as Gmsh writes it, less
+// the last block):
+//   block 1 "hex"  HEX8     the unit cube [0,1]^3 (nodes 1-8)
+//   block 2        wedge    (lower case) on the cube's face x = 1: triangle (1,0) (2,0)
+//                           (1,1) from z = 0 to 1, nodes 2 9 3 and 6 10 7 (volume 1/2)
+//   block 3        TETRA10  on the wedge: 6 10 7 and 11 = (1,0,2) (volume 1/6), mid-edge
+//                           nodes 13-18 (unused)
+//   block 4        PYRAMID  on the cube: base 5 6 7 8, apex 12 = (0.5,0.5,2) (volume 1/3)
+//   block 5        HEX8     a wedge written as LS-DYNA writes one (N5 = N6, N7 = N8) on
+//                           [3,4] x [0,1] x [0,1]: base 19 20 21 22 at z = 0, 23 = (3,0,1)
+//                           and 24 = (3,1,1) (volume 1/2)
+// Element ids 10, 20, 30, 40, 50. Side set 1 "faces" names every side of the wedge, the
+// tetrahedron and the pyramid, side 6 of the cube and sides 5 and 1 of the LS-DYNA wedge;
+// node set 1 "apex" the pyramid's apex.
+void write_mixed(const std::string& path) {
+  const int id = create(path);
+  check(ex_put_init(id, "anvil reader test: mixed solids", 3, 24, 5, 5, 1, 1), "ex_put_init");
+  std::vector<double> x = {0, 1, 1, 0, 0, 1, 1, 0, 2, 2, 1, 0.5};
+  std::vector<double> y = {0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 0, 0.5};
+  std::vector<double> z = {0, 0, 0, 0, 1, 1, 1, 1, 0, 1, 2, 2};
+  // TETRA10 mid-edge nodes 13-18: edges 1-2, 2-3, 1-3, 1-4, 2-4, 3-4 of the tetrahedron.
+  const int tet[4] = {6, 10, 7, 11};
+  const int tet_edges[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
+  for (const auto& e : tet_edges) {
+    const int p = tet[e[0]] - 1, q = tet[e[1]] - 1;
+    x.push_back(0.5 * (x[p] + x[q]));
+    y.push_back(0.5 * (y[p] + y[q]));
+    z.push_back(0.5 * (z[p] + z[q]));
+  }
+  // The LS-DYNA wedge, nodes 19-24.
+  for (const auto& p :
+       {std::array<double, 3>{3, 0, 0}, {4, 0, 0}, {4, 1, 0}, {3, 1, 0}, {3, 0, 1}, {3, 1, 1}}) {
+    x.push_back(p[0]);
+    y.push_back(p[1]);
+    z.push_back(p[2]);
+  }
+  check(ex_put_coord(id, x.data(), y.data(), z.data()), "ex_put_coord");
+
+  struct Block {
+    const char* type;
+    int nodes;
+    std::vector<int> conn;
+  };
+  const std::vector<Block> blocks = {
+      {"HEX8", 8, {1, 2, 3, 4, 5, 6, 7, 8}},
+      {"wedge", 6, {2, 9, 3, 6, 10, 7}},
+      {"TETRA10", 10, {6, 10, 7, 11, 13, 14, 15, 16, 17, 18}},
+      {"PYRAMID", 5, {5, 6, 7, 8, 12}},
+      {"HEX8", 8, {19, 20, 21, 22, 23, 23, 24, 24}},
+  };
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const int blk_id = static_cast<int>(b) + 1;
+    check(ex_put_block(id, EX_ELEM_BLOCK, blk_id, blocks[b].type, 1, blocks[b].nodes, 0, 0, 0),
+          "ex_put_block");
+    check(ex_put_conn(id, EX_ELEM_BLOCK, blk_id, blocks[b].conn.data(), nullptr, nullptr), "conn");
+  }
+  check(ex_put_name(id, EX_ELEM_BLOCK, 1, "hex"), "block name");
+  std::vector<int> elem_map = {10, 20, 30, 40, 50};
+  check(ex_put_id_map(id, EX_ELEM_MAP, elem_map.data()), "elem map");
+
+  std::vector<int> apex = {12};
+  check(ex_put_set_param(id, EX_NODE_SET, 1, 1, 0), "ns param");
+  check(ex_put_set(id, EX_NODE_SET, 1, apex.data(), nullptr), "ns");
+  check(ex_put_name(id, EX_NODE_SET, 1, "apex"), "ns name");
+
+  std::vector<int> elems = {1, 2, 2, 2, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4, 4, 5, 5};
+  std::vector<int> sides = {6, 1, 2, 3, 4, 5, 1, 2, 3, 4, 1, 2, 3, 4, 5, 5, 1};
+  check(ex_put_set_param(id, EX_SIDE_SET, 1, static_cast<int>(elems.size()), 0), "ss param");
+  check(ex_put_set(id, EX_SIDE_SET, 1, elems.data(), sides.data()), "ss");
+  check(ex_put_name(id, EX_SIDE_SET, 1, "faces"), "ss name");
+  check(ex_close(id), "ex_close");
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -153,5 +227,6 @@ int main(int argc, char** argv) {
   write_box(dir + "/bad_elem_range.exo", "elem_range");
   write_box(dir + "/bad_2d.exo", "dim2");
   write_hex20(dir + "/hex20.exo");
+  write_mixed(dir + "/mixed_solids.exo");
   return 0;
 }
