@@ -33,6 +33,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 VTK_HEXAHEDRON = 12
+# VTK's solid cells as anvil's hexahedra: which of the cell's points each corner is
+# (the inverse of vtk_cell() in src/anvil/mesh/mesh.cpp).
+_AS_HEXAHEDRON = {
+    12: (0, 1, 2, 3, 4, 5, 6, 7),
+    13: (0, 2, 1, 1, 3, 5, 4, 4),  # wedge: VTK a c b, d f e
+    14: (0, 1, 2, 3, 4, 4, 4, 4),  # pyramid
+    10: (0, 1, 2, 2, 3, 3, 3, 3),  # tetrahedron
+}
 
 _DTYPES = {
     "Float64": "f8",
@@ -95,14 +103,20 @@ class Grid:
         return self.cell_conn.reshape(-1, 8)
 
     def hexahedra(self):
-        """Indices of the cells that are VTK hexahedra (type 12)."""
-        return np.flatnonzero(self.cell_types == VTK_HEXAHEDRON)
+        """Indices of the solid cells: VTK hexahedra (type 12), and the wedges (13),
+        pyramids (14) and tetrahedra (10) anvil writes for hexahedra whose nodes repeat."""
+        return np.flatnonzero(np.isin(self.cell_types, list(_AS_HEXAHEDRON)))
 
     def hex_connectivity(self):
-        """(n_hex, 8) point indices of the hexahedra, and (n_hex,) their cell indices."""
+        """(n_solid, 8) point indices of the solid cells as anvil's hexahedra (a wedge,
+        pyramid or tetrahedron with repeated corners, src/anvil/mesh/mesh.hpp), and
+        (n_solid,) their cell indices."""
         cells = self.hexahedra()
-        starts = self.offsets[cells] - 8
-        conn = self.cell_conn[starts[:, None] + np.arange(8)[None, :]]
+        conn = np.empty((len(cells), 8), dtype=np.int64)
+        for vtk_type, corners in _AS_HEXAHEDRON.items():
+            mine = self.cell_types[cells] == vtk_type
+            starts = self.offsets[cells[mine]] - len(set(corners))
+            conn[mine] = self.cell_conn[starts[:, None] + np.array(corners)[None, :]]
         return conn, cells
 
     def _name(self):

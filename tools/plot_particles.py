@@ -151,8 +151,8 @@ def main(argv=None):
     lim_hi = np.max([np.max(g.points[:, plane], axis=0) for _, g, _ in parts], axis=0)
     for (entry, g, fe), v, ax in zip(parts, all_vals, axs[0]):
         # The mesh in the section.
-        if fe is not None and fe.cell_types.size and np.all(fe.cell_types == 12):
-            conn = fe.connectivity
+        if fe is not None and fe.cell_types.size:
+            conn, _ = fe.hex_connectivity()  # (wedges, pyramids, tetrahedra as hexahedra)
             cent = fe.points[conn].mean(axis=1)
             keep = np.abs(cent[:, axis] - cut) <= 0.5 * np.ptp(fe.points[conn][:, :, axis], axis=1).max(initial=0) + 1e-12
             from matplotlib.collections import PolyCollection

@@ -84,4 +84,42 @@ TEST(Vtu, AppendedArraysLieAtTheirOffsets) {
   EXPECT_NE(header.find(">0.25</DataArray>"), std::string::npos);
 }
 
+// The appended arrays of a written piece, in the header's order.
+std::vector<std::string> appended_arrays(const std::string& s) {
+  std::vector<std::string> out;
+  const std::string mark = "<AppendedData encoding=\"raw\">\n   _";
+  const auto start = s.find(mark);
+  if (start == std::string::npos) return out;
+  const std::size_t base = start + mark.size();
+  const std::regex offset_re("offset=\"([0-9]+)\"");
+  const std::string header = s.substr(0, start);
+  for (auto it = std::sregex_iterator(header.begin(), header.end(), offset_re);
+       it != std::sregex_iterator(); ++it) {
+    const std::size_t off = std::stoul((*it)[1].str());
+    std::uint64_t n = 0;
+    std::memcpy(&n, s.data() + base + off, sizeof(n));
+    out.push_back(s.substr(base + off + sizeof(n), n));
+  }
+  return out;
+}
+
+// A hexahedron whose nodes repeat (a wedge a b c c d e f f, mesh.hpp) is written as VTK's
+// wedge, a c b d f e (VTK's first triangle runs counter-clockwise seen from outside); a
+// plain hexahedron and other cells as they are.
+TEST(Vtu, RepeatedNodesAreWrittenAsTheSolidTheyAre) {
+  anvil::VtuPiece p;
+  p.points.assign(3 * 15, 0.0);
+  p.connectivity = {0, 1, 2, 3, 4, 5, 6, 7, /* wedge */ 8, 9, 10, 10, 11, 12, 13, 13, 14};
+  p.offsets = {8, 16, 17};
+  p.types = {12, 12, 1};
+  const std::string path = temp_path("wedge.vtu");
+  anvil::write_vtu(path, p);
+  const auto arrays = appended_arrays(slurp(path));
+  ASSERT_EQ(arrays.size(), 4u); // points, connectivity, offsets, types
+  EXPECT_EQ(arrays[1],
+            bytes_of(std::vector<std::int64_t>{0, 1, 2, 3, 4, 5, 6, 7, 8, 10, 9, 11, 13, 12, 14}));
+  EXPECT_EQ(arrays[2], bytes_of(std::vector<std::int64_t>{8, 14, 15}));
+  EXPECT_EQ(arrays[3], bytes_of(std::vector<std::uint8_t>{12, 13, 1}));
+}
+
 } // namespace

@@ -77,6 +77,10 @@ template <class V>
 V dot3(const V3<V>& a, const V3<V>& b) {
   return a.x * b.x + a.y * b.y + a.z * b.z;
 }
+template <class V>
+V3<V> cross3(const V3<V>& a, const V3<V>& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
 
 template <class V, class M>
 struct Foot {
@@ -86,9 +90,15 @@ struct Foot {
 };
 
 // x(xi, eta) = c + a xi + b eta + d xi eta; Newton on the gradient of |x - p|^2 / 2 from
-// the centre, on dot products formed once.
+// the centre, on dot products formed once. A triangle (x2 = x3: the face of a wedge,
+// pyramid or tetrahedron) is flat: its foot is the projection on its plane, in closed
+// form. With barycentric coordinates la, lb, lc of x0, x1, x2 the bilinear map of the
+// collapsed quadrilateral gives eta = 2 lc - 1 and xi = (lb - la) / (la + lb), so that its
+// shape functions (quad_shape) are la, lb and lc shared by the last two corners. (Newton
+// from the centre converges slowly there: the map is singular at the collapsed edge.)
 template <class V, class M>
 Foot<V, M> foot(const V3<V> (&x)[4], const V3<V>& p) {
+  const M tri = (x[2].x == x[3].x) && (x[2].y == x[3].y) && (x[2].z == x[3].z);
   const V3<V> c = mul(add(add(add(x[0], x[1]), x[2]), x[3]), 0.25);
   const V3<V> a = mul(sub(add(add(mul(x[0], -1.0), x[1]), x[2]), x[3]), 0.25);
   const V3<V> b = mul(add(add(sub(mul(x[0], -1.0), x[1]), x[2]), x[3]), 0.25);
@@ -99,7 +109,7 @@ Foot<V, M> foot(const V3<V> (&x)[4], const V3<V>& p) {
   const V ra = dot3(r0, a), rb = dot3(r0, b), rd = dot3(r0, d);
   const V scale = aa + bb;
   V xi = 0.0, eta = 0.0;
-  M active(true), converged(false);
+  M active = !tri, converged(false);
   for (int it = 0; it < 12 && any(active); ++it) {
     // res = x(xi, eta) - p, t_xi = a + eta d, t_eta = b + xi d.
     const V xe = xi * eta;
@@ -153,11 +163,39 @@ Foot<V, M> foot(const V3<V> (&x)[4], const V3<V>& p) {
   }
   r.gap = dot3(sub(p, r.point), r.normal);
   r.converged = converged;
+  if (any(tri)) {
+    const V3<V> e1 = sub(x[1], x[0]), e2 = sub(x[2], x[0]), w = sub(p, x[0]);
+    const V3<V> nt = cross3(e1, e2);
+    const V nn = dot3(nt, nt);
+    const M flat = tri && nn > 0.0;
+    V safe = nn;
+    set_where(!flat, safe, V(1.0));
+    const V lb = dot3(cross3(w, e2), nt) / safe, lc = dot3(cross3(e1, w), nt) / safe;
+    const V la = (1.0 - lb) - lc, s = la + lb;
+    V ts = s;
+    set_where(!(s > 0.0), ts, V(1.0));
+    V txi = (lb - la) / ts;
+    set_where(!(s > 0.0), txi, V(0.0));
+    const V3<V> pt = add(add(x[0], mul(e1, lb)), mul(e2, lc));
+    const V inv = 1 / sqrt_(safe);
+    const V3<V> nu = mul(nt, inv);
+    set_where(flat, r.xi, txi);
+    set_where(flat, r.eta, 2.0 * lc - 1.0);
+    set_where(flat, r.point.x, pt.x);
+    set_where(flat, r.point.y, pt.y);
+    set_where(flat, r.point.z, pt.z);
+    set_where(flat, r.normal.x, nu.x);
+    set_where(flat, r.normal.y, nu.y);
+    set_where(flat, r.normal.z, nu.z);
+    set_where(flat, r.gap, dot3(sub(p, pt), nu));
+    set_where(tri, r.converged, false);
+    set_where(flat, r.converged, true);
+  }
   if (any(!converged)) { // accept a foot where the gradient vanishes to round-off
     const V3<V> res = sub(r.point, p);
     const V g1 = dot3(res, t1), g2 = dot3(res, t2);
     const M flat = abs_(g1) + abs_(g2) <= 1e-9 * (sqrt_(dot3(res, res)) + 1e-300) * sqrt_(scale);
-    set_where(!converged && flat, r.converged, true);
+    set_where(!converged && !tri && flat, r.converged, true);
   }
   return r;
 }

@@ -378,6 +378,20 @@ int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array
   alive.assign(p, 1.0);
   mass_scale.clear();
   wave_scale.clear();
+  step_factor.clear();
+  for (std::size_t e = 0; e < p; ++e) {
+    int n = 0, k_max = 0;
+    for (int c = 0; c < 8; ++c) {
+      int k = 0;
+      for (int d = 0; d < 8; ++d) k += conn[d][e] == conn[c][e];
+      k_max = std::max(k_max, k);
+      n += std::find_if(conn.begin(), conn.begin() + c,
+                        [&](const auto& cd) { return cd[e] == conn[c][e]; }) == conn.begin() + c;
+    }
+    if (k_max == 1) continue;
+    if (step_factor.empty()) step_factor.assign(p, 1.0);
+    step_factor[e] = 8.0 / (n * k_max);
+  }
   hex_volumes(*this, x, volume);
   const double rho = material->elastic().density;
   mass.assign(p, 0.0);
@@ -488,6 +502,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
   const bool has_ep = !b.plastic_strain.empty(), has_T = !b.temperature.empty();
   const bool erode_ep = b.erosion.plastic_strain > 0 && has_ep;
   const bool scaled = !b.wave_scale.empty(); // mass scaling
+  const bool degenerate = !b.step_factor.empty();
   // Nodal assembly (HexWorkspace::begin_nodal_forces), or null.
   double* const sums = work.assembled_nodes_ >= 0 ? work.sums_.data() : nullptr;
   const std::uint8_t* rows = b.corner_rows.data();
@@ -823,6 +838,8 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
       // element's step, at least that, cannot be the smallest. The step is therefore
       // min(cheap, Gershgorin)'s wherever it matters, on any decomposition.
       vdouble dte;
+      // (Wedges, pyramids, tetrahedra: their nodes' masses, HexBlock::step_factor.)
+      const vdouble sf = degenerate ? simd::load(&b.step_factor[e]) : vdouble(1.0);
       if (!Asq) {
         // Both forms bound lambda, the largest eigenvalue of sum_al gamma_al gamma_al^T.
         // Viscous: the damping rate r = kv lambda / (m / 8) joins the rate term (below).
@@ -891,21 +908,21 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
             ((h[0][i] * h[0][i] + h[1][i] * h[1][i]) + h[2][i] * h[2][i]) + h[3][i] * h[3][i];
         const vdouble hh = (hhd[0] + hhd[1]) + hhd[2];
         const vdouble cheap = hex8::hourglass_damping_bound_frobenius(bb, hh);
-        dte = step(cheap);
+        dte = sf * step(cheap);
         // (Every element's own step, where the caller asks for each: formed everywhere.)
         if (result.element_dt || stdx::any_of(dte <= best_dt)) {
           vdouble Bc[3][8];
           _Pragma("GCC unroll 12") for (int a = 0; a < 8; ++a)
               _Pragma("GCC unroll 12") for (int i = 0; i < 3; ++i) Bc[i][a] =
                   Bt(a, i) * (1.0 / 12.0);
-          dte = step(stdx::min(cheap, hex8::hourglass_damping_bound(Bc, h)));
+          dte = sf * step(stdx::min(cheap, hex8::hourglass_damping_bound(Bc, h)));
         }
       } else {
         // The assumed-strain forms take the plain step: their hourglass stiffness, the
         // physical one of the bending modes, raises the element's largest frequency by
         // under 2% even on warped elements, within the plain step's margin
         // (test_element_step.cpp, docs/element.md).
-        dte = lc / (qv + stdx::sqrt(qv * qv + c * c));
+        dte = sf * (lc / (qv + stdx::sqrt(qv * qv + c * c)));
       }
 
       // Eroded elements: no force, no energy, no time step (select, not multiply: their

@@ -81,6 +81,13 @@ struct HexBlock {
   // material's, and 1 / sqrt f, which scales its material's wave speed there. `mass` and
   // the density the material sees stay physical.
   std::vector<double> mass_scale, wave_scale;
+  // Wedges, pyramids and tetrahedra (corners that share a node; mesh.hpp): their nodes
+  // take equal shares of the element's mass (corner_share), 1 / n each of n nodes, where
+  // the kernel's step bounds assume an eighth per corner; a node of k corners gets
+  // 8 / (n k) times that, and the element's step is taken times the least of these,
+  // step_factor = 8 / (n k_max) (0.5 for a tetrahedron, 2/3 for a wedge, 0.4 for a
+  // pyramid), which keeps it stable. Empty where every element is a hexahedron.
+  std::vector<double> step_factor;
   std::vector<double> volume;                          // current volume, m^3
   std::vector<double> alive;                           // 1, or 0 once eroded
   std::int64_t eroded = 0;                             // elements with alive 0
@@ -108,6 +115,19 @@ struct HexBlock {
                                          // all; see HexWorkspace::begin_nodal_forces)
 
   int size() const { return static_cast<int>(gid.size()); }
+  // The share of element e's mass that corner a gives its node: 1/8, or 1 / (n k) for a
+  // node that k of its corners share among n distinct nodes.
+  double corner_share(std::size_t e, int a) const {
+    if (step_factor.empty() || step_factor[e] == 1.0) return 0.125;
+    int n = 0, k = 0;
+    for (int c = 0; c < 8; ++c) {
+      k += conn[c][e] == conn[a][e];
+      bool first = true;
+      for (int d = 0; d < c; ++d) first = first && conn[d][e] != conn[c][e];
+      n += first;
+    }
+    return 1.0 / (n * k);
+  }
   // Element e's mass with mass scaling's (what its nodes carry), kg.
   double scaled_mass(std::size_t e) const {
     return mass_scale.empty() ? mass[e] : mass[e] * mass_scale[e];

@@ -1,5 +1,7 @@
 #include "anvil/io/vtu.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <deque>
 #include <string_view>
@@ -7,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "anvil/io/files.hpp"
+#include "anvil/mesh/mesh.hpp"
 
 namespace anvil {
 
@@ -43,7 +46,55 @@ void array_tag(Appended& a, const VtuArray& arr) {
 
 } // namespace
 
+namespace {
+
+// Hexahedra whose nodes repeat (wedges, pyramids, tetrahedra; mesh.hpp) as VTK's own cells,
+// which ParaView's filters (surfaces, slices, volumes) take as the solids they are. False
+// (and nothing written) when the piece has none.
+bool own_cells(const VtuPiece& p, std::vector<std::int64_t>& connectivity,
+               std::vector<std::int64_t>& offsets, std::vector<std::uint8_t>& types) {
+  auto repeats = [&](std::size_t c) {
+    const auto* h = &p.connectivity[static_cast<std::size_t>(p.offsets[c]) - 8];
+    for (int a = 1; a < 8; ++a)
+      for (int b = 0; b < a; ++b)
+        if (h[a] == h[b]) return true;
+    return false;
+  };
+  bool any = false;
+  for (std::size_t c = 0; c < p.types.size() && !any; ++c) any = p.types[c] == 12 && repeats(c);
+  if (!any) return false;
+  connectivity.reserve(p.connectivity.size());
+  offsets.reserve(p.offsets.size());
+  types.reserve(p.types.size());
+  std::size_t begin = 0;
+  for (std::size_t c = 0; c < p.types.size(); ++c) {
+    const auto end = static_cast<std::size_t>(p.offsets[c]);
+    if (p.types[c] == 12) {
+      Hex h;
+      std::copy(p.connectivity.begin() + static_cast<std::ptrdiff_t>(begin),
+                p.connectivity.begin() + static_cast<std::ptrdiff_t>(end), h.begin());
+      std::array<std::int64_t, 8> cell;
+      int n = 0;
+      types.push_back(static_cast<std::uint8_t>(vtk_cell(h, cell, n)));
+      connectivity.insert(connectivity.end(), cell.begin(), cell.begin() + n);
+    } else {
+      types.push_back(p.types[c]);
+      connectivity.insert(connectivity.end(),
+                          p.connectivity.begin() + static_cast<std::ptrdiff_t>(begin),
+                          p.connectivity.begin() + static_cast<std::ptrdiff_t>(end));
+    }
+    offsets.push_back(static_cast<std::int64_t>(connectivity.size()));
+    begin = end;
+  }
+  return true;
+}
+
+} // namespace
+
 void write_vtu(const std::string& path, const VtuPiece& p) {
+  std::vector<std::int64_t> own_connectivity, own_offsets;
+  std::vector<std::uint8_t> own_types;
+  const bool own = own_cells(p, own_connectivity, own_offsets, own_types);
   Appended a;
   const std::size_t np = p.points.size() / 3, nc = p.types.size();
   a.header += "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
@@ -64,13 +115,13 @@ void write_vtu(const std::string& path, const VtuPiece& p) {
   a.header += "      </Points>\n      <Cells>\n";
   a.header += fmt::format("        <DataArray type=\"Int64\" Name=\"connectivity\" "
                           "format=\"appended\" offset=\"{}\"/>\n",
-                          a.add(p.connectivity));
+                          a.add(own ? own_connectivity : p.connectivity));
   a.header += fmt::format(
       "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"{}\"/>\n",
-      a.add(p.offsets));
+      a.add(own ? own_offsets : p.offsets));
   a.header += fmt::format(
       "        <DataArray type=\"UInt8\" Name=\"types\" format=\"appended\" offset=\"{}\"/>\n",
-      a.add(p.types));
+      a.add(own ? own_types : p.types));
   a.header += "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n  <AppendedData "
               "encoding=\"raw\">\n   _";
   std::vector<std::string_view> pieces;

@@ -25,7 +25,9 @@ struct VtuPiece {
   std::vector<double> points;             // x, y, z per point
   std::vector<std::int64_t> connectivity; // point indices of every cell
   std::vector<std::int64_t> offsets;      // end of each cell in connectivity
-  std::vector<std::uint8_t> types;        // VTK cell type per cell (12 hexahedron, 1 vertex)
+  std::vector<std::uint8_t> types;        // VTK cell type per cell (12 hexahedron, 1 vertex);
+                                          // a hexahedron whose nodes repeat is written as
+                                          // the wedge, pyramid or tetrahedron it is
   std::vector<VtuArray> point_data, cell_data;
   double time = 0; // written as the TimeValue field (ParaView reads it)
 };

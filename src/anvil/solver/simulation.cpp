@@ -101,7 +101,8 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
     for (int e = 0; e < blocks_[b].size(); ++e)
       for (int a = 0; a < 8; ++a)
         corner_mass[fe_.blocks[b].slot(static_cast<std::size_t>(e), a)] =
-            blocks_[b].scaled_mass(static_cast<std::size_t>(e)) / 8;
+            blocks_[b].scaled_mass(static_cast<std::size_t>(e)) *
+            blocks_[b].corner_share(static_cast<std::size_t>(e), a);
   corner_exchange_->exchange({corner_mass.data()});
   gather_corners(fe_, {corner_mass.data()}, {nodes_.mass.data()});
   std::fill(corner_mass.begin(), corner_mass.end(), 0.0);
@@ -1307,7 +1308,7 @@ Sample Simulation::sample() const {
 
 // Each part's and particle set's share of the kinetic, internal and hourglass energies of
 // this rank. A node's kinetic energy is split among its elements by the mass each gave it
-// (an eighth of the element's: the lumped mass), so the parts' kinetic energies add up to
+// (the element's corner shares: the lumped mass), so the parts' kinetic energies add up to
 // the nodes'; the velocity is the one the total uses (the deck's at t = 0, then the mean
 // of the half-step velocities around t(n)).
 std::vector<double> Simulation::part_energies() const {
@@ -1327,9 +1328,10 @@ std::vector<double> Simulation::part_energies() const {
     double* out = e.data() + 3 * static_cast<std::size_t>(b.part);
     for (int el = 0; el < b.size(); ++el) {
       const auto k = static_cast<std::size_t>(el);
-      double v2 = 0;
+      double v2 = 0; // (mass-weighted: corner_share is 1/8 on a hexahedron)
       for (int a = 0; a < 8; ++a)
-        v2 += speed2(nodes_.v, v_prev_, static_cast<std::size_t>(b.conn[a][k]));
+        v2 += 8 * b.corner_share(k, a) *
+              speed2(nodes_.v, v_prev_, static_cast<std::size_t>(b.conn[a][k]));
       out[0] += 0.5 * (b.scaled_mass(k) / 8) * v2;
       out[1] += b.internal_energy[k];
       out[2] += b.hourglass_energy[k];
