@@ -379,18 +379,21 @@ int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array
   mass_scale.clear();
   wave_scale.clear();
   step_factor.clear();
+  tetrahedron.clear();
   for (std::size_t e = 0; e < p; ++e) {
-    int n = 0, k_max = 0;
+    int n = 8, k_max = 1;
     for (int c = 0; c < 8; ++c) {
-      int k = 0;
-      for (int d = 0; d < 8; ++d) k += conn[d][e] == conn[c][e];
+      const auto [distinct, k] = corner_multiplicity(e, c);
+      n = distinct;
       k_max = std::max(k_max, k);
-      n += std::find_if(conn.begin(), conn.begin() + c,
-                        [&](const auto& cd) { return cd[e] == conn[c][e]; }) == conn.begin() + c;
     }
     if (k_max == 1) continue;
     if (step_factor.empty()) step_factor.assign(p, 1.0);
     step_factor[e] = 8.0 / (n * k_max);
+    if (n == 4) {
+      if (tetrahedron.empty()) tetrahedron.assign(p, 0.0);
+      tetrahedron[e] = 1.0;
+    }
   }
   hex_volumes(*this, x, volume);
   const double rho = material->elastic().density;
@@ -502,7 +505,7 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
   const bool has_ep = !b.plastic_strain.empty(), has_T = !b.temperature.empty();
   const bool erode_ep = b.erosion.plastic_strain > 0 && has_ep;
   const bool scaled = !b.wave_scale.empty(); // mass scaling
-  const bool degenerate = !b.step_factor.empty();
+  const bool degenerate = !b.step_factor.empty(), tetrahedra = !b.tetrahedron.empty();
   // Nodal assembly (HexWorkspace::begin_nodal_forces), or null.
   double* const sums = work.assembled_nodes_ >= 0 ? work.sums_.data() : nullptr;
   const std::uint8_t* rows = b.corner_rows.data();
@@ -923,6 +926,24 @@ void block_forces(HexBlock& b, const NodalView& nodes, double dt, CornerView cor
         // under 2% even on warped elements, within the plain step's margin
         // (test_element_step.cpp, docs/element.md).
         dte = sf * (lc / (qv + stdx::sqrt(qv * qv + c * c)));
+      }
+      // A tetrahedron (a b c c d d d d) has no hourglass modes: its four nodes carry linear
+      // fields only. Its step is the plain one of its nodes, each with the gradient B_n
+      // of the corners that share it and the mass m / 4: omega^2 <= 4 c^2 sum_n |B_n|^2 /
+      // V^2, so dt = V / (c sqrt(sum_n |B_n|^2)) (dt omega_max 1.58-2.00 over random
+      // tetrahedra; test_element_step.cpp), with the bulk viscosity as above.
+      if (tetrahedra) {
+        const auto tet = simd::load(&b.tetrahedron[e]) > 0.0;
+        if (stdx::any_of(tet)) {
+          vdouble sum = 0.0; // 144 sum_n |B_n|^2
+          _Pragma("GCC unroll 3") for (int i = 0; i < 3; ++i) {
+            const vdouble b23 = Bt(2, i) + Bt(3, i);
+            const vdouble b47 = (Bt(4, i) + Bt(5, i)) + (Bt(6, i) + Bt(7, i));
+            sum += ((Bt(0, i) * Bt(0, i) + Bt(1, i) * Bt(1, i)) + b23 * b23) + b47 * b47;
+          }
+          const vdouble lt = vol / stdx::sqrt(sum * (1.0 / 144.0));
+          stdx::where(tet, dte) = lt / (qv + stdx::sqrt(qv * qv + c * c));
+        }
       }
 
       // Eroded elements: no force, no energy, no time step (select, not multiply: their

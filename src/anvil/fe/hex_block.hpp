@@ -11,6 +11,7 @@
 #include <new>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "anvil/material/material.hpp"
@@ -85,9 +86,13 @@ struct HexBlock {
   // take equal shares of the element's mass (corner_share), 1 / n each of n nodes, where
   // the kernel's step bounds assume an eighth per corner; a node of k corners gets
   // 8 / (n k) times that, and the element's step is taken times the least of these,
-  // step_factor = 8 / (n k_max) (0.5 for a tetrahedron, 2/3 for a wedge, 0.4 for a
-  // pyramid), which keeps it stable. Empty where every element is a hexahedron.
+  // step_factor = 8 / (n k_max) (2/3 for a wedge, 0.4 for a pyramid; a tetrahedron has a
+  // bound of its own, below), which keeps it stable. Empty where every element is a
+  // hexahedron.
   std::vector<double> step_factor;
+  // 1 for a tetrahedron (a b c c d d d d), which has no hourglass modes: its step is the
+  // plain one of its own four nodes (hex_block.cpp). Empty where there is none.
+  std::vector<double> tetrahedron;
   std::vector<double> volume;                          // current volume, m^3
   std::vector<double> alive;                           // 1, or 0 once eroded
   std::int64_t eroded = 0;                             // elements with alive 0
@@ -119,6 +124,12 @@ struct HexBlock {
   // node that k of its corners share among n distinct nodes.
   double corner_share(std::size_t e, int a) const {
     if (step_factor.empty() || step_factor[e] == 1.0) return 0.125;
+    const auto [n, k] = corner_multiplicity(e, a);
+    return 1.0 / (n * k);
+  }
+  // Of element e's corners: how many distinct nodes they name (n), and how many of them
+  // name corner a's node (k).
+  std::pair<int, int> corner_multiplicity(std::size_t e, int a) const {
     int n = 0, k = 0;
     for (int c = 0; c < 8; ++c) {
       k += conn[c][e] == conn[a][e];
@@ -126,7 +137,7 @@ struct HexBlock {
       for (int d = 0; d < c; ++d) first = first && conn[d][e] != conn[c][e];
       n += first;
     }
-    return 1.0 / (n * k);
+    return {n, k};
   }
   // Element e's mass with mass scaling's (what its nodes carry), kg.
   double scaled_mass(std::size_t e) const {

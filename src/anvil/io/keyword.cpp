@@ -481,6 +481,12 @@ std::string wide_id(const Card& card, int i, std::string_view field, std::string
                      wider.empty() ? "" : ", or ");
 }
 
+// The message for a segment's node N1-N4 that is blank, zero or negative.
+std::string segment_node_needed(const std::string& name) {
+  return fmt::format("{} must be a positive node id{}", name,
+                     name == "N4" ? " (a triangle repeats N3 as N4)" : "");
+}
+
 // A card of free text (title, heading): the whole line, trimmed.
 std::string text_card(const Line& l) {
   return std::string(trim(l.text));
@@ -2160,7 +2166,8 @@ private:
       if (!is_face(sorted) || (sorted[0] < 0 && seg[2] != seg[3]))
         throw InputError(at.loc(key + ".N4"),
                          fmt::format("segment ({}, {}, {}, {}) repeats a node other than as a "
-                                     "triangle N1 N2 N3 N3",
+                                     "triangle (N1 N2 N3 N3, or one node twice in neighbouring "
+                                     "places)",
                                      ids[0], ids[1], ids[2], ids[3]));
       const auto it =
           std::lower_bound(faces.begin(), faces.end(), sorted,
@@ -2377,7 +2384,7 @@ private:
         for (int a = 0; a < 4; ++a) {
           const std::string name = fmt::format("N{}", a + 1);
           sl.nodes[a] = card.integer(3 + a, name, 0);
-          if (sl.nodes[a] <= 0) card.fail(name, fmt::format("{} must be a positive node id", name));
+          if (sl.nodes[a] <= 0) card.fail(name, segment_node_needed(name));
         }
         if (card.integer(7, "N5", 0) != 0)
           card.fail("N5", "higher-order segments (N5-N8) are not supported: anvil's faces are "
@@ -2406,7 +2413,7 @@ private:
       for (int a = 0; a < 4; ++a) {
         const std::string name = fmt::format("N{}", a + 1);
         n[a] = card.integer(a, name, 0);
-        if (n[a] <= 0) card.fail(name, fmt::format("{} must be a positive node id", name));
+        if (n[a] <= 0) card.fail(name, segment_node_needed(name));
       }
       s.segments.push_back(n);
       s.at.push_back(where_of(*r));

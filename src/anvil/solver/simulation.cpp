@@ -78,16 +78,23 @@ Simulation::Simulation(const Config& config, const Comm& comm) : config_(config)
       const double v = comm_.min(bad >= 0 && hb.gid[bad] == bad_gid ? hb.volume[bad] : 1e300);
       const std::int64_t id =
           mesh.blocks[b].id(static_cast<std::size_t>(bad_gid - block_offsets_[b]));
+      const Shape shape =
+          shape_of(mesh.blocks[b].elements[static_cast<std::size_t>(bad_gid - block_offsets_[b])]);
+      // "element 12 (a tetrahedron) of part p in mesh file m.msh"
+      const std::string which = fmt::format(
+          "element {}{} of part {}{}", id,
+          shape == Shape::hexahedron ? "" : fmt::format(" (a {})", shape_name(shape)), part.name,
+          part.mesh.kind == MeshConfig::Kind::file ? fmt::format(" in mesh file {}", part.mesh.file)
+                                                   : "");
       if (!(v > 0))
         throw InputError(part.mesh.where,
-                         fmt::format("element {} of part {} has a non-positive volume ({:.3g} "
-                                     "m^3): check the node order",
-                                     id, part.name, v));
+                         fmt::format("{} has a non-positive volume ({:.3g} m^3): check the node "
+                                     "order",
+                                     which, v));
       throw InputError(part.mesh.where,
-                       fmt::format("element {} of part {} is tangled: its volume is positive "
-                                   "({:.3g} m^3) but its Jacobian at the centre is not: check "
-                                   "the node order",
-                                   id, part.name, v));
+                       fmt::format("{} is tangled: its volume is positive ({:.3g} m^3) but its "
+                                   "Jacobian at the centre is not: check the node order",
+                                   which, v));
     }
     hb.corner_rows = lb.exchanged_vectors; // the other nodes are summed in the kernel
     blocks_.push_back(std::move(hb));
