@@ -381,13 +381,10 @@ int HexBlock::init(std::span<const std::int64_t> ids, std::span<const std::array
   step_factor.clear();
   tetrahedron.clear();
   for (std::size_t e = 0; e < p; ++e) {
-    int n = 8, k_max = 1;
-    for (int c = 0; c < 8; ++c) {
-      const auto [distinct, k] = corner_multiplicity(e, c);
-      n = distinct;
-      k_max = std::max(k_max, k);
-    }
-    if (k_max == 1) continue;
+    const int n = corner_multiplicity(e, 0).first; // distinct nodes
+    if (n == 8) continue;
+    int k_max = 1;
+    for (int c = 0; c < 8; ++c) k_max = std::max(k_max, corner_multiplicity(e, c).second);
     if (step_factor.empty()) step_factor.assign(p, 1.0);
     step_factor[e] = 8.0 / (n * k_max);
     if (n == 4) {

@@ -3717,6 +3717,9 @@ Config KeywordReader::config(const std::string& deck_file) {
     }
     return mname;
   };
+  std::set<std::int64_t> not_tetrahedra; // parts with an element of another shape
+  for (const auto& e : elements_)
+    if (shape_of(e.nodes) != Shape::tetrahedron) not_tetrahedra.insert(e.pid);
   for (std::size_t i = 0; i < order.size(); ++i) {
     const PartCard& p = *std::find_if(parts_.begin(), parts_.end(),
                                       [&](const PartCard& q) { return q.pid == order[i]; });
@@ -3746,9 +3749,7 @@ Config KeywordReader::config(const std::string& deck_file) {
     }
     // ELFORM 10 (LS-DYNA's one-point tetrahedron) on tetrahedra is what anvil's element is
     // on a tetrahedron (element.md): no warning.
-    const bool tetrahedra = std::all_of(elements_.begin(), elements_.end(), [&](const auto& e) {
-      return e.pid != p.pid || shape_of(e.nodes) == Shape::tetrahedron;
-    });
+    const bool tetrahedra = !not_tetrahedra.count(p.pid);
     if (sec->second.elform != 1 && sec->second.elform != 0 &&
         !(sec->second.elform == 10 && tetrahedra))
       warnings.push_back(fmt::format("{}: section {} asks for ELFORM {}; anvil uses its one-point "
