@@ -425,6 +425,42 @@ void queue_candidates(const std::vector<ContactNodeItem>& nodes, const FaceBoxes
   w.query_start[w.active.size()] = static_cast<int>(w.query_face.size());
 }
 
+namespace {
+
+// Ramp of the edge band: 0 where the foot's parent coordinate t lies further than `band`
+// inside the face's edge at t = 1, rising to 1 at the edge and staying 1 beyond it.
+double edge_ramp(double t, double band) {
+  return std::clamp((t - (1 - band)) / band, 0.0, 1.0);
+}
+
+// Weight of face g in the blended normal and gap of a pair on face f with its foot at q:
+// g shares an edge of f (both its nodes) or only a corner, and the weight is the ramp of
+// that edge, or the product of the corner's two ramps; the largest of them when several
+// apply (a triangle's collapsed edge is a corner shared by every face around it).
+double blend_weight(const ContactFaceItem& f, const QuadProjection& q, const ContactFaceItem& g,
+                    double band) {
+  bool shared[4];
+  for (int a = 0; a < 4; ++a)
+    shared[a] = g.node[0] == f.node[a] || g.node[1] == f.node[a] || g.node[2] == f.node[a] ||
+                g.node[3] == f.node[a];
+  // Corner a at ((-1, -1), (1, -1), (1, 1), (-1, 1))[a]; edge a joins corners a and a + 1.
+  const double xi_ramp[2] = {edge_ramp(-q.xi, band), edge_ramp(q.xi, band)};
+  const double eta_ramp[2] = {edge_ramp(-q.eta, band), edge_ramp(q.eta, band)};
+  constexpr int xi_side[4] = {0, 1, 1, 0}, eta_side[4] = {0, 0, 1, 1};
+  double w = 0;
+  for (int a = 0; a < 4; ++a) {
+    if (!shared[a]) continue;
+    const int b = (a + 1) % 4;
+    const double corner = xi_ramp[xi_side[a]] * eta_ramp[eta_side[a]];
+    // Edges 0 and 2 run along xi (eta = -1, 1), edges 1 and 3 along eta (xi = 1, -1).
+    const double edge = !shared[b] ? 0 : a % 2 == 0 ? eta_ramp[eta_side[a]] : xi_ramp[xi_side[a]];
+    w = std::max(w, std::max(corner, edge));
+  }
+  return w;
+}
+
+} // namespace
+
 void check_queued(const std::vector<ContactNodeItem>& nodes,
                   const std::vector<ContactFaceItem>& faces, const SearchOptions& opt,
                   SearchWorkspace& w, std::vector<ContactPair>& pairs) {
@@ -454,7 +490,9 @@ void check_queued(const std::vector<ContactNodeItem>& nodes,
     ContactPair best, tracked;
     bool found = false, have_tracked = false;
     std::int64_t best_gid = 0;
-    for (int j = w.query_start[k]; j < w.query_start[k + 1]; ++j) {
+    int best_j = 0, tracked_j = 0;
+    const int jb = w.query_start[k], je = w.query_start[k + 1];
+    for (int j = jb; j < je; ++j) {
       const int f = w.query_face[static_cast<std::size_t>(j)];
       const auto& fc = faces[static_cast<std::size_t>(f)];
       const QuadProjection& q = w.feet[static_cast<std::size_t>(j)];
@@ -462,6 +500,7 @@ void check_queued(const std::vector<ContactNodeItem>& nodes,
       if (fc.gid == nd.last_face && -q.gap <= 2 * fc.depth) {
         tracked = {static_cast<int>(n),           f, q.xi, q.eta, q.gap, q.normal,
                    std::min(nd.allowance, -q.gap)};
+        tracked_j = j;
         have_tracked = true;
       }
       if (!(-q.gap < fc.depth)) continue;
@@ -490,13 +529,92 @@ void check_queued(const std::vector<ContactNodeItem>& nodes,
       if (!found || q.gap > best.gap || (q.gap == best.gap && fc.gid < best_gid)) {
         best = {static_cast<int>(n), f, q.xi, q.eta, q.gap, q.normal, -q.gap};
         best_gid = fc.gid;
+        best_j = j;
         found = true;
       }
     }
-    if (have_tracked)
-      pairs.push_back(tracked);
-    else if (found)
-      pairs.push_back(best);
+    if (!have_tracked && !found) continue;
+    ContactPair pair = have_tracked ? tracked : best;
+    int pj = have_tracked ? tracked_j : best_j;
+    // A tracked pair whose foot has left its face (within the parametric tolerance) moves to
+    // the face across the edge it crossed when the foot lies on that face and the node is
+    // behind it, no deeper than a tracked pair may go: a node sliding over an interface
+    // pairs with the face it is over, whichever face it met first (of several, the least
+    // penetrated, then the lower id).
+    if (have_tracked && (std::abs(pair.xi) > 1 || std::abs(pair.eta) > 1)) {
+      const auto& fc = faces[static_cast<std::size_t>(pair.face)];
+      const QuadProjection& qt = w.feet[static_cast<std::size_t>(pj)];
+      int to = -1;
+      std::int64_t to_gid = 0;
+      double to_gap = 0;
+      for (int j = jb; j < je; ++j) {
+        const int f = w.query_face[static_cast<std::size_t>(j)];
+        const auto& g = faces[static_cast<std::size_t>(f)];
+        const QuadProjection& q = w.feet[static_cast<std::size_t>(j)];
+        if (f == pair.face || !q.converged || std::abs(q.xi) > 1 || std::abs(q.eta) > 1 ||
+            !(q.gap < 0) || -q.gap > 2 * g.depth || blend_weight(fc, qt, g, opt.edge_blend) == 0)
+          continue;
+        if (to < 0 || q.gap > to_gap || (q.gap == to_gap && g.gid < to_gid)) {
+          to = j;
+          to_gid = g.gid;
+          to_gap = q.gap;
+        }
+      }
+      if (to >= 0) {
+        const QuadProjection& q = w.feet[static_cast<std::size_t>(to)];
+        pair = {static_cast<int>(n),
+                w.query_face[static_cast<std::size_t>(to)],
+                q.xi,
+                q.eta,
+                q.gap,
+                q.normal,
+                std::min(nd.allowance, -q.gap)};
+        pj = to;
+      }
+    }
+    // Near an edge or a corner of its face the pair's normal and gap blend with those of
+    // the queued faces across it (blend_weight; faces turned less than 90 degrees from
+    // this one, their feet found within the tolerance): at the edge or corner itself they
+    // are the plain average of the faces that share it. So the normal turns continuously
+    // as a node slides from face to face, and does not depend on which of the faces around
+    // a vertex the node met first: a node that meets a mesh at one of its nodes (matching
+    // meshes) is pushed along the mean normal of the faces there, as its mirror image is.
+    if (opt.edge_blend > 0 &&
+        std::max(std::abs(pair.xi), std::abs(pair.eta)) > 1 - opt.edge_blend) {
+      const auto& fc = faces[static_cast<std::size_t>(pair.face)];
+      const QuadProjection& qp = w.feet[static_cast<std::size_t>(pj)];
+      w.blend.clear();
+      for (int j = jb; j < je; ++j) {
+        const int f = w.query_face[static_cast<std::size_t>(j)];
+        const QuadProjection& q = w.feet[static_cast<std::size_t>(j)];
+        if (f == pair.face || !q.converged || std::abs(q.xi) > tol || std::abs(q.eta) > tol ||
+            !(dot(q.normal, qp.normal) > 0))
+          continue;
+        const auto& g = faces[static_cast<std::size_t>(f)];
+        const double b = blend_weight(fc, qp, g, opt.edge_blend);
+        if (b > 0) w.blend.push_back({g.gid, j, b});
+      }
+      if (!w.blend.empty()) {
+        // Summed in ascending face id, the pair's own face among them: the same bits
+        // whatever order this rank holds the faces in.
+        w.blend.push_back({fc.gid, pj, 1.0});
+        std::sort(w.blend.begin(), w.blend.end(),
+                  [](const auto& a, const auto& b) { return a.gid < b.gid; });
+        Vec3 normal;
+        double gap = 0, weight = 0;
+        for (const auto& e : w.blend) {
+          const QuadProjection& q = w.feet[static_cast<std::size_t>(e.query)];
+          normal += e.weight * q.normal;
+          gap += e.weight * q.gap;
+          weight += e.weight;
+        }
+        const double len = norm(normal);
+        if (len > 0) pair.normal = normal * (1 / len);
+        pair.gap = gap / weight;
+        pair.allowance = std::min(pair.allowance, std::max(0.0, -pair.gap));
+      }
+    }
+    pairs.push_back(pair);
   }
 }
 

@@ -91,6 +91,11 @@ FacePlane set_capture(ContactFaceItem& face);
 struct SearchOptions {
   double dt = 0; // the step just predicted: x - dt v is the start of the step (0: no check)
   double parametric_tolerance = 0.02; // the foot may lie this far outside [-1, 1]^2
+  // Width, in parent coordinates, of the band along a face's edges where a pair's normal
+  // and gap blend with those of the faces across the edge (see check_queued): at an edge
+  // or corner they are the plain average of the faces that share it, and they change
+  // continuously as the foot moves across.
+  double edge_blend = 0.05;
   // Skin of the candidate lists, as a fraction of the median capture-box size: a list
   // holds the faces whose capture box, enlarged by the skin, held the node when it was
   // built, and stays valid until a node or a capture-box side has moved half the skin.
@@ -126,6 +131,14 @@ struct SearchWorkspace {
   std::vector<int> query_start, query_face;
   std::vector<QuadQuery> queries;
   std::vector<QuadProjection> feet;
+  // A pair's faces across the edge or corner its foot is near (check_queued): face id,
+  // query and weight.
+  struct BlendEntry {
+    std::int64_t gid;
+    int query;
+    double weight;
+  };
+  std::vector<BlendEntry> blend;
 
   // Candidate lists (Verlet lists): for each node with at least one candidate (active),
   // the faces whose enlarged capture box held it at the last build, ascending: first the
