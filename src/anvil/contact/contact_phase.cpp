@@ -89,10 +89,7 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
                            const Vec3& rcb_scale)
     : config_(config), fe_(fe), comm_(comm), rcb_(comm, rcb_scale) {
   global_nodes_ = mesh.num_nodes();
-  std::vector<bool> selected(mesh.blocks.size(), config.parts.empty());
-  for (const auto& name : config.parts)
-    for (std::size_t b = 0; b < mesh.blocks.size(); ++b)
-      if (mesh.blocks[b].name == name) selected[b] = true;
+  const std::vector<bool> selected = blocks_named(mesh, config.parts);
   // Parts that erode also list the faces between their elements, active once erosion
   // exposes them (set_eroded).
   std::vector<bool> erodible(mesh.blocks.size(), false);

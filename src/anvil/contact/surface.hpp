@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "anvil/mesh/mesh.hpp"
@@ -27,11 +28,23 @@ struct ExteriorFaces {
   std::size_t size() const { return element.size(); }
 };
 
+// The blocks of the named parts (all of them when `parts` is empty): a contact's surfaces.
+std::vector<bool> blocks_named(const Mesh& mesh, const std::vector<std::string>& parts);
+
 // Exterior faces of the blocks with `selected[b]` true. A face is exterior when no other
 // element of the whole mesh (any block) has the same nodes (face_key). With `erodible` (per
 // block; empty: none), also the faces between two elements of which one is erodible:
 // the faces erosion may expose (LS-DYNA's eroding contact), `behind` their neighbour.
 ExteriorFaces exterior_faces(const Mesh& mesh, const std::vector<bool>& selected,
                              const std::vector<bool>& erodible = {});
+
+// Pairs of elements (global ids, the lower first, ascending, each once) of different
+// bodies whose faces among `faces` come within a face's size of each other: the bodies
+// (the mesh's connected components, elements joined by shared nodes) that start close
+// enough to meet soon. The static partition joins them (partition_elements' links), so
+// that the elements of a contact interface tend to fall on one rank, as the contact
+// decomposition's boxes put them; docs/cycle.md, "The decompositions".
+std::vector<std::array<std::int64_t, 2>> links_between_bodies(const Mesh& mesh,
+                                                              const ExteriorFaces& faces);
 
 } // namespace anvil

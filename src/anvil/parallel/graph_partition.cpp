@@ -9,8 +9,8 @@
 
 namespace anvil {
 
-std::vector<int> partition_elements(const Mesh& mesh, int parts,
-                                    std::span<const int> block_weight) {
+std::vector<int> partition_elements(const Mesh& mesh, int parts, std::span<const int> block_weight,
+                                    std::span<const std::array<std::int64_t, 2>> links) {
   const auto ne = mesh.num_elements();
   std::vector<int> out(static_cast<std::size_t>(ne), 0);
   if (parts <= 1 || ne == 0) return out;
@@ -48,11 +48,42 @@ std::vector<int> partition_elements(const Mesh& mesh, int parts,
   // Parts within 0.5% of the mean weight (METIS's default for k-way is 3%: on 2 ranks one
   // could wait 6% of the FE phase for the other); the cut barely grows.
   options[METIS_OPTION_UFACTOR] = 5;
-  std::vector<idx_t> epart(static_cast<std::size_t>(ne)), npart(static_cast<std::size_t>(n_nodes));
-  const int rc = METIS_PartMeshDual(&n_el, &n_nodes, eptr.data(), eind.data(),
-                                    vwgt.empty() ? nullptr : vwgt.data(), nullptr, &ncommon,
-                                    &nparts, nullptr, options, &objval, epart.data(), npart.data());
-  if (rc != METIS_OK) throw std::runtime_error("METIS_PartMeshDual failed");
+  std::vector<idx_t> epart(static_cast<std::size_t>(ne));
+  // The dual graph (what METIS_PartMeshDual partitions), then the links added to it.
+  idx_t numflag = 0, *xadj = nullptr, *adjncy = nullptr;
+  if (METIS_MeshToDual(&n_el, &n_nodes, eptr.data(), eind.data(), &ncommon, &numflag, &xadj,
+                       &adjncy) != METIS_OK)
+    throw std::runtime_error("METIS_MeshToDual failed");
+  std::vector<idx_t> ptr(xadj, xadj + n_el + 1), adj(adjncy, adjncy + xadj[n_el]);
+  METIS_Free(xadj);
+  METIS_Free(adjncy);
+  if (!links.empty()) {
+    std::vector<std::vector<idx_t>> extra(static_cast<std::size_t>(ne));
+    for (const auto& [a, b] : links) {
+      if (a == b || a < 0 || b < 0 || a >= ne || b >= ne) continue;
+      extra[static_cast<std::size_t>(a)].push_back(static_cast<idx_t>(b));
+      extra[static_cast<std::size_t>(b)].push_back(static_cast<idx_t>(a));
+    }
+    std::vector<idx_t> ptr2(ptr.size()), adj2;
+    adj2.reserve(adj.size() + 2 * links.size());
+    for (std::size_t e = 0; e < static_cast<std::size_t>(ne); ++e) {
+      ptr2[e] = static_cast<idx_t>(adj2.size());
+      const auto first = adj2.size();
+      adj2.insert(adj2.end(), adj.begin() + ptr[e], adj.begin() + ptr[e + 1]);
+      adj2.insert(adj2.end(), extra[e].begin(), extra[e].end());
+      std::sort(adj2.begin() + static_cast<std::ptrdiff_t>(first), adj2.end());
+      adj2.erase(std::unique(adj2.begin() + static_cast<std::ptrdiff_t>(first), adj2.end()),
+                 adj2.end());
+    }
+    ptr2[static_cast<std::size_t>(ne)] = static_cast<idx_t>(adj2.size());
+    ptr.swap(ptr2);
+    adj.swap(adj2);
+  }
+  idx_t ncon = 1;
+  const int rc = METIS_PartGraphKway(&n_el, &ncon, ptr.data(), adj.data(),
+                                     vwgt.empty() ? nullptr : vwgt.data(), nullptr, nullptr,
+                                     &nparts, nullptr, nullptr, options, &objval, epart.data());
+  if (rc != METIS_OK) throw std::runtime_error("METIS_PartGraphKway failed");
   for (std::size_t i = 0; i < out.size(); ++i) out[i] = static_cast<int>(epart[i]);
   return out;
 }
