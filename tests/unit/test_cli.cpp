@@ -547,4 +547,24 @@ TEST(Cli, DecomposeWritesTheParticleDecomposition) {
   EXPECT_TRUE(std::filesystem::exists(dir + "/particles.pvd"));
 }
 
+// decomposition.json counts the links of bodies about to meet (docs/cycle.md): a striker
+// 0.05 mm above a plate links elements of both; the Taylor bar (one body, a rigid wall,
+// no contact) none.
+TEST(Cli, DecomposeCountsTheLinksBetweenBodies) {
+  const auto dir = (std::filesystem::temp_directory_path() / "anvil_cli_links").string();
+  auto links = [&](const std::string& example) {
+    std::filesystem::remove_all(dir);
+    const auto r = run("decompose " + std::string(anvil::test::source_dir()) + "/examples/" +
+                       example + " -o " + dir);
+    EXPECT_EQ(r.status, 0) << r.out;
+    std::stringstream json;
+    json << std::ifstream(dir + "/decomposition.json").rdbuf();
+    const auto at = json.str().find("\"body_links\": ");
+    EXPECT_NE(at, std::string::npos) << json.str();
+    return at == std::string::npos ? -1L : std::stol(json.str().substr(at + 14));
+  };
+  EXPECT_GT(links("tetrahedra_impact.yaml"), 0);
+  EXPECT_EQ(links("taylor_bar.yaml"), 0);
+}
+
 } // namespace

@@ -88,7 +88,12 @@ void write_decomposition(const Config& config, const std::string& outdir, const 
     fe["neighbours"] = per_rank(comm, static_cast<double>(sim.fe().neighbors.size()));
     const Mesh mesh = build_mesh(config);
     const std::vector<int> owner = partition_model(mesh, config, comm); // collective
-    if (comm.rank() == 0) fe["edge_cut"] = partition_cut(mesh, owner);
+    if (comm.rank() == 0) {
+      fe["edge_cut"] = partition_cut(mesh, owner);
+      // Pairs of elements of bodies about to meet that the graph links (METIS only).
+      if (dc.fe == DecompositionConfig::Fe::metis)
+        fe["body_links"] = contact_body_links(mesh, config).size();
+    }
     j["fe"] = fe;
   }
   if (const ContactPhase* cp = sim.contact()) {

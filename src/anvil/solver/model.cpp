@@ -360,6 +360,13 @@ std::vector<SideEntry> resolve_surface(const Mesh& mesh, const Config& config,
   return faces;
 }
 
+std::vector<std::array<std::int64_t, 2>> contact_body_links(const Mesh& mesh,
+                                                            const Config& config) {
+  if (config.contact.empty()) return {};
+  return links_between_bodies(mesh,
+                              exterior_faces(mesh, blocks_named(mesh, config.contact[0].parts)));
+}
+
 std::vector<int> partition_model(const Mesh& mesh, const Config& config, const Comm& comm) {
   std::vector<int> weight;
   weight.reserve(config.parts.size());
@@ -367,17 +374,13 @@ std::vector<int> partition_model(const Mesh& mesh, const Config& config, const C
     weight.push_back(element_cost(part.hourglass, part.thick_shell));
   std::vector<int> owner;
   if (config.decomposition.fe == DecompositionConfig::Fe::metis) {
-    if (comm.rank() == 0) {
-      // Bodies in contact that start within a face's size of each other are linked in the
-      // graph: the elements of an interface then tend to share a rank in both the FE and
-      // the contact decomposition (docs/cycle.md, "The decompositions").
-      std::vector<std::array<std::int64_t, 2>> links;
-      if (!config.contact.empty() && comm.size() > 1) {
-        links = links_between_bodies(
-            mesh, exterior_faces(mesh, blocks_named(mesh, config.contact[0].parts)));
-      }
-      owner = partition_elements(mesh, comm.size(), weight, links);
-    }
+    // Bodies in contact that start within a face's size of each other are linked in the
+    // graph: the elements of an interface then tend to share a rank in both the FE and the
+    // contact decomposition (docs/cycle.md, "The static FE decomposition").
+    if (comm.rank() == 0)
+      owner = partition_elements(mesh, comm.size(), weight,
+                                 comm.size() > 1 ? contact_body_links(mesh, config)
+                                                 : std::vector<std::array<std::int64_t, 2>>{});
     comm.broadcast(owner, 0);
     return owner;
   }

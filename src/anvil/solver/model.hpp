@@ -3,6 +3,7 @@
 // selections against it.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -47,6 +48,12 @@ std::vector<std::int64_t> elements_holding(const Mesh& mesh, std::span<const std
 // an RCB of the element centres in the deck's stretched coordinates; both weigh each
 // element by its formulation's cost (element_cost), so that a thick-shell part and a
 // solid part share the ranks by work, not by count. Collective.
+// With METIS the graph also links the elements of bodies in contact that start within a
+// face's size of each other (contact_body_links).
 std::vector<int> partition_model(const Mesh& mesh, const Config& config, const Comm& comm);
+
+// The links between bodies of the deck's contact (links_between_bodies of its parts'
+// exterior faces); none without contact.
+std::vector<std::array<std::int64_t, 2>> contact_body_links(const Mesh& mesh, const Config& config);
 
 } // namespace anvil
