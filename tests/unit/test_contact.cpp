@@ -296,6 +296,37 @@ struct Scene {
     set_capture(own);
     faces.push_back(own);
   }
+  // A face with the given corners (counter-clockwise seen from outside) and node ids.
+  void quad(std::int64_t gid, const std::array<Vec3, 4>& x, const std::array<std::int64_t, 4>& id) {
+    ContactFaceItem f{};
+    f.gid = gid;
+    for (int a = 0; a < 4; ++a) {
+      f.node[a] = id[static_cast<std::size_t>(a)];
+      f.opposite[a] = 5000 + 10 * gid + a;
+      for (int i = 0; i < 3; ++i) f.x[a][i] = x[static_cast<std::size_t>(a)][i];
+      f.mass[a] = 1;
+    }
+    f.stiffness = 1e6;
+    f.depth = 0.2;
+    set_capture(f);
+    faces.push_back(f);
+  }
+  // The four faces of a shallow cone z = s (|x| + |y|) over [-1, 1]^2 (s = 0.1: a dish,
+  // -0.1: a peak), its vertex node 4 at the origin (nodes 0..8 row by row from (-1, -1)),
+  // face ids in `ids` (quadrants -x-y, +x-y, +x+y, -x+y).
+  void cone(const std::array<std::int64_t, 4>& ids, double slope = 0.1) {
+    auto at = [slope](int i, int j) {
+      return Vec3{i - 1.0, j - 1.0, slope * (std::abs(i - 1.0) + std::abs(j - 1.0))};
+    };
+    auto node_id = [](int i, int j) { return std::int64_t{3 * j + i}; };
+    const int lo[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (int q = 0; q < 4; ++q) {
+      const int i = lo[q][0], j = lo[q][1];
+      quad(ids[static_cast<std::size_t>(q)],
+           {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)},
+           {node_id(i, j), node_id(i + 1, j), node_id(i + 1, j + 1), node_id(i, j + 1)});
+    }
+  }
   void run() { find_contacts(nodes, faces, SearchOptions{}, work, pairs); }
 };
 
@@ -357,6 +388,75 @@ TEST(Contact, DetailedCheckRules) {
       ASSERT_EQ(s.pairs.size(), 1u);
       EXPECT_EQ(s.faces[static_cast<std::size_t>(s.pairs[0].face)].gid, 5);
     }
+  }
+}
+
+// Near an edge or corner of its face a pair's normal and gap blend with those of the faces
+// sharing it (docs/contact.md, item 4). Reference: the geometry of a cone z = 0.1 (|x| +
+// |y|) whose four faces meet at its vertex, each tilted by atan(0.1 sqrt 2) (normal z
+// component 1 / sqrt(1.02)). A node 0.05 under the vertex lies behind all four: whichever
+// wins (the lower id, which the face ids here move round the quadrants), the normal is
+// their mean, +z, and the gap the mean of theirs, -0.05 / sqrt(1.02) (to 1e-12). Before,
+// it was the winning face's normal, tilted 0.1 / sqrt(1.02) towards the vertex in x and y.
+// Over the middle of a face, nothing blends; near an edge, the face across it weighs the
+// ramp of the foot's distance from the edge (1 at the edge, 0 at 5% of the parent
+// coordinates inside); a tracked node whose foot crosses the edge moves to that face.
+TEST(Contact, NormalsBlendAtEdgesAndCorners) {
+  const double nz = 1 / std::sqrt(1.02), nt = 0.1 / std::sqrt(1.02);
+  for (const std::array<std::int64_t, 4>& ids :
+       {std::array<std::int64_t, 4>{1, 2, 3, 4}, std::array<std::int64_t, 4>{3, 4, 1, 2},
+        std::array<std::int64_t, 4>{4, 1, 2, 3}}) {
+    Scene s;
+    s.cone(ids);
+    s.node(70, {0, 0, -0.05});
+    s.run();
+    ASSERT_EQ(s.pairs.size(), 1u);
+    EXPECT_NEAR(s.pairs[0].normal.x, 0, 1e-12);
+    EXPECT_NEAR(s.pairs[0].normal.y, 0, 1e-12);
+    EXPECT_NEAR(s.pairs[0].normal.z, 1, 1e-12);
+    EXPECT_NEAR(s.pairs[0].gap, -0.05 * nz, 1e-12);
+  }
+  { // over the middle of the +x+y face: its own normal (-nt, -nt, nz)
+    Scene s;
+    s.cone({1, 2, 3, 4});
+    s.node(70, {0.5, 0.5, 0.1 - 0.01});
+    s.run();
+    ASSERT_EQ(s.pairs.size(), 1u);
+    EXPECT_EQ(s.faces[static_cast<std::size_t>(s.pairs[0].face)].gid, 3);
+    EXPECT_NEAR(s.pairs[0].normal.x, -nt, 1e-12);
+    EXPECT_NEAR(s.pairs[0].normal.z, nz, 1e-12);
+  }
+  { // on the peak z = -0.1 (|x| + |y|), over the +x+y face (id 3) 0.005 from its edge x =
+    // 0, 0.001 behind it: behind the -x+y face (id 4) too, whose foot lies just past that
+    // edge. Face 4 weighs the ramp of face 3's foot, r = (|xi| - 0.95) / 0.05 with xi =
+    // 2 x_foot - 1, and the normal and gap are (n3 + r n4) / |..| and (g3 + r g4) / (1 + r)
+    Scene s;
+    s.cone({1, 2, 3, 4}, -0.1);
+    const double x = 0.005, y = 0.5;
+    const Vec3 p{x, y, -0.1 * (x + y) - 0.001};
+    s.node(70, p);
+    s.run();
+    ASSERT_EQ(s.pairs.size(), 1u);
+    EXPECT_EQ(s.faces[static_cast<std::size_t>(s.pairs[0].face)].gid, 3);
+    const double len = std::sqrt(1.02);
+    const Vec3 n3{0.1 / len, 0.1 / len, 1 / len}, n4{-0.1 / len, 0.1 / len, 1 / len};
+    const double g3 = dot(p, n3), g4 = dot(p, n4); // both planes pass through the origin
+    const Vec3 foot3 = p - g3 * n3;
+    const double r = (std::abs(2 * foot3.x - 1) - 0.95) / 0.05;
+    ASSERT_GT(r, 0.0);
+    ASSERT_LT(r, 1.0);
+    const Vec3 sum = n3 + r * n4, n = sum * (1 / norm(sum));
+    EXPECT_NEAR(s.pairs[0].normal.x, n.x, 1e-12);
+    EXPECT_NEAR(s.pairs[0].normal.y, n.y, 1e-12);
+    EXPECT_NEAR(s.pairs[0].normal.z, n.z, 1e-12);
+    EXPECT_NEAR(s.pairs[0].gap, (g3 + r * g4) / (1 + r), 1e-12);
+    // Tracked on face 4, whose foot has crossed onto face 3: the pair moves to face 3.
+    Scene t;
+    t.cone({1, 2, 3, 4}, -0.1);
+    t.node(70, p, /*last=*/4);
+    t.run();
+    ASSERT_EQ(t.pairs.size(), 1u);
+    EXPECT_EQ(t.faces[static_cast<std::size_t>(t.pairs[0].face)].gid, 3);
   }
 }
 

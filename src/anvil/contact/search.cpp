@@ -428,8 +428,10 @@ void queue_candidates(const std::vector<ContactNodeItem>& nodes, const FaceBoxes
 namespace {
 
 // Ramp of the edge band: 0 where the foot's parent coordinate t lies further than `band`
-// inside the face's edge at t = 1, rising to 1 at the edge and staying 1 beyond it.
+// inside the face's edge at t = 1, rising to 1 at the edge and staying 1 beyond it (a band
+// of 0: a step at the edge).
 double edge_ramp(double t, double band) {
+  if (!(band > 0)) return t >= 1 ? 1.0 : 0.0;
   return std::clamp((t - (1 - band)) / band, 0.0, 1.0);
 }
 
