@@ -469,6 +469,8 @@ void check_queued(const std::vector<ContactNodeItem>& nodes,
   pairs.clear();
   if (w.query_face.empty()) return;
   const double tol = 1 + opt.parametric_tolerance;
+  // Room for the faces around a vertex (a blend takes a handful; reserved once).
+  if (w.blend.capacity() < 32) w.blend.reserve(32);
   // Pass 1: the queries, node by node.
   w.queries.clear();
   for (std::size_t k = 0; k < w.active.size(); ++k) {
