@@ -13,7 +13,8 @@
 //    folded half must lie on the base, no flap node below the base's top surface by more
 //    than a tenth of the thickness, contact must have acted, and the energy balance hold
 //    within 1%.
-// 3. The shortened last step, 4. friction, 5. initial overlaps, 6. matching meshes (below).
+// 3. The shortened last step, 4. friction, 5. initial overlaps, 6. and 7. matching meshes
+//    (below).
 #include <gtest/gtest.h>
 
 #include <array>
@@ -289,8 +290,9 @@ TEST(Contact, InitialOverlapIsWarnedOf) {
 //    for bit. Before a pair's normal blended the faces around the vertex where its node
 //    met the plate (each node took the face of lowest id there and kept it) the punch
 //    turned: 0.23 m v0 a at 40 us, its corners rising at +22 and falling at -17 m/s.
-TEST(Contact, MatchingMeshesKeepTheirSymmetry) {
-  const Config c = test::deck(R"(
+// The punch and plate of tests 6 and 7: `elements` of both, meshes matching.
+std::string punch_on_plate(const std::string& elements, const std::string& penalty) {
+  return R"(
 termination: {time: 4.0e-5}
 materials:
   steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
@@ -298,18 +300,27 @@ materials:
         yield_stress: 1.5e8, hardening_modulus: 2.0e8}
 parts:
   punch:
-    mesh: {generate: box, min: [0.003, 0.003, 0.002], max: [0.007, 0.007, 0.006], divisions: [4, 4, 4]}
+    mesh: {generate: box, min: [0.003, 0.003, 0.002], max: [0.007, 0.007, 0.006], divisions: [4, 4, 4],
+           elements: )" +
+         elements + R"(}
     material: steel
   plate:
-    mesh: {generate: box, min: [0, 0, 0], max: [0.01, 0.01, 0.002], divisions: [10, 10, 2]}
+    mesh: {generate: box, min: [0, 0, 0], max: [0.01, 0.01, 0.002], divisions: [10, 10, 2],
+           elements: )" +
+         elements + R"(}
     material: alu
 initial_conditions:
   - {part: punch, velocity: [0, 0, -100.0]}
 boundary_conditions:
   - {set: plate.zmin, fix: all}
 contact:
-  - {type: general}
-)");
+  - {type: general, penalty_scale: )" +
+         penalty + R"(}
+)";
+}
+
+TEST(Contact, MatchingMeshesKeepTheirSymmetry) {
+  const Config c = test::deck(punch_on_plate("hexahedra", "0.1"));
   const Comm world = Comm::world();
   Simulation sim(c, world);
   while (!sim.finished()) sim.step();
@@ -346,6 +357,47 @@ contact:
   EXPECT_LT(norm(spin), 1e-3 * mass * v0 * a);
   EXPECT_LT(std::hypot(p.x, p.y), 1e-3 * mass * v0);
   EXPECT_GT(p.z, 0.0); // the punch rebounds: contact acted
+}
+
+// 7. The same punch and plate meshed in wedges (triangular faces, the box generator's
+//    cut, not mirror-symmetric), penalty scale 0.2 (as for wedges in test 1). Reference:
+//    the hexahedral punch rebounds (test 6), and no punch can pass through a plate whose
+//    base is held: the punch moves up at the end (29 m/s), the layer where its bottom
+//    nodes met the plate's top stays above the plate's mid-plane (z = 1 mm; it dents to
+//    1.8 mm), and the punch's nodes above that layer stay above the plate's top (2 mm).
+//    Before QA round 35 fixed a triangle's xi at its apex the punch went through (its
+//    lowest node at z = -0.5 mm, still moving down at 58 m/s).
+TEST(Contact, WedgePunchDoesNotPassThroughAMatchingPlate) {
+  const Config c = test::deck(punch_on_plate("wedges", "0.2"));
+  const Comm world = Comm::world();
+  Simulation sim(c, world);
+  while (!sim.finished()) sim.step();
+  const auto& nd = sim.nodes();
+  double mass = 0, pz = 0, lowest = 1e300;
+  for (std::size_t n = 0; n < nd.size(); ++n) {
+    if (nd.x0[2][n] < 0.0025) continue; // the punch above its bottom layer
+    lowest = std::min(lowest, nd.x[2][n]);
+    if (!sim.fe().node_owned[n]) continue;
+    mass += nd.mass[n];
+    pz += nd.mass[n] * nd.v[2][n];
+  }
+  double sums[2] = {mass, pz};
+  world.sum(std::span<double>(sums));
+  lowest = world.min(lowest);
+  // The punch's bottom layer nodes coincide with the plate's: its second layer is 1 mm up.
+  double bottom = 1e300;
+  for (std::size_t n = 0; n < nd.size(); ++n)
+    if (std::abs(nd.x0[2][n] - 0.002) < 1e-9 && nd.x0[0][n] > 0.0029 && nd.x0[0][n] < 0.0071 &&
+        nd.x0[1][n] > 0.0029 && nd.x0[1][n] < 0.0071)
+      bottom = std::min(bottom, nd.x[2][n]);
+  bottom = world.min(bottom);
+  if (world.rank() == 0)
+    std::printf("wedge punch on matching plate: vertical velocity %.2f m/s, lowest node of the "
+                "plate and punch's shared layer %.3f mm, punch above it %.3f mm\n",
+                sums[1] / sums[0], bottom * 1e3, lowest * 1e3);
+  EXPECT_GT(sums[1], 0.0);
+  EXPECT_GT(bottom, 0.001);
+  EXPECT_GT(lowest, 0.002);
 }
 
 } // namespace

@@ -18,6 +18,13 @@ std::array<double, 4> quad_shape(double xi, double eta) {
   return n;
 }
 
+std::array<double, 4> foot_shape(double xi, double eta, bool triangle) {
+  if (!triangle) return quad_shape(xi, eta);
+  // lb - la = xi max(la + lb, 0.05) (see foot() below), la + lb = (1 - eta) / 2.
+  const double s = 0.5 * (1 - eta), d = xi * std::max(s, 0.05);
+  return {0.5 * (s - d), 0.5 * (s + d), 0.25 * (1 + eta), 0.25 * (1 + eta)};
+}
+
 namespace {
 
 // The projection written once for one face (V = double) and for `simd::width` faces, one
@@ -94,8 +101,9 @@ struct Foot {
 // pyramid or tetrahedron) is flat: its foot is the projection on its plane, in closed
 // form. With barycentric coordinates la, lb, lc of x0, x1, x2 the bilinear map of the
 // collapsed quadrilateral gives eta = 2 lc - 1 and xi = (lb - la) / (la + lb), so that its
-// shape functions (quad_shape) are la, lb and lc shared by the last two corners. (Newton
-// from the centre converges slowly there: the map is singular at the collapsed edge.)
+// shape functions (quad_shape) are la, lb and lc shared by the last two corners (within 5%
+// of the apex xi = (lb - la) / 0.05, below). (Newton from the centre converges slowly
+// there: the map is singular at the collapsed edge.)
 template <class V, class M>
 Foot<V, M> foot(const V3<V> (&x)[4], const V3<V>& p) {
   const M tri = (x[2].x == x[3].x) && (x[2].y == x[3].y) && (x[2].z == x[3].z);
@@ -172,10 +180,14 @@ Foot<V, M> foot(const V3<V> (&x)[4], const V3<V>& p) {
     set_where(!flat, safe, V(1.0));
     const V lb = dot3(cross3(w, e2), nt) / safe, lc = dot3(cross3(e1, w), nt) / safe;
     const V la = (1.0 - lb) - lc, s = la + lb;
+    // Within 5% of the apex (la + lb below 0.05) xi divides by 0.05 instead: la + lb, the
+    // collapsed quadrilateral's width there, goes to 0 at the apex, and with it the
+    // tolerance on xi, so a node on the apex that moved off it by round-off found its foot
+    // at xi = 1e7 and lost the face it tracked (a wedge punch on a matching plate went
+    // through it, QA round 35). Inside the triangle |xi| stays within 1.
     V ts = s;
-    set_where(!(s > 0.0), ts, V(1.0));
-    V txi = (lb - la) / ts;
-    set_where(!(s > 0.0), txi, V(0.0));
+    set_where(!(s > 0.05), ts, V(0.05));
+    const V txi = (lb - la) / ts;
     const V3<V> pt = add(add(x[0], mul(e1, lb)), mul(e2, lc));
     const V inv = 1 / sqrt_(safe);
     const V3<V> nu = mul(nt, inv);

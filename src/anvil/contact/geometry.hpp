@@ -20,6 +20,10 @@ struct QuadProjection {
 // Bilinear shape functions of the face nodes 0..3 at (xi, eta); corner a at
 // ((-1, -1), (1, -1), (1, 1), (-1, 1))[a].
 std::array<double, 4> quad_shape(double xi, double eta);
+// The shape functions at a foot of project_on_quad: quad_shape, or on a triangle (x2 = x3)
+// its barycentric coordinates, exact also within 5% of its apex x2, where the foot's xi is
+// (lb - la) / 0.05 rather than the collapsed quadrilateral's (lb - la) / (la + lb).
+std::array<double, 4> foot_shape(double xi, double eta, bool triangle);
 
 // Foot of the normal from p onto the bilinear surface through x[0..3] (counter-clockwise
 // seen from outside), by Newton's method on (x(xi, eta) - p) . x_xi = (x - p) . x_eta = 0

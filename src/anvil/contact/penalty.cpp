@@ -21,7 +21,7 @@ void penalty_forces(const std::vector<ContactNodeItem>& nodes,
   for (const auto& p : pairs) {
     const auto& n = nodes[static_cast<std::size_t>(p.node)];
     const auto& f = faces[static_cast<std::size_t>(p.face)];
-    const auto N = quad_shape(p.xi, p.eta);
+    const auto N = foot_shape(p.xi, p.eta, f.node[2] == f.node[3]);
     // The pair's inverse mass: the node against the face's nodes at the foot.
     double inv_m = 1 / n.mass;
     for (int a = 0; a < 4; ++a) inv_m += N[a] * N[a] / f.mass[a];

@@ -177,6 +177,24 @@ std::vector<std::array<std::int64_t, 2>> links_between_bodies(const Mesh& mesh,
       if (box[f].lo[i] > box[g].hi[i] + d || box[g].lo[i] > box[f].hi[i] + d) return false;
     return true;
   };
+  // Each face links to the nearest (by centre; the lower index on a tie) of the faces of
+  // other bodies close to it: about one link per face of an interface, so that the links
+  // between two bodies weigh about as much as the faces along the interface would.
+  std::vector<Vec3> centre(nf);
+  for (std::size_t f = 0; f < nf; ++f)
+    for (int a = 0; a < 4; ++a)
+      centre[f] = centre[f] + 0.25 * mesh.nodes[static_cast<std::size_t>(faces.nodes[f][a])];
+  std::vector<std::int64_t> nearest(nf, -1);
+  std::vector<double> nearest_d2(nf, 0);
+  auto offer = [&](std::size_t f, std::size_t g) {
+    const Vec3 d = centre[g] - centre[f];
+    const double d2 = dot(d, d);
+    const auto gi = static_cast<std::int64_t>(g);
+    if (nearest[f] < 0 || d2 < nearest_d2[f] || (d2 == nearest_d2[f] && gi < nearest[f])) {
+      nearest[f] = gi;
+      nearest_d2[f] = d2;
+    }
+  };
   for (std::size_t b = 0; b < entries.size();) {
     std::size_t e = b;
     while (e < entries.size() && entries[e][0] == entries[b][0]) ++e;
@@ -185,11 +203,17 @@ std::vector<std::array<std::int64_t, 2>> links_between_bodies(const Mesh& mesh,
         const auto f = static_cast<std::size_t>(entries[i][1]),
                    g = static_cast<std::size_t>(entries[j][1]);
         if (body[f] == body[g] || !close(f, g)) continue;
-        const std::int64_t a = faces.element[f], c = faces.element[g];
-        links.push_back({std::min(a, c), std::max(a, c)});
+        offer(f, g);
+        offer(g, f);
       }
     b = e;
   }
+  for (std::size_t f = 0; f < nf; ++f)
+    if (nearest[f] >= 0) {
+      const std::int64_t a = faces.element[f],
+                         c = faces.element[static_cast<std::size_t>(nearest[f])];
+      links.push_back({std::min(a, c), std::max(a, c)});
+    }
   std::sort(links.begin(), links.end());
   links.erase(std::unique(links.begin(), links.end()), links.end());
   return links;

@@ -39,7 +39,8 @@ ExteriorFaces exterior_faces(const Mesh& mesh, const std::vector<bool>& selected
                              const std::vector<bool>& erodible = {});
 
 // Pairs of elements (global ids, the lower first, ascending, each once) of different
-// bodies whose faces among `faces` come within a face's size of each other: the bodies
+// bodies whose faces among `faces` come within a face's size of each other, each face
+// linked to the nearest such face of another body (by centre): the bodies
 // (the mesh's connected components, elements joined by shared nodes) that start close
 // enough to meet soon. The static partition joins them (partition_elements' links), so
 // that the elements of a contact interface tend to fall on one rank, as the contact
