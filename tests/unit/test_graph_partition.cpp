@@ -92,8 +92,8 @@ Vec3 centre(const Mesh& m, std::int64_t e) {
   return c;
 }
 
-// Reference: the geometry. Faces of different bodies whose boxes come within a face's size
-// (0.1) of each other link their elements: with the cube 0.01 above the bar, the bar's top
+// Reference: the geometry. A face links to the nearest face of another body whose box
+// comes within a face's size (0.1) of its own: with the cube 0.01 above the bar, the bar's top
 // layer under it and one element beside it (centres x from 1.25, z = 0.15; the next, 0.15
 // away, not) and the cube's bottom layer (z = 0.26; its top layer is 0.11 away); with the
 // cube 0.15 above (more than a face's size), or one body alone, none.

@@ -102,8 +102,9 @@ struct Foot {
 // form. With barycentric coordinates la, lb, lc of x0, x1, x2 the bilinear map of the
 // collapsed quadrilateral gives eta = 2 lc - 1 and xi = (lb - la) / (la + lb), so that its
 // shape functions (quad_shape) are la, lb and lc shared by the last two corners (within 5%
-// of the apex xi = (lb - la) / 0.05, below). (Newton from the centre converges slowly
-// there: the map is singular at the collapsed edge.)
+// of the apex xi = (lb - la) / 0.05, below, and foot_shape gives la and lb from it).
+// (Newton from the centre converges slowly there: the map is singular at the collapsed
+// edge.)
 template <class V, class M>
 Foot<V, M> foot(const V3<V> (&x)[4], const V3<V>& p) {
   const M tri = (x[2].x == x[3].x) && (x[2].y == x[3].y) && (x[2].z == x[3].z);

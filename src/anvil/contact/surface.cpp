@@ -170,7 +170,7 @@ std::vector<std::array<std::int64_t, 2>> links_between_bodies(const Mesh& mesh,
               {(static_cast<std::int64_t>(k) * n[1] + j) * n[0] + i, static_cast<std::int64_t>(f)});
   }
   std::sort(entries.begin(), entries.end());
-  // Two faces of different bodies link when their boxes are within the larger size.
+  // Two faces of different bodies are close when their boxes are within the larger size.
   auto close = [&](std::size_t f, std::size_t g) {
     const double d = std::max(size[f], size[g]);
     for (int i = 0; i < 3; ++i)

@@ -57,11 +57,11 @@ std::vector<int> partition_elements(const Mesh& mesh, int parts, std::span<const
   std::vector<idx_t> ptr(xadj, xadj + n_el + 1), adj(adjncy, adjncy + xadj[n_el]);
   METIS_Free(xadj);
   METIS_Free(adjncy);
-  // With links, a face between elements weighs 20 and a link 1: a body meets another
-  // over many links (each element's face near several of the other's), and METIS is to
-  // cut the links between two bodies before the faces inside one (QA round 35: with equal
-  // weights two bodies stacked face to face were cut across both, 6-10 times the cut, and
-  // stacks side by side, linked, were split). A body that meets another only through
+  // With links (about one per face of an interface), a face between elements weighs 20
+  // and a link 1: METIS is to cut along an interface, through its links, before it cuts
+  // through a body, through its faces (QA round 35: with every close pair linked and
+  // equal weights, two bodies stacked face to face were cut across both, 6-10 times the
+  // cut, and stacks side by side were split). A body that meets another only through
   // links still goes with it: cutting them all costs more than cutting none.
   constexpr idx_t face_weight = 20, link_weight = 1;
   std::vector<idx_t> wgt;
