@@ -256,3 +256,96 @@ TEST(RigidBody, HeldComponentsTakeTheirValues) {
 }
 
 } // namespace
+
+// 6. Planar walls on a body (apply_walls_to_body). Reference: the mechanics of an impulse
+//    at a point of a rigid body (Goldstein, "Classical Mechanics", 3rd ed., 2002, section
+//    1.2: the impulse J at x_P changes the momentum by J and the angular momentum about the
+//    centre by (x_P - c) x J). The brick of item 1, moving and spinning towards a wall
+//    tilted to its faces, which only its corner at the origin reaches in the step: the
+//    corner lands on the wall (its normal velocity the one that puts it there; 1e-12 of its
+//    motion over the step), every other corner in front; without friction the impulse is
+//    along the normal, so the momentum changes along it only and the angular momentum about
+//    the corner not at all (1e-12 relative), and the impulse reported is the change of the
+//    normal momentum (1e-12 relative). With friction mu the impulse in the wall's plane is
+//    at most mu times the normal one (Coulomb) and slows the corner's sliding. Every
+//    component held: the wall cannot move the body, which keeps its motion.
+TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
+  const std::vector<RigidPoint> p = brick();
+  double M = 0;
+  Vec3 c{0, 0, 0};
+  for (const auto& q : p) {
+    M += q.m;
+    c += q.m * q.x;
+  }
+  c = c * (1 / M);
+  const Vec3 n = Vec3{0.3, 0.2, 1.0} * (1 / norm(Vec3{0.3, 0.2, 1.0}));
+  const WallPlane wall{-0.001 * n, n, 0.0};
+  RigidMotion m0;
+  m0.centre = c;
+  m0.velocity = {1.0, 0.5, -3.0};
+  m0.omega = {0.4, -0.3, 0.2};
+  m0.dt = 0.01;
+  m0.mass = M;
+  // Angular momentum about a point x_P at t(n): I omega + M (c - x_P) x v_c.
+  auto momentum_about = [&](const RigidMotion& m, const Vec3& xp) {
+    double J[3][3] = {};
+    for (const auto& q : p) {
+      const Vec3 r = q.x - c;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) J[i][j] += q.m * r[i] * r[j];
+    }
+    const double tr = J[0][0] + J[1][1] + J[2][2];
+    Vec3 L{0, 0, 0};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) L[i] += ((i == j ? tr : 0.0) - J[i][j]) * m.omega[j];
+    return L + M * cross(c - xp, m.velocity);
+  };
+  auto landing = [&](const RigidMotion& m, const RigidPoint& q) {
+    return dot(n, q.x + m.dt * m.point_velocity(q.x) - wall.point);
+  };
+  ASSERT_LT(landing(m0, p[0]), 0.0);
+  for (std::size_t k = 1; k < p.size(); ++k) ASSERT_GT(landing(m0, p[k]), 0.0);
+  const double step = m0.dt * norm(m0.point_velocity(p[0].x));
+
+  RigidMotion m = m0;
+  BodyWallScratch scratch;
+  std::vector<WallImpulse> out;
+  const std::vector<WallPlane> walls{wall};
+  EXPECT_GT(apply_walls_to_body(p, walls, RigidHold{}, m, scratch, out), 0);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].point, 0u);
+  EXPECT_EQ(out[0].wall, 0);
+  EXPECT_NEAR(landing(m, p[0]), 0.0, 1e-12 * step);
+  for (std::size_t k = 1; k < p.size(); ++k) EXPECT_GT(landing(m, p[k]), 0.0);
+  const Vec3 dP = M * (m.velocity - m0.velocity);
+  EXPECT_NEAR(dot(dP, n), out[0].impulse, 1e-12 * out[0].impulse);
+  EXPECT_LT(norm(dP - dot(dP, n) * n), 1e-12 * out[0].impulse);
+  const Vec3 L0 = momentum_about(m0, p[0].x), L1 = momentum_about(m, p[0].x);
+  EXPECT_LT(norm(L1 - L0), 1e-12 * norm(L0));
+  // Friction.
+  RigidMotion mf = m0;
+  const std::vector<WallPlane> rough{{wall.point, n, 0.2}};
+  out.clear();
+  EXPECT_GT(apply_walls_to_body(p, rough, RigidHold{}, mf, scratch, out), 0);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_NEAR(landing(mf, p[0]), 0.0, 1e-12 * step);
+  const Vec3 dPf = M * (mf.velocity - m0.velocity);
+  const Vec3 tangential = dPf - dot(dPf, n) * n;
+  EXPECT_GT(norm(tangential), 0.0);
+  EXPECT_LE(norm(tangential), 0.2 * out[0].impulse * (1 + 1e-12));
+  auto sliding = [&](const RigidMotion& mm) {
+    const Vec3 u = mm.point_velocity(p[0].x);
+    return norm(u - dot(u, n) * n);
+  };
+  EXPECT_LT(sliding(mf), sliding(m));
+  // Every component held.
+  RigidHold all;
+  all.velocity_held = {true, true, true};
+  all.spin_held = {true, true, true};
+  RigidMotion mh = m0;
+  out.clear();
+  apply_walls_to_body(p, walls, all, mh, scratch, out);
+  EXPECT_TRUE(out.empty());
+  EXPECT_EQ(norm(mh.velocity - m0.velocity), 0.0);
+  EXPECT_EQ(norm(mh.omega - m0.omega), 0.0);
+}

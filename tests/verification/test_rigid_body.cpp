@@ -32,6 +32,15 @@
 //    *INITIAL_VELOCITY_RIGID_BODY): at t = 0 a free rigid box's centre moves at V and its
 //    angular momentum is I omega about the centre; it keeps both for 200 steps (a free
 //    body: Newton, Euler); all to 1e-12 of |V| and of |I omega|.
+// 5. A free rigid cube, moving along x and spinning about y, dropped onto a frictionless
+//    planar wall (`rigid_walls`): it lands on an edge, turns onto its face and leaves
+//    rocking. Reference: the mechanics of impulses on a rigid body (Goldstein, "Classical
+//    Mechanics", 3rd ed., 2002, section 1.2) and the wall's kinematic condition (the point
+//    that would cross it lands on it, contact.md "Rigid walls"): no node ever behind the
+//    wall (1e-12 m, round-off of 1 cm coordinates); the x momentum kept (1e-12 relative:
+//    the wall pushes along z only); the wall's impulses, its force history times the step,
+//    the body's change of z momentum (1e-9 relative); the energy balance closed (1e-12:
+//    the walls' work is external work); the same bits on one rank and on all.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -578,6 +587,79 @@ TEST(RigidBody, DrivenPlateSendsTheOneDimensionalWave) {
   EXPECT_NEAR(last.rigid_bodies[2], V * t_sample, 1e-12 * V * t_sample);
   EXPECT_LT(test::relative_error(force, f_ref), 0.01);
   EXPECT_LT(test::relative_error(stress, s_ref), 0.01);
+}
+
+struct WallDrop {
+  std::vector<double> rows; // per step: the wall's force, then the body's motion
+  double behind = 0, px_worst = 0, impulse = 0, vz0 = 0, vz1 = 0, balance = 0;
+};
+
+WallDrop drop_on_wall(const Comm& comm) {
+  Simulation sim(test::deck(R"(
+termination: {time: 4.0e-4}
+materials:
+  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+parts:
+  cube:
+    mesh: {generate: box, min: [0, 0, 0.0005], max: [0.01, 0.01, 0.0105], divisions: [2, 2, 2]}
+    material: steel
+    rigid: true
+  other:
+    mesh: {generate: box, min: [0.05, 0, 0.01], max: [0.06, 0.01, 0.02], divisions: [1, 1, 1]}
+    material: steel
+initial_conditions:
+  - {part: cube, velocity: [3.0, 0, -10.0], angular_velocity: [0, 1000.0, 0], center: mass_center}
+rigid_walls:
+  - {point: [0, 0, 0], normal: [0, 0, 1]}
+)"),
+                 comm);
+  WallDrop r;
+  const double M = 7850 * 1e-6;
+  bool first = true;
+  while (!sim.finished()) {
+    sim.step();
+    const Sample s = sim.sample();
+    const auto& nd = sim.nodes();
+    double lowest = 1;
+    for (std::size_t n = 0; n < nd.size(); ++n)
+      if (nd.x0[0][n] < 0.02) lowest = std::min(lowest, nd.x[2][n]);
+    r.behind = std::max(r.behind, -comm.min(lowest));
+    // The body's velocity over the step (rigid_bodies: ux, uy, uz, vx, vy, vz, wx, wy, wz).
+    const double vx = s.rigid_bodies[3], vz = s.rigid_bodies[5];
+    r.px_worst = std::max(r.px_worst, std::abs(vx - 3.0) / 3.0);
+    if (first) r.vz0 = vz;
+    first = false;
+    r.vz1 = vz;
+    // (The force is the step's impulses over the interval dt_avg around t(n): the steps
+    // are all equal here, the cube of `other` setting them, so dt_avg is dt.)
+    r.impulse += s.wall_force[0] * s.dt;
+    r.rows.push_back(s.wall_force[0]);
+    r.rows.insert(r.rows.end(), s.rigid_bodies.begin(), s.rigid_bodies.end());
+    r.balance = sim.balance_error(s);
+  }
+  r.impulse /= M; // as a change of velocity
+  return r;
+}
+
+TEST(RigidBody, FreeBodyLandsOnAWall) {
+  const Comm world = Comm::world();
+  const WallDrop r = drop_on_wall(world);
+  if (world.rank() == 0)
+    std::printf("rigid cube on a wall: deepest node behind it %.1e m, x momentum %.1e, "
+                "impulse / M %.6f m/s against the change of vz %.6f m/s, balance %.1e\n",
+                r.behind, r.px_worst, r.impulse, r.vz1 - r.vz0, r.balance);
+  EXPECT_LT(r.behind, 1e-12);
+  EXPECT_LT(r.px_worst, 1e-12);
+  EXPECT_GT(r.vz1, 0.0); // it left the wall
+  EXPECT_NEAR(r.impulse, r.vz1 - r.vz0, 1e-9 * std::abs(r.vz0));
+  EXPECT_LT(r.balance, 1e-12);
+  if (world.rank() != 0) return;
+  const WallDrop one = drop_on_wall(Comm::self());
+  ASSERT_EQ(one.rows.size(), r.rows.size());
+  std::size_t differing = 0;
+  for (std::size_t k = 0; k < r.rows.size(); ++k)
+    differing += std::memcmp(&one.rows[k], &r.rows[k], sizeof(double)) != 0;
+  EXPECT_EQ(differing, 0u) << "wall forces and body motions differing from the one-rank run";
 }
 
 } // namespace

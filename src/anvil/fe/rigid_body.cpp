@@ -1,5 +1,6 @@
 #include "anvil/fe/rigid_body.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace anvil {
@@ -176,6 +177,122 @@ RigidMotion rigid_motion(std::span<const RigidPoint> p, const Vec3& g, double dt
         out.held_torque[i] =
             (I[i][0] * omega[0] + I[i][1] * omega[1] + I[i][2] * omega[2] - L[i]) / dt_avg;
   return out;
+}
+
+int apply_walls_to_body(std::span<const RigidPoint> p, std::span<const WallPlane> walls,
+                        const RigidHold& hold, RigidMotion& motion, BodyWallScratch& scratch,
+                        std::vector<WallImpulse>& out) {
+  const double dt = motion.dt;
+  if (!(dt > 0) || walls.empty() || p.empty() || !(motion.mass > 0)) return 0;
+  const Vec3 c = motion.centre;
+  auto& rows = scratch.rows;
+  rows.clear();
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (std::size_t w = 0; w < walls.size(); ++w) {
+      const Vec3& n = walls[w].normal;
+      const Vec3 land = p[i].x + dt * motion.point_velocity(p[i].x);
+      if (dot(n, land - walls[w].point) < 0)
+        rows.push_back({i, static_cast<int>(w), p[i].x - c, cross(p[i].x - c, n),
+                        dot(n, walls[w].point - p[i].x) / dt, 0.0, 0.0, Vec3{0, 0, 0}});
+    }
+  if (rows.empty()) return 0;
+  // The body's response to an impulse: its centre's velocity changes by J / M and its
+  // angular velocity by I^-1 (r x J), I the inertia at t(n); a held component does not
+  // change (its rows of I omega = L give way to omega_i = its value, as in rigid_motion).
+  Mat3 J{};
+  for (const auto& q : p) {
+    const Vec3 r = q.x - c;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) J[i][j] += q.m * r[i] * r[j];
+  }
+  const double trJ = J[0][0] + J[1][1] + J[2][2];
+  Mat3 I;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) I[i][j] = (i == j ? trJ : 0.0) - J[i][j];
+  const bool all_held = hold.spin_held[0] && hold.spin_held[1] && hold.spin_held[2];
+  const double trI = I[0][0] + I[1][1] + I[2][2];
+  for (int i = 0; i < 3; ++i)
+    if (hold.spin_held[static_cast<std::size_t>(i)])
+      for (int j = 0; j < 3; ++j) I[i][j] = i == j ? trI : 0.0;
+  Mat3 W{}; // columns: the change of omega per unit torque about each axis
+  if (!all_held)
+    for (int k = 0; k < 3; ++k) {
+      Vec3 e{0, 0, 0};
+      e[k] = 1;
+      Vec3 col = solve(I, e);
+      for (int i = 0; i < 3; ++i) {
+        if (hold.spin_held[static_cast<std::size_t>(i)]) col[i] = 0;
+        W[i][k] = col[i];
+      }
+    }
+  const double inv_m = 1 / motion.mass;
+  auto dv = [&](const Vec3& imp) {
+    Vec3 d = inv_m * imp;
+    for (int i = 0; i < 3; ++i)
+      if (hold.velocity_held[static_cast<std::size_t>(i)]) d[i] = 0;
+    return d;
+  };
+  auto dw = [&](const Vec3& tau) {
+    Vec3 d;
+    for (int i = 0; i < 3; ++i) d[i] = W[i][0] * tau[0] + W[i][1] * tau[1] + W[i][2] * tau[2];
+    return d;
+  };
+  auto response = [&](const Vec3& r, const Vec3& dir) {
+    const Vec3 rd = cross(r, dir);
+    return dot(dir, dv(dir)) + dot(rd, dw(rd));
+  };
+  double scale = 0;
+  for (auto& row : rows) {
+    row.k = response(row.r, walls[static_cast<std::size_t>(row.wall)].normal);
+    scale = std::max(scale, std::abs(row.target) + norm(motion.point_velocity(p[row.point].x)));
+  }
+  const double tol = 1e-12 * scale;
+  int sweep = 0;
+  for (double worst = 2 * tol + 1; sweep < 1000 && worst > tol;) {
+    ++sweep;
+    for (auto& row : rows) {
+      if (!(row.k > 0)) continue; // every component the impulse would move is held
+      const WallPlane& wall = walls[static_cast<std::size_t>(row.wall)];
+      const Vec3& n = wall.normal;
+      const Vec3& x = p[row.point].x;
+      const double lambda =
+          std::max(0.0, row.lambda + (row.target - dot(n, motion.point_velocity(x))) / row.k);
+      const double d = lambda - row.lambda;
+      row.lambda = lambda;
+      motion.velocity += dv(d * n);
+      motion.omega += dw(d * row.rn);
+      if (!(wall.friction > 0)) continue;
+      // Friction: the impulse in the wall's plane that stops the point's sliding, within
+      // mu times the normal impulse.
+      const Vec3 u = motion.point_velocity(x);
+      const Vec3 ut = u - dot(n, u) * n;
+      const double slide = norm(ut);
+      Vec3 jt = row.jt;
+      if (slide > 0) {
+        const Vec3 dir = ut * (1 / slide);
+        const double kt = response(row.r, dir);
+        if (kt > 0) jt = jt - (slide / kt) * dir;
+      }
+      const double limit = wall.friction * row.lambda, size = norm(jt);
+      if (size > limit) jt = size > 0 ? jt * (limit / size) : Vec3{0, 0, 0};
+      const Vec3 dj = jt - row.jt;
+      row.jt = jt;
+      motion.velocity += dv(dj);
+      motion.omega += dw(cross(row.r, dj));
+    }
+    // How far from settled: a point still landing behind its wall, or one pushed by an
+    // impulse off it (the impulse could be less).
+    worst = 0;
+    for (const auto& row : rows) {
+      if (!(row.k > 0)) continue;
+      const double miss = row.target - dot(walls[static_cast<std::size_t>(row.wall)].normal,
+                                           motion.point_velocity(p[row.point].x));
+      worst = std::max(worst, row.lambda > 0 ? std::abs(miss) : miss);
+    }
+  }
+  for (const auto& row : rows)
+    if (row.lambda > 0) out.push_back({row.point, row.wall, row.lambda});
+  return sweep;
 }
 
 } // namespace anvil

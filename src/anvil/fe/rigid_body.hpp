@@ -16,7 +16,9 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <span>
+#include <vector>
 
 #include "anvil/core/vec3.hpp"
 
@@ -63,5 +65,48 @@ struct RigidMotion {
 // then solve the free rows of L = I omega.
 RigidMotion rigid_motion(std::span<const RigidPoint> p, const Vec3& g, double dt_prev,
                          double dt_avg, double dt, const RigidHold& hold = {});
+
+// A planar wall as a rigid body meets it: a point on the wall, its unit normal (towards the
+// side bodies stay on) and the Coulomb friction coefficient.
+struct WallPlane {
+  Vec3 point, normal;
+  double friction = 0;
+};
+
+// The normal impulse (N s) one wall gave one point of a body over the step.
+struct WallImpulse {
+  std::size_t point;
+  int wall;
+  double impulse;
+};
+
+// The constraints of apply_walls_to_body(), kept between calls (no allocation once grown).
+struct BodyWallScratch {
+  struct Row {
+    std::size_t point;
+    int wall;
+    Vec3 r, rn;    // the point's offset from the centre, and r x n
+    double target; // the normal velocity that lands the point on the wall
+    double k;      // the inverse of the body's effective mass along n at the point
+    double lambda; // the normal impulse so far
+    Vec3 jt;       // the friction impulse so far
+  };
+  std::vector<Row> rows;
+};
+
+// Planar walls on a rigid body, kinematically as on nodes (contact/rigid_wall.hpp): where
+// some point of the body would land behind a wall, x + dt v(x) with v(x) the motion's
+// point_velocity, the body's velocity and angular velocity change by the impulses at those
+// points that put each of them on its wall at t(n) + dt (or leave it in front), pushing and
+// never pulling; friction then opposes each such point's sliding by at most mu times its
+// normal impulse. The impulses solve the constraints together, point after point in the
+// order given, repeated until every landing is on or in front of its wall to round-off
+// (projected Gauss-Seidel, at most 1,000 sweeps). Held components do not change (they
+// take the impulse, as a fixed node does). The inertia is that of the points at t(n)
+// about the motion's centre. Appends each normal impulse to `out`; returns the sweeps made
+// (0: no point behind a wall, the motion unchanged).
+int apply_walls_to_body(std::span<const RigidPoint> p, std::span<const WallPlane> walls,
+                        const RigidHold& hold, RigidMotion& motion, BodyWallScratch& scratch,
+                        std::vector<WallImpulse>& out);
 
 } // namespace anvil

@@ -79,12 +79,8 @@ void Simulation::setup_rigid_bodies(const Mesh& mesh) {
                                        config_.parts[part_of_body[o]].name,
                                        config_.parts[part_of_body[o]].name));
   }
-  if (!config_.rigid_walls.empty())
-    warnings_.push_back(fmt::format(
-        "{}: rigid walls do not act on rigid parts ({} here): a rigid body passes through a "
-        "wall; give the wall as a rigid part in contact instead (docs/contact.md, \"Rigid "
-        "bodies\")",
-        config_.rigid_walls[0].where.str(), config_.parts[part_of_body[0]].name));
+  wall_planes_.clear();
+  for (const auto& w : config_.rigid_walls) wall_planes_.push_back({w.point, w.normal, w.friction});
   rigid_offset_.assign(rigid_gids_.size() + 1, 0);
   for (std::size_t o = 0; o < rigid_gids_.size(); ++o)
     rigid_offset_[o + 1] = rigid_offset_[o] + rigid_gids_[o].size();
@@ -104,6 +100,11 @@ void Simulation::setup_rigid_bodies(const Mesh& mesh) {
       rigid_node_[n] = 1;
       constrained_[n] = 7; // every component follows the body
     }
+  rigid_point_owned_.assign(rigid_points_.size(), 0);
+  for (const auto& rn : rigid_nodes_)
+    if (rn.owned)
+      rigid_point_owned_[rigid_offset_[static_cast<std::size_t>(rn.body)] +
+                         static_cast<std::size_t>(rn.slot)] = 1;
   rigid_send_.reserve(rigid_nodes_.size());
   rigid_recv_.reserve(rigid_points_.size());
   // Each body's centre of mass at t = 0 (history's rigid.NAME.ux...; the same bits on any
@@ -198,6 +199,9 @@ void Simulation::gather_rigid_points(bool with_contact) {
 // nodes_.v. With contact (correct): the contact forces added, v(n - 1/2) in v_prev_.
 void Simulation::move_rigid_bodies(bool with_contact) {
   gather_rigid_points(with_contact);
+  // The walls act on the step's last motion: with contact, the one with the contact forces.
+  const bool walls = !wall_planes_.empty() && (with_contact || !contact_);
+  if (walls) rigid_wall_hits_.clear();
   const Vec3 g{gravity_[0], gravity_[1], gravity_[2]};
   const auto& bcs = config_.boundary_conditions;
   for (std::size_t o = 0; o < rigid_gids_.size(); ++o) {
@@ -232,6 +236,16 @@ void Simulation::move_rigid_bodies(bool with_contact) {
                          "it spins too fast for the time step (by about a radian or more a "
                          "step, or a held spin by more than a radian): its rotation over a "
                          "step cannot be followed; lower time_step.scale or the spin");
+    if (!walls) continue;
+    // The walls' impulses change the motion; the nodes' velocities follow it, and the
+    // change beyond the forces' is the constraints' (external) work, as a held component's.
+    // Each point's normal impulse is a hit of its wall on the rank that owns its node.
+    body_wall_impulses_.clear();
+    apply_walls_to_body(pts, wall_planes_, hold, rigid_motion_[o], body_wall_scratch_,
+                        body_wall_impulses_);
+    for (const auto& h : body_wall_impulses_)
+      if (rigid_point_owned_[rigid_offset_[o] + h.point] != 0)
+        rigid_wall_hits_.push_back({rigid_gids_[o][h.point], h.wall, h.impulse});
   }
 }
 

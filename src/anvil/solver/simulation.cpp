@@ -1173,7 +1173,8 @@ void Simulation::correct() {
 }
 
 void Simulation::apply_walls() {
-  wall_hits_.clear();
+  // The rigid bodies met the walls in their motion (move_rigid_bodies); their hits first.
+  wall_hits_.assign(rigid_wall_hits_.begin(), rigid_wall_hits_.end());
   const WallNodes wn{{nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()},
                      {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()},
                      {v_prev_[0].data(), v_prev_[1].data(), v_prev_[2].data()},

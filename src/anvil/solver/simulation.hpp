@@ -375,6 +375,14 @@ private:
   std::vector<int> condition_body_;
   std::vector<Vec3> rigid_centre0_; // each body's centre of mass at t = 0
   std::vector<std::array<int, 6>> rigid_holder_;
+  // The rigid walls as the bodies meet them (apply_walls_to_body), per body point whether
+  // its node is owned here, and the hits of the step's last motion on the owned points
+  // (joined to the nodes' in apply_walls()).
+  std::vector<WallPlane> wall_planes_;
+  std::vector<std::uint8_t> rigid_point_owned_;
+  BodyWallScratch body_wall_scratch_;
+  std::vector<WallImpulse> body_wall_impulses_;
+  std::vector<WallHit> rigid_wall_hits_;
 
   // Element probes: (block, element) on the rank that holds the element, (-1, -1) elsewhere.
   std::vector<std::array<int, 2>> element_probe_;
