@@ -10,6 +10,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "anvil/io/outputs.hpp"
 #include "test_support.hpp"
 
@@ -130,6 +132,19 @@ TEST(Cli, CheckPrintsCountsMassAndTimeStep) {
   EXPECT_NE(r.out.find("stable dt"), std::string::npos) << r.out;
 }
 
+// `check` names the element that sets the step (QA round 36: one 1 um element among 200,000
+// set a step 2,500 times smaller, unnamed): a 2 um cube beside the 54 elements of the block.
+TEST(Cli, CheckNamesTheElementThatSetsTheStep) {
+  std::string deck = small_deck;
+  const auto at = deck.find("initial_conditions:");
+  deck.insert(at, "  tiny:\n    mesh: {generate: box, min: [0.05, 0, 0], max: [0.050002, 0.000002, "
+                  "0.000002], divisions: [1, 1, 1]}\n    material: steel\n");
+  const auto r = run("check " + write_temp("tiny_element.yaml", deck));
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("set by element 55 (part tiny, element 1 of the part)"), std::string::npos)
+      << r.out;
+}
+
 // A rigid translation does not compress: its stable step is the step at rest (element.md,
 // "Artificial bulk viscosity"; the same six digits `check` prints). Its tr D is round-off,
 // and with the sign alone deciding, the linear viscosity's term cut this block's step by
@@ -177,6 +192,26 @@ TEST(Cli, NodesBehindAWallAreWarnedOf) {
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_EQ(r.out.find("behind rigid wall"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("outside the model"), std::string::npos) << r.out; // probe on the top
+  // A rigid body's nodes: the wall moves them through the body (contact.md, "Rigid walls"),
+  // so they count: the 4 of its base.
+  r = run("check " + write_temp("rigid_behind_wall.yaml", R"(
+termination: {time: 1.0e-6}
+materials:
+  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+parts:
+  body:
+    mesh: {generate: box, min: [0, 0, 0], max: [0.01, 0.01, 0.02], divisions: [1, 1, 2]}
+    material: steel
+    rigid: true
+  other:
+    mesh: {generate: box, min: [0.1, 0, 0.1], max: [0.11, 0.01, 0.11], divisions: [1, 1, 1]}
+    material: steel
+rigid_walls:
+  - {point: [0, 0, 0.005], normal: [0, 0, 1]}
+)"));
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("4 nodes or particles start behind rigid wall 0"), std::string::npos)
+      << r.out;
 }
 
 // A probe far from the model takes the nearest node silently; check warns.
@@ -565,6 +600,53 @@ TEST(Cli, DecomposeCountsTheLinksBetweenBodies) {
   };
   EXPECT_GT(links("tetrahedra_impact.yaml"), 0);
   EXPECT_EQ(links("taylor_bar.yaml"), 0);
+}
+
+// A contact node past its face's contact depth is warned of, once, as it happens (QA round
+// 36: a steel punch at 3 km/s went 199% of the depth into an aluminium block and through
+// it, unflagged): the punch at 3 km/s warns and summary.json has the share; at 100 m/s
+// neither.
+TEST(Cli, ContactPastTheDepthIsWarnedOf) {
+  auto deck = [](const std::string& speed) {
+    return R"(
+termination: {time: 1.0e-6}
+materials:
+  al: {model: j2_plasticity, density: 2700, youngs_modulus: 70.0e9, poissons_ratio: 0.33, yield_stress: 2.0e8}
+  st: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+parts:
+  block:
+    mesh: {generate: box, min: [0, 0, 0], max: [0.01, 0.01, 0.006], divisions: [5, 5, 3]}
+    material: al
+  punch:
+    mesh: {generate: box, min: [0.007, 0.002, 0.00605], max: [0.013, 0.008, 0.00905], divisions: [4, 4, 2]}
+    material: st
+initial_conditions:
+  - {part: punch, velocity: [0, 0, -)" +
+           speed + R"(]}
+contact:
+  - {}
+)";
+  };
+  const auto dir = std::filesystem::temp_directory_path() / "anvil_cli_test";
+  for (const std::string speed : {"3000.0", "100.0"}) {
+    const std::string out = (dir / ("deep_" + speed)).string();
+    const auto r =
+        run("run -q " + write_temp("deep_" + speed + ".yaml", deck(speed)) + " -o " + out);
+    EXPECT_EQ(r.status, 0) << r.out;
+    std::ifstream in(out + "/summary.json");
+    const auto j = nlohmann::json::parse(in);
+    const double share = j["contact"]["max_penetration_of_depth"].get<double>();
+    const bool warned =
+        r.out.find("of its face's contact depth behind the face") != std::string::npos;
+    if (speed == "100.0") {
+      EXPECT_LT(share, 1.0);
+      EXPECT_FALSE(warned) << r.out;
+    } else {
+      EXPECT_GE(share, 1.0);
+      EXPECT_TRUE(warned) << r.out;
+      EXPECT_NE(r.out.find("penalty_scale"), std::string::npos) << r.out;
+    }
+  }
 }
 
 } // namespace

@@ -50,4 +50,37 @@ TEST(ElementsHolding, ElementsOfVeryDifferentSizesSideBySide) {
   EXPECT_EQ(elements_holding(m, blocks, points, {}), expected);
 }
 
+// Reference: the geometry. Two boxes of wedges and two of tetrahedra that touch exactly
+// on a face (z = 3 mm), the meshes matching: every node of the upper box's lower face is
+// on the surface of the lower box, not inside it, though it lies on a corner or an edge of
+// lower elements that reach the surface there only by that corner or edge, with no face on
+// it (QA round 36: 8 nodes of wedges and 32 of tetrahedra were reported inside). A point
+// in the lower box's interior is still held, and so is one on a face between two of its
+// elements (on the plane y = 2 mm between its cells).
+TEST(ElementsHolding, TouchingMeshesOfWedgesAndTetrahedraAreNotInside) {
+  for (const Shape shape : {Shape::wedge, Shape::tetrahedron}) {
+    Mesh m = generate_box({{0, 0, 0}, {0.003, 0.003, 0.003}, {3, 3, 3}, shape});
+    const Mesh upper = generate_box({{0, 0, 0.003}, {0.003, 0.003, 0.006}, {3, 3, 3}, shape});
+    const auto lower_nodes = m.nodes.size();
+    m.append(upper, "upper");
+    const std::vector<std::size_t> blocks{0, 1};
+    std::vector<Vec3> points;
+    std::vector<std::int64_t> ids;
+    for (std::size_t n = lower_nodes; n < m.nodes.size(); ++n)
+      if (m.nodes[n].z < 0.003 + 1e-12) {
+        points.push_back(m.nodes[n]);
+        ids.push_back(static_cast<std::int64_t>(n));
+      }
+    ASSERT_EQ(points.size(), 16u);
+    const auto touching = elements_holding(m, blocks, points, ids);
+    for (std::size_t i = 0; i < points.size(); ++i)
+      EXPECT_EQ(touching[i], -1) << shape_name(shape) << " node " << ids[i] << " at ("
+                                 << points[i].x << ", " << points[i].y << ", " << points[i].z
+                                 << ")";
+    const std::vector<Vec3> inner{{0.0011, 0.0012, 0.0013}, {0.0011, 0.002, 0.0013}};
+    for (const std::int64_t h : elements_holding(m, blocks, inner, {}))
+      EXPECT_GE(h, 0) << shape_name(shape);
+  }
+}
+
 } // namespace

@@ -231,8 +231,8 @@ ContactPhase::ContactPhase(const ContactConfig& config, const Mesh& mesh, const 
   allowance_.assign(fe.node_gid.size(), 0.0);
   {
     const auto P = static_cast<std::size_t>(comm.size());
-    mine_.assign(4 + P, 0.0);
-    gathered_.assign((4 + P) * P, 0.0);
+    mine_.assign(stat_values + P, 0.0);
+    gathered_.assign((stat_values + P) * P, 0.0);
     force_counts_.assign(P, 0);
     force_recv_.assign(P, 0);
   }
@@ -1379,34 +1379,39 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
     force_dest_.clear();
     penalty_forces(*search_nodes_, *search_faces_, pairs_, {config_.friction, dt},
                    {fe_.holder_start, fe_.holder_ranks}, force_out_, force_dest_);
-    double deepest = 0, resisted = 0;
+    double deepest = 0, resisted = 0, deepest_share = 0;
     for (const auto& p : pairs_) {
       deepest = std::max(deepest, -p.gap);
       resisted = std::max(resisted, -p.gap - p.allowance);
+      const double depth = (*search_faces_)[static_cast<std::size_t>(p.face)].depth;
+      if (depth > 0) deepest_share = std::max(deepest_share, -p.gap / depth);
     }
     // Load of this rank: nodes searched plus faces held. One collective (an all-gather of
-    // four values per rank, reduced here in rank order) for the balance test, the pair
-    // count and the deepest penetrations, which need both sums and maxima; and of the
+    // stat_values values per rank, reduced here in rank order) for the balance test, the
+    // pair count and the deepest penetrations, which need both sums and maxima; and of the
     // force items' counts per destination rank, for the force plan (no all-to-all).
     const auto P = static_cast<std::size_t>(comm_.size());
+    constexpr std::size_t K = stat_values;
     mine_[0] = static_cast<double>(search_nodes_->size() + search_faces_->size());
     mine_[1] = static_cast<double>(pairs_.size());
     mine_[2] = deepest;
     mine_[3] = resisted;
+    mine_[4] = deepest_share;
     Migration::count(comm_.size(), force_dest_, force_counts_);
-    for (std::size_t q = 0; q < P; ++q) mine_[4 + q] = static_cast<double>(force_counts_[q]);
+    for (std::size_t q = 0; q < P; ++q) mine_[K + q] = static_cast<double>(force_counts_[q]);
     comm_.allgather_bytes(mine_.data(), mine_.size() * sizeof(double), gathered_.data());
     for (std::size_t q = 0; q < P; ++q)
       force_recv_[q] = static_cast<std::int64_t>(
-          gathered_[(4 + P) * q + 4 + static_cast<std::size_t>(comm_.rank())]);
-    double load_max = 0, load_sum = 0, pair_sum = 0, deep_max = 0, resisted_max = 0;
+          gathered_[(K + P) * q + K + static_cast<std::size_t>(comm_.rank())]);
+    double load_max = 0, load_sum = 0, pair_sum = 0, deep_max = 0, resisted_max = 0, share_max = 0;
     for (int r = 0; r < comm_.size(); ++r) {
-      const double* g = gathered_.data() + (4 + P) * static_cast<std::size_t>(r);
+      const double* g = gathered_.data() + (K + P) * static_cast<std::size_t>(r);
       load_max = std::max(load_max, g[0]);
       load_sum += g[0];
       pair_sum += g[1];
       deep_max = std::max(deep_max, g[2]);
       resisted_max = std::max(resisted_max, g[3]);
+      share_max = std::max(share_max, g[4]);
     }
     const double mean = load_sum / comm_.size();
     stats_.imbalance = mean > 0 ? load_max / mean : 1.0;
@@ -1414,6 +1419,7 @@ void ContactPhase::forces(const ContactNodes& nd, double dt, PhaseTimers& timers
     stats_.pairs = static_cast<std::int64_t>(pair_sum);
     stats_.max_penetration = std::max(stats_.max_penetration, deep_max);
     stats_.max_penetration_resisted = std::max(stats_.max_penetration_resisted, resisted_max);
+    stats_.max_penetration_of_depth = std::max(stats_.max_penetration_of_depth, share_max);
     if (just_rebalanced_) rebalance_floor_ = stats_.imbalance;
     just_rebalanced_ = false;
     rebalance_due_ =

@@ -53,6 +53,11 @@ struct ContactStats {
   // penalty force resists. max_penetration minus this is depth a pair already had when the
   // search first found it (docs/contact.md, "The can crush and its limits").
   double max_penetration_resisted = 0;
+  // Largest penetration as a share of its face's contact depth (the element's V / A times
+  // depth_fraction), over all cycles: new pairs are taken to 1, a tracked pair is followed
+  // to 2 and then released, so a node past 1 is close to passing through unseen (docs/
+  // contact.md, "Tunnelling").
+  double max_penetration_of_depth = 0;
 };
 
 // FE-side view of the nodes the contact phase reads and writes.
@@ -147,8 +152,11 @@ private:
   std::vector<double> allowance_;       // per local node: penetration allowed without force
   std::vector<int> history_set_;        // local nodes whose history forces() set last cycle
   bool history_set_all_ = false;        // set_history() may have set any
-  std::vector<double> mine_, gathered_; // forces(): four values and the force items' counts
-                                        // per destination, of this rank and all-gathered
+  // forces(): per rank, stat_values values (load, pairs, deepest, deepest resisted, deepest
+  // share of the depth) and the force items' counts
+  static constexpr std::size_t stat_values = 5;
+  std::vector<double> mine_, gathered_;
+  // per destination, of this rank and all-gathered
   std::vector<std::int64_t> force_counts_, force_recv_; // force items to, from each rank
   std::vector<std::int64_t> my_face_gid_;
   std::vector<std::array<int, 4>> my_face_nodes_;    // local node indices

@@ -106,6 +106,7 @@ private:
   std::int64_t start_cycle_ = 0; // the cycle this run started from (its checkpoint's)
   double start_fraction_ = 0;    // the fraction done at that cycle
   bool tty_ = false;
+  bool deep_warned_ = false; // a contact node went past its face's contact depth (said once)
   PhaseTimers output_timer_;
   Sample last_sample_;
   bool have_sample_ = false;

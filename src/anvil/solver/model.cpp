@@ -256,6 +256,79 @@ std::vector<std::int64_t> elements_holding(const Mesh& mesh, std::span<const std
             if (const auto it = grid.find({a, c, d}); it != grid.end()) test(it->second);
     }
   }
+  // A point on a bounding face of the part that holds it touches that part, whichever
+  // element's test it passed: the elements of wedges and tetrahedra that reach the surface
+  // at a corner or an edge only have no bounding face there, and a point on that corner or
+  // edge lies on their inner faces (QA round 36: touching meshes of tetrahedra reported 32
+  // nodes inside). (The faces of the point's own part, which it lies on, are not looked at.)
+  std::vector<std::int64_t> first_gid(mesh.blocks.size() + 1, 0);
+  for (std::size_t b = 0; b < mesh.blocks.size(); ++b)
+    first_gid[b + 1] = first_gid[b] + static_cast<std::int64_t>(mesh.blocks[b].elements.size());
+  std::map<std::array<std::int64_t, 3>, std::vector<std::size_t>> held; // the held points
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (holder[i] >= 0) held[{key(points[i].x), key(points[i].y), key(points[i].z)}].push_back(i);
+  if (held.empty()) return holder;
+  for (std::size_t b : blocks)
+    for (const Hex& e : mesh.blocks[b].elements)
+      for (int f = 0; f < 6; ++f) {
+        const FaceKey k = face_key(e, f);
+        if (!is_face(k) || !bounding(k)) continue;
+        auto in_this_part = [&](std::size_t i) {
+          return holder[i] >= first_gid[b] && holder[i] < first_gid[b + 1] &&
+                 (node.empty() || std::find(k.begin(), k.end(), node[i]) == k.end());
+        };
+        const auto& q = hex_faces[static_cast<std::size_t>(f)];
+        const std::array<Vec3, 4> v = {mesh.nodes[static_cast<std::size_t>(e[q[0]])],
+                                       mesh.nodes[static_cast<std::size_t>(e[q[1]])],
+                                       mesh.nodes[static_cast<std::size_t>(e[q[2]])],
+                                       mesh.nodes[static_cast<std::size_t>(e[q[3]])]};
+        Box3 fb{v[0], v[0]};
+        for (const Vec3& w : v)
+          for (int i = 0; i < 3; ++i) {
+            fb.lo[i] = std::min(fb.lo[i], w[i]);
+            fb.hi[i] = std::max(fb.hi[i], w[i]);
+          }
+        const double tol =
+            1e-6 * std::max({fb.hi.x - fb.lo.x, fb.hi.y - fb.lo.y, fb.hi.z - fb.lo.z});
+        // On the face: within tol of one of its triangles (0 1 2, 0 2 3; a triangle's
+        // repeated corner makes the second one empty).
+        auto on_face = [&](const Vec3& x) {
+          for (int t = 0; t < 2; ++t) {
+            const Vec3 &a = v[0], &b1 = v[1 + t], &c1 = v[2 + t];
+            const Vec3 n = cross(b1 - a, c1 - a);
+            const double n2 = dot(n, n);
+            if (!(n2 > 0)) continue;
+            const double len = std::sqrt(n2);
+            if (std::abs(dot(x - a, n)) > tol * len) continue;
+            // Barycentric: each edge's side, within tol of the edge.
+            const bool inside = dot(cross(b1 - a, x - a), n) >= -tol * len * norm(b1 - a) &&
+                                dot(cross(c1 - b1, x - b1), n) >= -tol * len * norm(c1 - b1) &&
+                                dot(cross(a - c1, x - c1), n) >= -tol * len * norm(a - c1);
+            if (inside) return true;
+          }
+          return false;
+        };
+        auto visit = [&](const std::vector<std::size_t>& cell_points) {
+          for (std::size_t i : cell_points)
+            if (holder[i] >= 0 && in_this_part(i) && on_face(points[i])) holder[i] = -1;
+        };
+        const std::int64_t l[3] = {key(fb.lo.x - tol), key(fb.lo.y - tol), key(fb.lo.z - tol)};
+        const std::int64_t h[3] = {key(fb.hi.x + tol), key(fb.hi.y + tol), key(fb.hi.z + tol)};
+        const double span = static_cast<double>(h[0] - l[0] + 1) *
+                            static_cast<double>(h[1] - l[1] + 1) *
+                            static_cast<double>(h[2] - l[2] + 1);
+        if (span > static_cast<double>(held.size())) {
+          for (const auto& [c, cell_points] : held)
+            if (c[0] >= l[0] && c[0] <= h[0] && c[1] >= l[1] && c[1] <= h[1] && c[2] >= l[2] &&
+                c[2] <= h[2])
+              visit(cell_points);
+          continue;
+        }
+        for (std::int64_t a = l[0]; a <= h[0]; ++a)
+          for (std::int64_t c = l[1]; c <= h[1]; ++c)
+            for (std::int64_t d = l[2]; d <= h[2]; ++d)
+              if (const auto it = held.find({a, c, d}); it != held.end()) visit(it->second);
+      }
   return holder;
 }
 

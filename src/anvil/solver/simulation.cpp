@@ -260,10 +260,12 @@ void Simulation::warn_of_setup(const Mesh& mesh) {
       return dot(Vec3{x, y, z} - walls[w].point, walls[w].normal);
     };
     const double tol = 1e-9 * size;
-    // (Those the wall leaves alone, fixed in every direction it could move them, aside.)
+    // (Those the wall leaves alone, fixed in every direction it could move them, aside; a
+    // rigid body's nodes, constrained to the body, are moved through it.)
     const Vec3 nrm = walls[w].normal;
     for (std::size_t n = 0; n < nodes_.size(); ++n)
-      if (fe_.node_owned[n] && wall_can_move(nrm, constrained_[n]) &&
+      if (fe_.node_owned[n] &&
+          (wall_can_move(nrm, constrained_[n]) || (!rigid_node_.empty() && rigid_node_[n] != 0)) &&
           gap(nodes_.x[0][n], nodes_.x[1][n], nodes_.x[2][n]) < -tol)
         ++behind[w];
     if (pt)
@@ -1634,7 +1636,7 @@ void Simulation::decompose_now() {
   if (contact_) contact_->detect(contact_view(), 0.0, timers_);
 }
 
-double Simulation::stable_time_step() {
+double Simulation::stable_time_step(std::int64_t* element) {
   const NodalView view{{nodes_.x[0].data(), nodes_.x[1].data(), nodes_.x[2].data()},
                        {nodes_.v[0].data(), nodes_.v[1].data(), nodes_.v[2].data()}};
   const CornerView corners{
@@ -1643,7 +1645,14 @@ double Simulation::stable_time_step() {
   // With dt_prev = 0 the kernel changes no state: rotation by the identity, no increment.
   for (auto& b : blocks_)
     if (b.size() > 0 && !b.rigid) hex_forces(b, view, 0.0, corners, workspace_, r);
-  return comm_.min(r.dt_stable);
+  const double dt = comm_.min(r.dt_stable);
+  if (element) {
+    const double none = std::numeric_limits<double>::infinity();
+    const double gid = comm_.min(
+        r.stable_gid >= 0 && r.dt_stable == dt ? static_cast<double>(r.stable_gid) : none);
+    *element = gid == none ? -1 : static_cast<std::int64_t>(gid);
+  }
+  return dt;
 }
 
 } // namespace anvil

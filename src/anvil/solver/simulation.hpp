@@ -111,8 +111,9 @@ public:
   // E(0): the kinetic energy the initial conditions gave (before constraints).
   double initial_energy() const { return initial_energy_; }
   // Smallest element stable time step at the current state (collective; runs the
-  // element kernel without advancing anything).
-  double stable_time_step();
+  // element kernel without advancing anything); `element`, if given, receives the global id
+  // of the element that sets it (the smallest of those that do), -1 without elements.
+  double stable_time_step(std::int64_t* element = nullptr);
   // Continues from a checkpoint of the same model (any rank count). InputError when it
   // does not match. Collective.
   void restore(const Checkpoint& checkpoint);
