@@ -629,11 +629,92 @@ TEST(Keyword, RigidMaterial) {
                {"*MAT_RIGID.E", "positive"});
   // Keywords that drive, load or shape rigid bodies would run another model if ignored
   // (QA round 29: a driven body ran free): errors at the keyword.
-  for (const char* k :
-       {"*BOUNDARY_PRESCRIBED_MOTION_RIGID_LOCAL", "*LOAD_RIGID_BODY", "*PART_INERTIA",
-        "*CONSTRAINED_RIGID_BODIES", "*CONSTRAINED_EXTRA_NODES_SET"})
+  for (const char* k : {"*BOUNDARY_PRESCRIBED_MOTION_RIGID_LOCAL", "*LOAD_RIGID_BODY",
+                        "*PART_INERTIA", "*CONSTRAINED_EXTRA_NODES_SET"})
     expect_error(with(good, "*END", std::string(k) + "\n         1\n*END"),
                  {std::string(k) + ":", "not supported"});
+}
+
+// *CONSTRAINED_RIGID_BODIES (LS-DYNA manual: "merge two rigid bodies", PIDS into PIDL): the
+// merged part's `merge_with` names the lead; PIDS's own *MAT_RIGID constraints give way to
+// the lead's (a warning); a part that is not rigid, merged twice, or a chain back to
+// itself is an error.
+TEST(Keyword, MergedRigidBodies) {
+  auto deck = [](const std::string& mat2, const std::string& merges) {
+    return R"(*KEYWORD
+*CONTROL_TERMINATION
+1.0E-04
+*PART
+lead
+1,1,1
+*PART
+tail
+2,1,2
+*SECTION_SOLID
+1,1
+*MAT_RIGID
+1,7850.0,2.0E+11,0.3
+
+
+)" + mat2 + R"(*NODE
+1,0,0,0
+2,1,0,0
+3,1,1,0
+4,0,1,0
+5,0,0,1
+6,1,0,1
+7,1,1,1
+8,0,1,1
+9,2,0,0
+10,3,0,0
+11,3,1,0
+12,2,1,0
+13,2,0,1
+14,3,0,1
+15,3,1,1
+16,2,1,1
+*ELEMENT_SOLID
+1,1,1,2,3,4,5,6,7,8
+2,2,9,10,11,12,13,14,15,16
+*CONSTRAINED_RIGID_BODIES
+)" + merges +
+           "*END\n";
+  };
+  const std::string rigid2 = "*MAT_RIGID\n2,7850.0,2.0E+11,0.3\n\n\n";
+  const Config c = kw(deck(rigid2, "1,2\n"));
+  ASSERT_EQ(c.parts.size(), 2u);
+  EXPECT_TRUE(c.parts[0].merge_with.empty());
+  EXPECT_EQ(c.parts[1].merge_with, "part1");
+  EXPECT_EQ(rigid_body_leads(c.parts), (std::vector<int>{0, 0}));
+  // The tail's CMO constraints give way to the body's lead's.
+  const Config held = kw(deck("*MAT_RIGID\n2,7850.0,2.0E+11,0.3\n1.0,7,7\n\n", "1,2\n"));
+  EXPECT_TRUE(held.boundary_conditions.empty());
+  ASSERT_EQ(held.warnings.size(), 1u);
+  EXPECT_NE(held.warnings[0].find("are ignored: it is merged into the body of part 1"),
+            std::string::npos)
+      << held.warnings[0];
+  expect_error(deck("*MAT_ELASTIC\n2,7850.0,2.0E+11,0.3\n", "1,2\n"),
+               {"*CONSTRAINED_RIGID_BODIES.PIDS", "part 2 is not rigid"});
+  expect_error(deck(rigid2, "1,2\n1,2\n"), {"*CONSTRAINED_RIGID_BODIES.PIDS", "merged twice"});
+  expect_error(deck(rigid2, "1,2\n2,1\n"), {"comes back to itself"});
+  expect_error(deck(rigid2, "1,1\n"), {"*CONSTRAINED_RIGID_BODIES.PIDS", "PIDS is PIDL"});
+}
+
+// anvil's planar walls stop rigid bodies; LS-DYNA's only with *CONTROL_CONTACT RWPNAL > 0:
+// a deck with both and RWPNAL 0 (its default) is told of the difference (QA round 37).
+TEST(Keyword, WallsAndRigidBodiesNameRwpnal) {
+  const std::string elastic = "*MAT_ELASTIC\n         1    7850.0   2.0E+11       0.3\n";
+  const std::string rigid = with(good, elastic,
+                                 "*MAT_RIGID\n1,7850.0,2.0E+11,0.3\n\n\n*RIGIDWALL_PLANAR\n0\n"
+                                 "0.0,0.0,-1.0,0.0,0.0,0.0\n");
+  const Config c = kw(rigid);
+  ASSERT_EQ(c.rigid_walls.size(), 1u);
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("RWPNAL > 0 (here 0)"), std::string::npos) << c.warnings[0];
+  const Config penalty = kw(with(rigid, "*END", "*CONTROL_CONTACT\n0.1,1.0\n*END"));
+  EXPECT_TRUE(penalty.warnings.empty()) << penalty.warnings.at(0);
+  EXPECT_TRUE(kw(with(good, "*END", "*RIGIDWALL_PLANAR\n0\n0.0,0.0,-1.0,0.0,0.0,0.0\n*END"))
+                  .warnings.empty());
 }
 
 // *INITIAL_VELOCITY_RIGID_BODY (LS-DYNA manual: "the initial translational and rotational

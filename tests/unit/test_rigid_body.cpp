@@ -268,7 +268,7 @@ TEST(RigidBody, HeldComponentsTakeTheirValues) {
 //    the corner not at all (1e-12 relative), and the impulse reported is the change of the
 //    normal momentum (1e-12 relative). With friction mu the impulse in the wall's plane is
 //    at most mu times the normal one (Coulomb) and slows the corner's sliding. Every
-//    component held: the wall cannot move the body, which keeps its motion.
+//    component held, or every translation: the wall leaves the body its motion.
 TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   const std::vector<RigidPoint> p = brick();
   double M = 0;
@@ -348,4 +348,15 @@ TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   EXPECT_TRUE(out.empty());
   EXPECT_EQ(norm(mh.velocity - m0.velocity), 0.0);
   EXPECT_EQ(norm(mh.omega - m0.omega), 0.0);
+  // The translations held, the spins free: turning alone cannot take a body off a wall in
+  // general, and the wall leaves it alone as it leaves a node held across it (QA round 37:
+  // a body driven into a wall was spun to 2e6 rad/s).
+  RigidHold driven;
+  driven.velocity_held = {true, true, true};
+  driven.velocity = m0.velocity;
+  RigidMotion md = m0;
+  out.clear();
+  EXPECT_EQ(apply_walls_to_body(p, walls, driven, md, scratch, out), 0);
+  EXPECT_TRUE(out.empty());
+  EXPECT_EQ(norm(md.omega - m0.omega), 0.0);
 }

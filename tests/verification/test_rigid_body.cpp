@@ -41,6 +41,13 @@
 //    the wall pushes along z only); the wall's impulses, its force history times the step,
 //    the body's change of z momentum (1e-9 relative); the energy balance closed (1e-12:
 //    the walls' work is external work); the same bits on one rank and on all.
+// 6. Merged rigid bodies (`merge_with`, LS-DYNA's *CONSTRAINED_RIGID_BODIES): two boxes
+//    apart, the second merged into the first, the initial velocity and spin given to the
+//    lead about the body's centre of mass. Reference: one rigid body (Newton, Euler): the
+//    body's mass is both parts' (1e-12 relative), its centre keeps the velocity given and
+//    the distance between a node of each part stays (1e-12 relative) over 300 steps, with
+//    one body's columns in the sample; a condition on the merged part (`fix: [z]`) holds the
+//    whole body (its z velocity 0 exactly).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -274,9 +281,10 @@ free
     Simulation sim(parse_keyword_deck(k, "model.k", "."), world);
     ADD_FAILURE() << "no error for rigid parts sharing nodes";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("rigid parts part1 and part2 share 4 nodes"),
+    EXPECT_NE(std::string(e.what()).find("rigid bodies of parts part1 and part2 share 4 nodes"),
               std::string::npos)
         << e.what();
+    EXPECT_NE(std::string(e.what()).find("merge_with"), std::string::npos) << e.what();
   }
 }
 
@@ -660,6 +668,64 @@ TEST(RigidBody, FreeBodyLandsOnAWall) {
   for (std::size_t k = 0; k < r.rows.size(); ++k)
     differing += std::memcmp(&one.rows[k], &r.rows[k], sizeof(double)) != 0;
   EXPECT_EQ(differing, 0u) << "wall forces and body motions differing from the one-rank run";
+}
+
+TEST(RigidBody, MergedPartsMoveAsOneBody) {
+  const Comm world = Comm::world();
+  const std::string deck = R"(
+termination: {cycles: 300}
+materials:
+  steel: {model: elastic, density: 7850, youngs_modulus: 200.0e9, poissons_ratio: 0.3}
+parts:
+  head:
+    mesh: {generate: box, min: [0, 0, 0], max: [0.01, 0.01, 0.01], divisions: [2, 2, 2]}
+    material: steel
+    rigid: true
+  tail:
+    mesh: {generate: box, min: [0.02, 0, 0], max: [0.04, 0.005, 0.005], divisions: [2, 1, 1]}
+    material: steel
+    rigid: true
+    merge_with: head
+  other:
+    mesh: {generate: box, min: [1, 1, 1], max: [1.01, 1.01, 1.01], divisions: [1, 1, 1]}
+    material: steel
+initial_conditions:
+  - {part: head, velocity: [2.0, -1.0, 0.5], angular_velocity: [100.0, -50.0, 200.0],
+     center: mass_center}
+probes:
+  - {name: h, at: [0, 0, 0]}
+  - {name: t, at: [0.04, 0.005, 0.005]}
+)";
+  const double M = 7850 * (1e-6 + 0.02 * 0.005 * 0.005);
+  const Vec3 a0{0, 0, 0}, b0{0.04, 0.005, 0.005};
+  {
+    Simulation sim(test::deck(deck), world);
+    double worst = 0;
+    std::size_t columns = 0;
+    while (!sim.finished()) {
+      sim.step();
+      const Sample s = sim.sample();
+      columns = s.rigid_bodies.size();
+      const Vec3 a = a0 + Vec3{s.probes[0], s.probes[1], s.probes[2]};
+      const Vec3 b = b0 + Vec3{s.probes[6], s.probes[7], s.probes[8]};
+      worst = std::max(worst, std::abs(norm(b - a) / norm(b0 - a0) - 1));
+    }
+    const RigidMotion& m = sim.rigid_motions().at(0);
+    if (world.rank() == 0)
+      std::printf("merged rigid body: mass %.6e kg (%.6e), velocity (%.12f, %.12f, %.12f), "
+                  "distance between the parts' nodes %.1e\n",
+                  m.mass, M, m.velocity.x, m.velocity.y, m.velocity.z, worst);
+    EXPECT_EQ(sim.rigid_motions().size(), 1u);
+    EXPECT_EQ(columns, 9u);
+    EXPECT_NEAR(m.mass, M, 1e-12 * M);
+    EXPECT_LT(norm(m.velocity - Vec3{2.0, -1.0, 0.5}), 1e-12 * 2.0);
+    EXPECT_LT(worst, 1e-12);
+  }
+  // A condition on the merged part holds the body.
+  Simulation held(test::deck(deck + "boundary_conditions:\n  - {part: tail, fix: [z]}\n"), world);
+  for (int n = 0; n < 20; ++n) held.step();
+  EXPECT_EQ(held.rigid_motions().at(0).velocity.z, 0.0);
+  EXPECT_NE(held.rigid_motions().at(0).velocity.x, 0.0);
 }
 
 } // namespace

@@ -190,6 +190,13 @@ int apply_walls_to_body(std::span<const RigidPoint> p, std::span<const WallPlane
   for (std::size_t i = 0; i < p.size(); ++i)
     for (std::size_t w = 0; w < walls.size(); ++w) {
       const Vec3& n = walls[w].normal;
+      // A wall nearly square to every free translation leaves the body alone (its held
+      // motion wins, as a node's does): turning alone cannot lift a face off a wall, and
+      // the impulses would spin it up without end (QA round 37: 2e6 rad/s in a step).
+      Vec3 free = n;
+      for (int k = 0; k < 3; ++k)
+        if (hold.velocity_held[static_cast<std::size_t>(k)]) free[k] = 0;
+      if (!(dot(free, free) > 1e-6)) continue;
       const Vec3 land = p[i].x + dt * motion.point_velocity(p[i].x);
       if (dot(n, land - walls[w].point) < 0)
         rows.push_back({i, static_cast<int>(w), p[i].x - c, cross(p[i].x - c, n),
@@ -292,7 +299,12 @@ int apply_walls_to_body(std::span<const RigidPoint> p, std::span<const WallPlane
   }
   for (const auto& row : rows)
     if (row.lambda > 0) out.push_back({row.point, row.wall, row.lambda});
-  return sweep;
+  double left = 0;
+  for (const auto& row : rows)
+    if (row.k > 0)
+      left = std::max(left, row.target - dot(walls[static_cast<std::size_t>(row.wall)].normal,
+                                             motion.point_velocity(p[row.point].x)));
+  return left > 1e-6 * scale ? -sweep : sweep;
 }
 
 } // namespace anvil

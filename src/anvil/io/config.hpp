@@ -56,8 +56,20 @@ struct PartConfig {
   // A rigid body (LS-DYNA's *MAT_RIGID): its nodes move together, its elements carry no
   // stress; the material gives its mass (density) and its contact stiffness (E, nu).
   bool rigid = false;
+  // A rigid part merged into another's body (LS-DYNA's *CONSTRAINED_RIGID_BODIES: PIDS
+  // into PIDL): the part whose body it joins; empty: a body of its own (or none). The
+  // body is named after its lead, the part at the end of the chain.
+  std::string merge_with;
+  SourceLocation merge_where;
   SourceLocation where;
 };
+
+// The lead part of each part's rigid body (following merge_with), or -1 for a part that is
+// not rigid. Assumes a validated config (the names exist, no cycles).
+std::vector<int> rigid_body_leads(const std::vector<PartConfig>& parts);
+// Throws InputError (at merge_with) where a part merges into no part, a part that is not
+// rigid, or a chain that comes back to itself.
+void check_rigid_merges(const std::vector<PartConfig>& parts);
 
 // SPH particles (DESIGN.md section 4, `particles:`): a lattice filling a shape at a
 // spacing, and the options of the particle formulation (docs/sph.md).

@@ -495,8 +495,8 @@ PartConfig parse_part(const std::string& name, const Node& n, const std::string&
   PartConfig p;
   p.name = name;
   p.where = n.where();
-  n.check_keys(
-      {"mesh", "material", "hourglass", "bulk_viscosity", "erosion", "thick_shell", "rigid"});
+  n.check_keys({"mesh", "material", "hourglass", "bulk_viscosity", "erosion", "thick_shell",
+                "rigid", "merge_with"});
   p.mesh = parse_mesh(n.required("mesh"), base_dir);
   p.material = n.required("material").str();
   if (n.has("rigid")) {
@@ -507,6 +507,13 @@ PartConfig parse_part(const std::string& name, const Node& n, const std::string&
         n.child(key).fail(fmt::format("a rigid part's elements do not deform: {} does not "
                                       "apply",
                                       key));
+  }
+  if (n.has("merge_with")) {
+    p.merge_with = n.child("merge_with").str();
+    p.merge_where = n.child("merge_with").where();
+    if (!p.rigid)
+      n.child("merge_with")
+          .fail("merge_with joins a rigid part to another's body: give the part `rigid: true`");
   }
   if (n.has("hourglass")) {
     const Node h = n.child("hourglass");
@@ -775,6 +782,52 @@ private:
 
 } // namespace
 
+std::vector<int> rigid_body_leads(const std::vector<PartConfig>& parts) {
+  std::vector<int> lead(parts.size(), -1);
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    if (!parts[p].rigid) continue;
+    std::size_t q = p;
+    for (std::size_t hops = 0; !parts[q].merge_with.empty() && hops < parts.size(); ++hops) {
+      const auto it = std::find_if(parts.begin(), parts.end(), [&](const PartConfig& c) {
+        return c.name == parts[q].merge_with;
+      });
+      if (it == parts.end()) break;
+      q = static_cast<std::size_t>(it - parts.begin());
+    }
+    lead[p] = static_cast<int>(q);
+  }
+  return lead;
+}
+
+void check_rigid_merges(const std::vector<PartConfig>& parts) {
+  for (const PartConfig& p : parts) {
+    if (p.merge_with.empty()) continue;
+    const auto it = std::find_if(parts.begin(), parts.end(),
+                                 [&](const PartConfig& c) { return c.name == p.merge_with; });
+    if (it == parts.end())
+      throw InputError(p.merge_where,
+                       fmt::format("part '{}' is not defined under parts", p.merge_with));
+    if (!it->rigid)
+      throw InputError(p.merge_where,
+                       fmt::format("part '{}' is not rigid: a rigid part merges into another "
+                                   "rigid part's body",
+                                   p.merge_with));
+  }
+  // (Every target exists now.) Following the chain must end at a part of its own body.
+  for (const PartConfig& p : parts) {
+    const PartConfig* q = &p;
+    for (std::size_t hops = 0; !q->merge_with.empty(); ++hops) {
+      if (hops >= parts.size())
+        throw InputError(p.merge_where,
+                         fmt::format("part '{}' merges into a chain of parts that comes back to "
+                                     "itself: one part of a body must merge into none (the lead)",
+                                     p.name));
+      q = &*std::find_if(parts.begin(), parts.end(),
+                         [&](const PartConfig& c) { return c.name == q->merge_with; });
+    }
+  }
+}
+
 Config parse_deck(const std::string& text, const std::string& name, const std::string& base_dir) {
   Config c;
   c.deck_file = name;
@@ -872,6 +925,7 @@ Config parse_deck(const std::string& text, const std::string& name, const std::s
     }
     if (c.parts.empty() && !top.has("particles"))
       top.child("parts").fail("at least one part is needed");
+    check_rigid_merges(c.parts);
   }
 
   if (top.has("particles")) {

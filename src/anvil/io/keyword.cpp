@@ -845,6 +845,7 @@ private:
       return mat_johnson_cook(b);
     if (n == "BOUNDARY_PRESCRIBED_MOTION_RIGID" || n == "BOUNDARY_PRESCRIBED_MOTION_RIGID_ID")
       return prescribed_motion_rigid(b);
+    if (n == "CONSTRAINED_RIGID_BODIES") return constrained_rigid_bodies(b);
     // Keywords that drive, load or shape rigid bodies otherwise: ignoring them would run
     // another model (QA round 29: a driven body ran free), so they are errors.
     for (const char* k : {"BOUNDARY_PRESCRIBED_MOTION_RIGID", "LOAD_RIGID_BODY", "PART_INERTIA",
@@ -2470,6 +2471,25 @@ private:
   // PID, DOF, VAD, LCID, SF, VID, DEATH, BIRTH (LS-DYNA manual,
   // *BOUNDARY_PRESCRIBED_MOTION_RIGID): the centre of mass (DOF 1-3) or the spin (DOF 5-7)
   // of a rigid part, anvil's condition on the body (`part:`).
+  // PIDL, PIDS, IFLAG per card: part PIDS joins the body of part PIDL (both *MAT_RIGID).
+  void constrained_rigid_bodies(const Block& b) {
+    Cursor c(b);
+    while (auto l = c.next_record()) {
+      const Card card(b, *l, {10, 10, 10});
+      RigidMerge m;
+      m.lead = card.integer(0, "PIDL", 0);
+      m.merged = card.integer(1, "PIDS", 0);
+      if (m.lead <= 0) card.fail("PIDL", "PIDL must be a positive part id");
+      if (m.merged <= 0) card.fail("PIDS", "PIDS must be a positive part id");
+      if (m.lead == m.merged) card.fail("PIDS", "PIDS is PIDL: a part merges into another");
+      const auto iflag = card.integer(2, "IFLAG", 0);
+      if (iflag != 0 && iflag != 1) card.fail("IFLAG", "IFLAG must be 0 or 1");
+      m.iflag = static_cast<int>(iflag);
+      m.at = where_of(*l);
+      rigid_merges_.push_back(m);
+    }
+  }
+
   void prescribed_motion_rigid(const Block& b) {
     Cursor c(b);
     if (ends_with(b.name, "_ID")) c.next();
@@ -2876,9 +2896,10 @@ private:
   void control_contact(const Block& b) {
     Cursor c(b);
     const Line l = c.next();
-    const Card card(b, l, {10});
+    const Card card(b, l, {10, 10});
     slsfac_ = card.real(0, "SLSFAC", 0);
     if (slsfac_ < 0) card.fail("SLSFAC", "SLSFAC must not be negative");
+    rwpnal_ = card.real(1, "RWPNAL", 0);
     // Card 2 and optional cards 3-7 tune LS-DYNA's contact algorithms, as do the other
     // fields of card 1; anvil's contact has no such switches.
     optional_cards(b, c, 6, false);
@@ -3456,6 +3477,7 @@ private:
   std::vector<ContactCard> contacts_;
   std::vector<WallCard> walls_;
   double slsfac_ = 0;
+  double rwpnal_ = 0; // *CONTROL_CONTACT: LS-DYNA's planar walls take rigid bodies when > 0
   bool have_termination_ = false;
   Where termination_at_;
   double endtim_ = 0;
@@ -3468,6 +3490,13 @@ private:
     Where at;
   };
   std::map<std::string, RigidConstraint> rigid_constraints_;
+  // *CONSTRAINED_RIGID_BODIES: part `merged` joins the body of part `lead`.
+  struct RigidMerge {
+    std::int64_t lead = 0, merged = 0;
+    int iflag = 0;
+    Where at;
+  };
+  std::vector<RigidMerge> rigid_merges_;
   double dtmin_ = 0;              // *CONTROL_TERMINATION DTMIN
   double mass_scaling_dt2ms_ = 0; // |DT2MS| of *CONTROL_TIMESTEP when DT2MS < 0
   SourceLocation mass_scaling_at_;
@@ -3851,6 +3880,36 @@ Config KeywordReader::config(const std::string& deck_file) {
     }
   }
 
+  // Merged rigid bodies: each PIDS joins PIDL's body (its own *MAT_RIGID constraints give
+  // way to the body's lead's, as in LS-DYNA).
+  for (const RigidMerge& m : rigid_merges_) {
+    const SourceLocation at = m.at.loc("*CONSTRAINED_RIGID_BODIES.PIDS");
+    const std::string lead = rigid_part(m.lead, m.at.loc("*CONSTRAINED_RIGID_BODIES.PIDL"),
+                                        "*CONSTRAINED_RIGID_BODIES merges its body");
+    const std::string merged = rigid_part(m.merged, at, "*CONSTRAINED_RIGID_BODIES merges it");
+    auto part = std::find_if(c.parts.begin(), c.parts.end(),
+                             [&](const PartConfig& p) { return p.name == merged; });
+    if (part == c.parts.end()) continue; // (rigid_part() has named it)
+    if (!part->merge_with.empty())
+      throw InputError(at, fmt::format("part {} is merged twice (into part {} before): a part "
+                                       "joins one body",
+                                       m.merged, part->merge_with.substr(4)));
+    part->merge_with = lead;
+    part->merge_where = at;
+    if (m.iflag == 1)
+      warnings.push_back(fmt::format("{}: IFLAG = 1 (keep PIDL's mass properties) is not "
+                                     "supported: anvil's merged body has the mass and inertia "
+                                     "of all its parts' nodes",
+                                     m.at.str()));
+    if (const auto con = rigid_constraints_.find(merged); con != rigid_constraints_.end()) {
+      warnings.push_back(fmt::format("{}: the *MAT_RIGID constraints of part {} (CMO) are "
+                                     "ignored: it is merged into the body of part {} ({}), "
+                                     "whose constraints hold the body",
+                                     con->second.at.str(), m.merged, m.lead, m.at.str()));
+      rigid_constraints_.erase(con);
+    }
+  }
+  check_rigid_merges(c.parts);
   conditions(c, mesh, warnings);
   loads(c, mesh, warnings);
   // A node set's particles go to their particle list (conditions on the set act on them
@@ -3966,7 +4025,19 @@ Config KeywordReader::config(const std::string& deck_file) {
     c.contact.push_back(std::move(*merged));
   }
 
-  // Rigid walls: a plane through the tail with the normal towards the head.
+  // Rigid walls: a plane through the tail with the normal towards the head. anvil's stop
+  // rigid bodies, LS-DYNA's only with RWPNAL > 0 (QA round 37: the answer changed unsaid).
+  if (!walls_.empty() && !(rwpnal_ > 0)) {
+    std::vector<std::string> rigid;
+    for (const auto& p : c.parts)
+      if (p.rigid) rigid.push_back(p.name);
+    if (!rigid.empty())
+      warnings.push_back(fmt::format(
+          "{}: anvil's planar rigid walls stop rigid bodies ({}), kinematically; LS-DYNA's "
+          "leave them out unless *CONTROL_CONTACT RWPNAL > 0 (here {}), so there they would "
+          "pass through",
+          walls_.front().at.str(), fmt::join(rigid, ", "), rwpnal_));
+  }
   for (const auto& w : walls_) {
     RigidWallConfig rw;
     rw.where = w.at.loc("*RIGIDWALL_PLANAR");

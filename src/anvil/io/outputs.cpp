@@ -231,7 +231,7 @@ std::string Outputs::history_header() const {
     if (c.boundary_conditions[b].holds_spin())
       for (const char* f : {"mx", "my", "mz"}) h += fmt::format(",bc{}.{}", b, f);
   for (const auto& p : c.parts)
-    if (p.rigid)
+    if (p.rigid && p.merge_with.empty()) // a body, named after its lead
       for (const char* f : {"ux", "uy", "uz", "vx", "vy", "vz", "wx", "wy", "wz"})
         h += fmt::format(",rigid.{}.{}", p.name, f);
   if (c.part_energies) {

@@ -20,32 +20,61 @@ namespace anvil {
 
 int Simulation::rigid_body_of(const BoundaryCondition& bc) const {
   if (!bc.nodes.name.empty() || bc.nodes.box || !bc.nodes.part) return -1;
+  const std::vector<int> lead = rigid_body_leads(config_.parts);
   for (std::size_t p = 0; p < config_.parts.size(); ++p)
-    if (config_.parts[p].rigid && config_.parts[p].name == *bc.nodes.part)
-      return static_cast<int>(p);
+    if (config_.parts[p].rigid && config_.parts[p].name == *bc.nodes.part) return lead[p];
   return -1;
+}
+
+// A selection of a whole rigid part merged with others (merge_with): every part of its
+// body, which moves as one (an initial velocity given to the lead is the body's).
+std::vector<std::int64_t> Simulation::body_nodes(const Mesh& mesh, const Selection& sel) const {
+  if (!sel.name.empty() || sel.box || !sel.part) return selected_nodes(mesh, sel);
+  const std::vector<int> lead = rigid_body_leads(config_.parts);
+  int body = -1;
+  for (std::size_t p = 0; p < config_.parts.size(); ++p)
+    if (config_.parts[p].name == *sel.part) body = lead[p];
+  if (body < 0) return selected_nodes(mesh, sel);
+  std::vector<std::int64_t> ids;
+  for (std::size_t p = 0; p < config_.parts.size(); ++p) {
+    if (lead[p] != body) continue;
+    Selection part = sel;
+    part.part = config_.parts[p].name;
+    const auto more = selected_nodes(mesh, part);
+    ids.insert(ids.end(), more.begin(), more.end());
+  }
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  return ids;
 }
 
 void Simulation::setup_rigid_bodies(const Mesh& mesh) {
   const std::size_t nn = fe_.node_gid.size();
   rigid_gids_.clear();
-  std::vector<std::size_t> part_of_body;
+  // The bodies in the deck order of their leads, each the nodes of its parts (the lead
+  // and those merged into it).
+  const std::vector<int> lead = rigid_body_leads(config_.parts);
+  std::vector<std::size_t> part_of_body, rigid_parts;
   for (std::size_t b = 0; b < config_.parts.size(); ++b) {
-    if (!config_.parts[b].rigid) continue;
+    if (lead[b] >= 0) rigid_parts.push_back(b);
+    if (lead[b] != static_cast<int>(b)) continue;
     std::vector<std::int64_t> gids;
-    for (const auto& h : mesh.blocks[b].elements) gids.insert(gids.end(), h.begin(), h.end());
+    for (std::size_t m = 0; m < config_.parts.size(); ++m)
+      if (lead[m] == static_cast<int>(b))
+        for (const auto& h : mesh.blocks[m].elements) gids.insert(gids.end(), h.begin(), h.end());
     std::sort(gids.begin(), gids.end());
     gids.erase(std::unique(gids.begin(), gids.end()), gids.end());
-    // Two rigid parts that share a node would be one body: anvil keeps bodies apart.
+    // Two bodies that share a node would be one: anvil keeps bodies apart.
     for (std::size_t o = 0; o < rigid_gids_.size(); ++o) {
       std::vector<std::int64_t> common;
       std::set_intersection(gids.begin(), gids.end(), rigid_gids_[o].begin(), rigid_gids_[o].end(),
                             std::back_inserter(common));
       if (!common.empty())
         throw InputError(config_.parts[b].where,
-                         fmt::format("rigid parts {} and {} share {} node{}: each rigid part is "
-                                     "a body of its own (merge them into one part, or keep "
-                                     "their nodes apart)",
+                         fmt::format("the rigid bodies of parts {} and {} share {} node{}: each "
+                                     "is a body of its own (merge one into the other with "
+                                     "`merge_with`, LS-DYNA's *CONSTRAINED_RIGID_BODIES, or "
+                                     "keep their nodes apart)",
                                      config_.parts[part_of_body[o]].name, config_.parts[b].name,
                                      common.size(), common.size() == 1 ? "" : "s"));
     }
@@ -53,7 +82,7 @@ void Simulation::setup_rigid_bodies(const Mesh& mesh) {
     part_of_body.push_back(b);
   }
   if (rigid_gids_.empty()) return;
-  if (rigid_gids_.size() == config_.parts.size() && config_.particles.empty())
+  if (rigid_parts.size() == config_.parts.size() && config_.particles.empty())
     throw InputError(config_.parts[0].where,
                      "every part is rigid: anvil needs a deformable part or particles (their "
                      "stable time step sets the step)");
@@ -111,7 +140,7 @@ void Simulation::setup_rigid_bodies(const Mesh& mesh) {
   // rank count, and at a restart, which builds the model from the deck again).
   rigid_centre0_.clear();
   for (const auto& gids : rigid_gids_) rigid_centre0_.push_back(mass_center(gids));
-  warn_of_thin_rigid_parts(rigid_part_);
+  warn_of_thin_rigid_parts(rigid_parts);
 }
 
 // A rigid element sets no time step, and contact takes a node only within depth_fraction
@@ -154,7 +183,11 @@ void Simulation::warn_of_thin_rigid_parts(const std::vector<std::size_t>& parts)
   }
   const double global_depth = comm_.min(depth);
   const double global_speed = comm_.max(speed);
-  const double dt = config_.time_step_scale * stable_time_step();
+  // (The particles' step where they set it: with no deformable element the elements' is
+  // a placeholder of 1e300 s, QA round 37.)
+  const double dt = config_.time_step_scale *
+                    std::min(stable_time_step(),
+                             sph_ ? sph_->initial_step() : std::numeric_limits<double>::infinity());
   const std::int64_t part =
       comm_.min(depth == global_depth && thinnest >= 0
                     ? static_cast<std::int64_t>(parts[static_cast<std::size_t>(thinnest)])
@@ -241,8 +274,12 @@ void Simulation::move_rigid_bodies(bool with_contact) {
     // change beyond the forces' is the constraints' (external) work, as a held component's.
     // Each point's normal impulse is a hit of its wall on the rank that owns its node.
     body_wall_impulses_.clear();
-    apply_walls_to_body(pts, wall_planes_, hold, rigid_motion_[o], body_wall_scratch_,
-                        body_wall_impulses_);
+    if (apply_walls_to_body(pts, wall_planes_, hold, rigid_motion_[o], body_wall_scratch_,
+                            body_wall_impulses_) < 0)
+      throw PhysicsError(fmt::format("rigid part {}", config_.parts[rigid_part_[o]].name),
+                         clock_.time,
+                         "the rigid walls' impulses on it did not settle (its held components "
+                         "and the walls leave it no motion in front of them)");
     for (const auto& h : body_wall_impulses_)
       if (rigid_point_owned_[rigid_offset_[o] + h.point] != 0)
         rigid_wall_hits_.push_back({rigid_gids_[o][h.point], h.wall, h.impulse});

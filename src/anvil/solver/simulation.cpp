@@ -502,7 +502,7 @@ Vec3 Simulation::mass_center(std::span<const std::int64_t> ids) const {
 void Simulation::apply_initial_conditions(const Mesh& mesh) {
   const std::size_t nn = fe_.node_gid.size();
   for (const auto& ic : config_.initial_conditions) {
-    const auto ids = selected_nodes(mesh, ic.nodes);
+    const auto ids = body_nodes(mesh, ic.nodes);
     warn_if_outside_model(ids, ic.nodes.where);
     const Vec3 centre = ic.about_mass_center ? mass_center(ids) : ic.center;
     for (std::size_t n = 0; n < nn; ++n) {

@@ -199,6 +199,7 @@ private:
   // The part index of the rigid part a condition holds as a body (`part:` a rigid part,
   // whole), or -1.
   int rigid_body_of(const BoundaryCondition& bc) const;
+  std::vector<std::int64_t> body_nodes(const Mesh& mesh, const Selection& sel) const;
   void warn_of_setup(const Mesh& mesh);
   void apply_walls();             // the rigid walls' part of correct()
   void sample_probe_velocities(); // at the end of correct()
