@@ -267,8 +267,10 @@ TEST(RigidBody, HeldComponentsTakeTheirValues) {
 //    along the normal, so the momentum changes along it only and the angular momentum about
 //    the corner not at all (1e-12 relative), and the impulse reported is the change of the
 //    normal momentum (1e-12 relative). With friction mu the impulse in the wall's plane is
-//    at most mu times the normal one (Coulomb) and slows the corner's sliding. Every
-//    component held, or every translation: the wall leaves the body its motion.
+//    at most mu times the normal one (Coulomb) and slows the corner's sliding. The spin
+//    about z held: it keeps its value and the free spin changes by the free rows of the
+//    inertia alone (1e-12). Every component held, or every translation: the wall leaves
+//    the body its motion.
 TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   const std::vector<RigidPoint> p = brick();
   double M = 0;
@@ -348,6 +350,32 @@ TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   EXPECT_TRUE(out.empty());
   EXPECT_EQ(norm(mh.velocity - m0.velocity), 0.0);
   EXPECT_EQ(norm(mh.omega - m0.omega), 0.0);
+  // The spin about z held: omega_z keeps its value, and the free components change by the
+  // free rows alone, I_ff d omega_f = (r x J)_f (the torque about z is the hold's).
+  RigidHold spin_z;
+  spin_z.spin_held = {false, false, true};
+  spin_z.spin = m0.omega;
+  RigidMotion mz = m0;
+  out.clear();
+  ASSERT_GT(apply_walls_to_body(p, walls, spin_z, mz, scratch, out), 0);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(mz.omega.z, m0.omega.z);
+  EXPECT_NEAR(landing(mz, p[0]), 0.0, 1e-12 * step);
+  {
+    double J[3][3] = {};
+    for (const auto& q : p) {
+      const Vec3 r = q.x - c;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) J[i][j] += q.m * r[i] * r[j];
+    }
+    const double tr = J[0][0] + J[1][1] + J[2][2];
+    const double a = tr - J[0][0], b = -J[0][1], d = tr - J[1][1]; // I_ff, 2 x 2
+    const Vec3 tau = out[0].impulse * cross(p[0].x - c, n);
+    const double det = a * d - b * b;
+    const double wx = (d * tau.x - b * tau.y) / det, wy = (a * tau.y - b * tau.x) / det;
+    EXPECT_NEAR(mz.omega.x - m0.omega.x, wx, 1e-12 * std::abs(wx));
+    EXPECT_NEAR(mz.omega.y - m0.omega.y, wy, 1e-12 * std::abs(wy));
+  }
   // The translations held, the spins free: turning alone cannot take a body off a wall in
   // general, and the wall leaves it alone as it leaves a node held across it (QA round 37:
   // a body driven into a wall was spun to 2e6 rad/s).

@@ -224,6 +224,9 @@ int apply_walls_to_body(std::span<const RigidPoint> p, std::span<const WallPlane
   Mat3 W{}; // columns: the change of omega per unit torque about each axis
   if (!all_held)
     for (int k = 0; k < 3; ++k) {
+      // (A torque about a held axis is the hold's: no change, column 0; the held rows'
+      // right-hand sides are 0, so the free rows solve I_ff dw_f = tau_f.)
+      if (hold.spin_held[static_cast<std::size_t>(k)]) continue;
       Vec3 e{0, 0, 0};
       e[k] = 1;
       Vec3 col = solve(I, e);
