@@ -145,19 +145,21 @@ int check(const std::string& deck, const anvil::Comm& comm) {
   if (!by_shape.empty()) by_shape += ")";
   std::printf("elements    %lld%s\n", static_cast<long long>(sim.global_elements()),
               by_shape.c_str());
+  const std::vector<int> leads = anvil::rigid_body_leads(config.parts);
   for (std::size_t i = 0; i < config.parts.size(); ++i) {
     const double added = sim.part_added_masses()[i];
-    std::printf(
-        "  part %-16s material %-16s mass %.6g kg%s%s\n", config.parts[i].name.c_str(),
-        config.parts[i].material.c_str(), sim.part_masses()[i],
-        added > 0 ? fmt::format(" + {:.6g} kg mass scaling ({:.3g}%)", added,
-                                100 * added / sim.part_masses()[i])
-                        .c_str()
-                  : "",
-        !config.parts[i].rigid ? ""
-        : config.parts[i].merge_with.empty()
-            ? "  rigid body"
-            : fmt::format("  rigid, in the body of {}", config.parts[i].merge_with).c_str());
+    std::printf("  part %-16s material %-16s mass %.6g kg%s%s\n", config.parts[i].name.c_str(),
+                config.parts[i].material.c_str(), sim.part_masses()[i],
+                added > 0 ? fmt::format(" + {:.6g} kg mass scaling ({:.3g}%)", added,
+                                        100 * added / sim.part_masses()[i])
+                                .c_str()
+                          : "",
+                !config.parts[i].rigid ? ""
+                : config.parts[i].merge_with.empty()
+                    ? "  rigid body"
+                    : fmt::format("  rigid, in the body of {}",
+                                  config.parts[static_cast<std::size_t>(leads[i])].name)
+                          .c_str());
   }
   if (config.mass_scaling_step > 0) {
     double added = 0, mass = 0;

@@ -407,6 +407,15 @@ TEST(Deck, RigidParts) {
   expect_error(hg, "    rigid: yes\n", {"deck.yaml:11", "parts.bar.rigid", "true or false"});
   expect_error(mat, mat + "    rigid: true\n",
                {"deck.yaml:12", "parts.bar.hourglass", "do not deform"});
+  // merge_with: a rigid part's, naming a rigid part (QA round 38: an empty name was taken
+  // as none).
+  expect_error(hg, "    rigid: true\n    merge_with: ''\n",
+               {"parts.bar.merge_with", "give the name of the rigid part"});
+  expect_error(hg, "    merge_with: bar\n",
+               {"parts.bar.merge_with", "give the part `rigid: true`"});
+  expect_error(hg, "    rigid: true\n    merge_with: nothing\n",
+               {"parts.bar.merge_with", "part 'nothing' is not defined"});
+  expect_error(hg, "    rigid: true\n    merge_with: bar\n", {"comes back to itself"});
 }
 
 TEST(Deck, PartEnergiesFlag) {

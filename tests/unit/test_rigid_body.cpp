@@ -268,9 +268,10 @@ TEST(RigidBody, HeldComponentsTakeTheirValues) {
 //    the corner not at all (1e-12 relative), and the impulse reported is the change of the
 //    normal momentum (1e-12 relative). With friction mu the impulse in the wall's plane is
 //    at most mu times the normal one (Coulomb) and slows the corner's sliding. The spin
-//    about z held: it keeps its value and the free spin changes by the free rows of the
-//    inertia alone (1e-12). Every component held, or every translation: the wall leaves
-//    the body its motion.
+//    about z held: it keeps its value, the free spin changes by the free rows of the
+//    inertia alone (1e-12) and the hold takes the rest of the torque (1e-9); the y
+//    translation held: the hold takes the impulse's y component (1e-12). Every component held, or
+//    every translation: the wall leaves the body its motion.
 TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   const std::vector<RigidPoint> p = brick();
   double M = 0;
@@ -313,7 +314,7 @@ TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   BodyWallScratch scratch;
   std::vector<WallImpulse> out;
   const std::vector<WallPlane> walls{wall};
-  EXPECT_GT(apply_walls_to_body(p, walls, RigidHold{}, m, scratch, out), 0);
+  EXPECT_GT(apply_walls_to_body(p, walls, RigidHold{}, 0.5 * m0.dt, m, scratch, out), 0);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].point, 0u);
   EXPECT_EQ(out[0].wall, 0);
@@ -328,7 +329,7 @@ TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   RigidMotion mf = m0;
   const std::vector<WallPlane> rough{{wall.point, n, 0.2}};
   out.clear();
-  EXPECT_GT(apply_walls_to_body(p, rough, RigidHold{}, mf, scratch, out), 0);
+  EXPECT_GT(apply_walls_to_body(p, rough, RigidHold{}, 0.5 * m0.dt, mf, scratch, out), 0);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_NEAR(landing(mf, p[0]), 0.0, 1e-12 * step);
   const Vec3 dPf = M * (mf.velocity - m0.velocity);
@@ -346,7 +347,7 @@ TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   all.spin_held = {true, true, true};
   RigidMotion mh = m0;
   out.clear();
-  apply_walls_to_body(p, walls, all, mh, scratch, out);
+  apply_walls_to_body(p, walls, all, 0.5 * m0.dt, mh, scratch, out);
   EXPECT_TRUE(out.empty());
   EXPECT_EQ(norm(mh.velocity - m0.velocity), 0.0);
   EXPECT_EQ(norm(mh.omega - m0.omega), 0.0);
@@ -357,7 +358,7 @@ TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   spin_z.spin = m0.omega;
   RigidMotion mz = m0;
   out.clear();
-  ASSERT_GT(apply_walls_to_body(p, walls, spin_z, mz, scratch, out), 0);
+  ASSERT_GT(apply_walls_to_body(p, walls, spin_z, 0.5 * m0.dt, mz, scratch, out), 0);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(mz.omega.z, m0.omega.z);
   EXPECT_NEAR(landing(mz, p[0]), 0.0, 1e-12 * step);
@@ -375,7 +376,23 @@ TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
     const double wx = (d * tau.x - b * tau.y) / det, wy = (a * tau.y - b * tau.x) / det;
     EXPECT_NEAR(mz.omega.x - m0.omega.x, wx, 1e-12 * std::abs(wx));
     EXPECT_NEAR(mz.omega.y - m0.omega.y, wy, 1e-12 * std::abs(wy));
+    // The hold takes the rest of the torque about z, I_zf d omega_f - tau_z, per dt_avg
+    // (QA round 38: the reactions left the walls out).
+    const double mz_expected = (-J[2][0] * wx - J[2][1] * wy - tau.z) / (0.5 * m0.dt);
+    EXPECT_NEAR(mz.held_torque.z, mz_expected, 1e-9 * std::abs(mz_expected));
   }
+  // The y translation held: the hold takes the impulse's y component.
+  RigidHold y_held;
+  y_held.velocity_held = {false, true, false};
+  y_held.velocity = m0.velocity;
+  RigidMotion my = m0;
+  out.clear();
+  ASSERT_GT(apply_walls_to_body(p, walls, y_held, 0.5 * m0.dt, my, scratch, out), 0);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(my.velocity.y, m0.velocity.y);
+  EXPECT_NEAR(landing(my, p[0]), 0.0, 1e-12 * step);
+  EXPECT_NEAR(my.held_force.y, -out[0].impulse * n.y / (0.5 * m0.dt),
+              1e-12 * out[0].impulse / m0.dt);
   // The translations held, the spins free: turning alone cannot take a body off a wall in
   // general, and the wall leaves it alone as it leaves a node held across it (QA round 37:
   // a body driven into a wall was spun to 2e6 rad/s).
@@ -384,7 +401,7 @@ TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   driven.velocity = m0.velocity;
   RigidMotion md = m0;
   out.clear();
-  EXPECT_EQ(apply_walls_to_body(p, walls, driven, md, scratch, out), 0);
+  EXPECT_EQ(apply_walls_to_body(p, walls, driven, 0.5 * m0.dt, md, scratch, out), 0);
   EXPECT_TRUE(out.empty());
   EXPECT_EQ(norm(md.omega - m0.omega), 0.0);
 }

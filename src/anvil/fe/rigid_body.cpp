@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace anvil {
 
@@ -125,6 +126,7 @@ RigidMotion rigid_motion(std::span<const RigidPoint> p, const Vec3& g, double dt
   inertia_of(J, I);
   Vec3 omega = solve_held(I, L);
   out.converged = false;
+  double last_change = std::numeric_limits<double>::infinity();
   const bool all_held = hold.spin_held[0] && hold.spin_held[1] && hold.spin_held[2];
   for (int it = 0; it < 100 && !all_held; ++it) {
     const Vec3 a = 0.5 * dt * omega;
@@ -147,10 +149,15 @@ RigidMotion rigid_motion(std::span<const RigidPoint> p, const Vec3& g, double dt
     const Vec3 next = solve_held(I, L);
     const double change = norm(next - omega);
     omega = next;
-    if (change <= 1e-14 * norm(omega)) {
+    // Settled to round-off, or no longer settling at round-off's level: a slender body's
+    // inertia, ill-conditioned, held the change at 1.1e-14 of omega, flipping between two
+    // values, and the run stopped as if it spun too fast (QA round 38: a bar turning 5e-4
+    // rad a step).
+    if (change <= 1e-14 * norm(omega) || (change >= last_change && change <= 1e-10 * norm(omega))) {
       out.converged = true;
       break;
     }
+    last_change = change;
   }
   // The physical root has |omega| dt / 2 <= 1 (about a principal axis the fixed point is
   // a = a0 (1 + a^2), a = omega dt / 2, whose smaller root is at most 1); the iteration can
@@ -180,8 +187,8 @@ RigidMotion rigid_motion(std::span<const RigidPoint> p, const Vec3& g, double dt
 }
 
 int apply_walls_to_body(std::span<const RigidPoint> p, std::span<const WallPlane> walls,
-                        const RigidHold& hold, RigidMotion& motion, BodyWallScratch& scratch,
-                        std::vector<WallImpulse>& out) {
+                        const RigidHold& hold, double dt_avg, RigidMotion& motion,
+                        BodyWallScratch& scratch, std::vector<WallImpulse>& out) {
   const double dt = motion.dt;
   if (!(dt > 0) || walls.empty() || p.empty() || !(motion.mass > 0)) return 0;
   const Vec3 c = motion.centre;
@@ -218,6 +225,10 @@ int apply_walls_to_body(std::span<const RigidPoint> p, std::span<const WallPlane
     for (int j = 0; j < 3; ++j) I[i][j] = (i == j ? trJ : 0.0) - J[i][j];
   const bool all_held = hold.spin_held[0] && hold.spin_held[1] && hold.spin_held[2];
   const double trI = I[0][0] + I[1][1] + I[2][2];
+  Mat3 I_full; // (before the held rows give way: the torque the holds take, below)
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) I_full[i][j] = I[i][j];
+  const Vec3 omega_before = motion.omega;
   for (int i = 0; i < 3; ++i)
     if (hold.spin_held[static_cast<std::size_t>(i)])
       for (int j = 0; j < 3; ++j) I[i][j] = i == j ? trI : 0.0;
@@ -251,15 +262,21 @@ int apply_walls_to_body(std::span<const RigidPoint> p, std::span<const WallPlane
     const Vec3 rd = cross(r, dir);
     return dot(dir, dv(dir)) + dot(rd, dw(rd));
   };
-  double scale = 0;
+  // The speeds' scale, and a floor under it for a body at rest on a wall, whose speeds are
+  // round-off (QA round 38: a cube at rest after landing flat stopped the run): the speed
+  // that moves the body by 1e-6 of its size in a step.
+  double scale = 0, extent = 0;
+  for (const auto& q : p) extent = std::max(extent, norm(q.x - c));
   for (auto& row : rows) {
     row.k = response(row.r, walls[static_cast<std::size_t>(row.wall)].normal);
     scale = std::max(scale, std::abs(row.target) + norm(motion.point_velocity(p[row.point].x)));
   }
-  // Settled to 1e-9 of the speeds (a landing behind the wall by 1e-9 of a step's motion);
-  // points on a line or a face are redundant constraints, which the sweeps settle slowly,
-  // and friction more slowly still: at most 500 sweeps.
-  const double tol = 1e-9 * scale;
+  scale = std::max(scale, 1e-6 * extent / dt);
+  // Settled to 1e-12 of the speeds (a landing behind the wall by 1e-12 of a step's
+  // motion); points on a line or a face are redundant constraints, which the sweeps settle
+  // slowly, and friction more slowly still: at most 500 sweeps, whatever is left then
+  // corrected the next step.
+  const double tol = 1e-12 * scale;
   int sweep = 0;
   for (double worst = 2 * tol + 1; sweep < 500 && worst > tol;) {
     ++sweep;
@@ -305,6 +322,25 @@ int apply_walls_to_body(std::span<const RigidPoint> p, std::span<const WallPlane
   }
   for (const auto& row : rows)
     if (row.lambda > 0) out.push_back({row.point, row.wall, row.lambda});
+  // What the holds take of the walls' impulses (their reactions, as of the forces'): a held
+  // translation all of the impulses along it; a held spin what its row of I d omega = the
+  // impulses' torque leaves over, d omega being the free components' change.
+  Vec3 J_all{0, 0, 0}, T_all{0, 0, 0};
+  for (const auto& row : rows) {
+    const Vec3 J = row.lambda * walls[static_cast<std::size_t>(row.wall)].normal + row.jt;
+    J_all += J;
+    T_all += cross(row.r, J);
+  }
+  if (dt_avg > 0)
+    for (int i = 0; i < 3; ++i) {
+      if (hold.velocity_held[static_cast<std::size_t>(i)])
+        motion.held_force[i] -= J_all[i] / dt_avg;
+      if (hold.spin_held[static_cast<std::size_t>(i)]) {
+        double Idw = 0;
+        for (int j = 0; j < 3; ++j) Idw += I_full[i][j] * (motion.omega[j] - omega_before[j]);
+        motion.held_torque[i] += (Idw - T_all[i]) / dt_avg;
+      }
+    }
   double left = 0;
   for (const auto& row : rows)
     if (row.k > 0)
@@ -312,8 +348,8 @@ int apply_walls_to_body(std::span<const RigidPoint> p, std::span<const WallPlane
                                              motion.point_velocity(p[row.point].x)));
   // (QA round 37's spin-up is excluded above; what is left after the sweeps is a landing
   // behind the wall by a small part of a step's motion, corrected the next step, unless it
-  // is gross.)
-  return left > 1e-3 * scale ? -sweep : sweep;
+  // is gross: 1e-3 of the body's size.)
+  return left * dt > 1e-3 * extent ? -sweep : sweep;
 }
 
 } // namespace anvil

@@ -100,16 +100,18 @@ struct BodyWallScratch {
 // points that put each of them on its wall at t(n) + dt (or leave it in front), pushing and
 // never pulling; friction then opposes each such point's sliding by at most mu times its
 // normal impulse. The impulses solve the constraints together, point after point in the
-// order given, repeated until every landing is on or in front of its wall to 1e-9 of the
-// speeds (projected Gauss-Seidel, at most 500 sweeps). Held components do not change (they
-// take the impulse, as a fixed node does), and a wall nearly square to every free
+// order given, repeated until every landing is on or in front of its wall to 1e-12 of the
+// speeds (at least 1e-6 of the body's size per step: at rest they are round-off;
+// projected Gauss-Seidel, at most 500 sweeps). Held components do not change (they
+// take the impulse, as a fixed node does: motion.held_force and held_torque, per dt_avg, add
+// what they take of it), and a wall nearly square to every free
 // translation (the free part n_f of its normal, |n_f|^2 <= 1e-6) leaves the body alone, as
 // it leaves a node: the held motion wins. The inertia is that of the points at t(n) about
 // the motion's centre. Appends each normal impulse to `out`; returns the sweeps made (0: no
 // point behind a wall, the motion unchanged), negated when some point still lands behind
-// its wall by more than 1e-3 of the speeds after them.
+// its wall by more than 1e-3 of the body's size after them.
 int apply_walls_to_body(std::span<const RigidPoint> p, std::span<const WallPlane> walls,
-                        const RigidHold& hold, RigidMotion& motion, BodyWallScratch& scratch,
-                        std::vector<WallImpulse>& out);
+                        const RigidHold& hold, double dt_avg, RigidMotion& motion,
+                        BodyWallScratch& scratch, std::vector<WallImpulse>& out);
 
 } // namespace anvil

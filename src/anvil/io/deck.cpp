@@ -511,6 +511,8 @@ PartConfig parse_part(const std::string& name, const Node& n, const std::string&
   if (n.has("merge_with")) {
     p.merge_with = n.child("merge_with").str();
     p.merge_where = n.child("merge_with").where();
+    if (p.merge_with.empty())
+      n.child("merge_with").fail("give the name of the rigid part whose body this one joins");
     if (!p.rigid)
       n.child("merge_with")
           .fail("merge_with joins a rigid part to another's body: give the part `rigid: true`");

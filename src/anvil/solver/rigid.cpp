@@ -274,7 +274,7 @@ void Simulation::move_rigid_bodies(bool with_contact) {
     // change beyond the forces' is the constraints' (external) work, as a held component's.
     // Each point's normal impulse is a hit of its wall on the rank that owns its node.
     body_wall_impulses_.clear();
-    if (apply_walls_to_body(pts, wall_planes_, hold, rigid_motion_[o], body_wall_scratch_,
+    if (apply_walls_to_body(pts, wall_planes_, hold, dt_avg_, rigid_motion_[o], body_wall_scratch_,
                             body_wall_impulses_) < 0)
       throw PhysicsError(fmt::format("rigid part {}", config_.parts[rigid_part_[o]].name),
                          clock_.time,
