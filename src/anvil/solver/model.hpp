@@ -34,7 +34,9 @@ std::vector<SideEntry> resolve_surface(const Mesh& mesh, const Config& config,
 // the body (behind the plane of each of its six faces, through the face's centre with the
 // normal of its diagonals, by more than 1e-6 of the element's size where the face bounds
 // the blocks: a point on the body's surface is not inside, one on a face between two
-// elements is), leaving out the elements of which it is a corner (`node[i]`: the point's
+// elements is; nor is a point within 1e-6 of a face's size of a face bounding the holding
+// element's block, which tetrahedra and wedges reach by a corner or an edge only), leaving
+// out the elements of which it is a corner (`node[i]`: the point's
 // global node id, or -1 for a particle); -1 where none does. The points are binned on a
 // grid of the elements' mean size; exact for flat faces, a warning's accuracy for warped
 // ones.
