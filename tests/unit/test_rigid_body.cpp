@@ -289,15 +289,16 @@ TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   m0.omega = {0.4, -0.3, 0.2};
   m0.dt = 0.01;
   m0.mass = M;
+  // The second moment of the points about the centre, J = sum m r r^T (I = tr(J) 1 - J).
+  double J[3][3] = {};
+  for (const auto& q : p) {
+    const Vec3 r = q.x - c;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) J[i][j] += q.m * r[i] * r[j];
+  }
+  const double tr = J[0][0] + J[1][1] + J[2][2];
   // Angular momentum about a point x_P at t(n): I omega + M (c - x_P) x v_c.
   auto momentum_about = [&](const RigidMotion& m, const Vec3& xp) {
-    double J[3][3] = {};
-    for (const auto& q : p) {
-      const Vec3 r = q.x - c;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) J[i][j] += q.m * r[i] * r[j];
-    }
-    const double tr = J[0][0] + J[1][1] + J[2][2];
     Vec3 L{0, 0, 0};
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) L[i] += ((i == j ? tr : 0.0) - J[i][j]) * m.omega[j];
@@ -310,11 +311,19 @@ TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   for (std::size_t k = 1; k < p.size(); ++k) ASSERT_GT(landing(m0, p[k]), 0.0);
   const double step = m0.dt * norm(m0.point_velocity(p[0].x));
 
-  RigidMotion m = m0;
   BodyWallScratch scratch;
   std::vector<WallImpulse> out;
+  // The motion m0 after the walls, with the holds `hold`; `sweeps` what the solver returned.
+  int sweeps = 0;
+  auto after = [&](const std::vector<WallPlane>& w, const RigidHold& hold) {
+    RigidMotion m = m0;
+    out.clear();
+    sweeps = apply_walls_to_body(p, w, hold, 0.5 * m0.dt, m, scratch, out);
+    return m;
+  };
   const std::vector<WallPlane> walls{wall};
-  EXPECT_GT(apply_walls_to_body(p, walls, RigidHold{}, 0.5 * m0.dt, m, scratch, out), 0);
+  const RigidMotion m = after(walls, RigidHold{});
+  EXPECT_GT(sweeps, 0);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].point, 0u);
   EXPECT_EQ(out[0].wall, 0);
@@ -326,10 +335,8 @@ TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   const Vec3 L0 = momentum_about(m0, p[0].x), L1 = momentum_about(m, p[0].x);
   EXPECT_LT(norm(L1 - L0), 1e-12 * norm(L0));
   // Friction.
-  RigidMotion mf = m0;
-  const std::vector<WallPlane> rough{{wall.point, n, 0.2}};
-  out.clear();
-  EXPECT_GT(apply_walls_to_body(p, rough, RigidHold{}, 0.5 * m0.dt, mf, scratch, out), 0);
+  const RigidMotion mf = after({{wall.point, n, 0.2}}, RigidHold{});
+  EXPECT_GT(sweeps, 0);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_NEAR(landing(mf, p[0]), 0.0, 1e-12 * step);
   const Vec3 dPf = M * (mf.velocity - m0.velocity);
@@ -345,9 +352,7 @@ TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   RigidHold all;
   all.velocity_held = {true, true, true};
   all.spin_held = {true, true, true};
-  RigidMotion mh = m0;
-  out.clear();
-  apply_walls_to_body(p, walls, all, 0.5 * m0.dt, mh, scratch, out);
+  const RigidMotion mh = after(walls, all);
   EXPECT_TRUE(out.empty());
   EXPECT_EQ(norm(mh.velocity - m0.velocity), 0.0);
   EXPECT_EQ(norm(mh.omega - m0.omega), 0.0);
@@ -356,20 +361,12 @@ TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   RigidHold spin_z;
   spin_z.spin_held = {false, false, true};
   spin_z.spin = m0.omega;
-  RigidMotion mz = m0;
-  out.clear();
-  ASSERT_GT(apply_walls_to_body(p, walls, spin_z, 0.5 * m0.dt, mz, scratch, out), 0);
+  const RigidMotion mz = after(walls, spin_z);
+  ASSERT_GT(sweeps, 0);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(mz.omega.z, m0.omega.z);
   EXPECT_NEAR(landing(mz, p[0]), 0.0, 1e-12 * step);
   {
-    double J[3][3] = {};
-    for (const auto& q : p) {
-      const Vec3 r = q.x - c;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) J[i][j] += q.m * r[i] * r[j];
-    }
-    const double tr = J[0][0] + J[1][1] + J[2][2];
     const double a = tr - J[0][0], b = -J[0][1], d = tr - J[1][1]; // I_ff, 2 x 2
     const Vec3 tau = out[0].impulse * cross(p[0].x - c, n);
     const double det = a * d - b * b;
@@ -385,9 +382,8 @@ TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   RigidHold y_held;
   y_held.velocity_held = {false, true, false};
   y_held.velocity = m0.velocity;
-  RigidMotion my = m0;
-  out.clear();
-  ASSERT_GT(apply_walls_to_body(p, walls, y_held, 0.5 * m0.dt, my, scratch, out), 0);
+  const RigidMotion my = after(walls, y_held);
+  ASSERT_GT(sweeps, 0);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(my.velocity.y, m0.velocity.y);
   EXPECT_NEAR(landing(my, p[0]), 0.0, 1e-12 * step);
@@ -399,9 +395,8 @@ TEST(RigidBody, WallsPushAtTheCornerThatReachesThem) {
   RigidHold driven;
   driven.velocity_held = {true, true, true};
   driven.velocity = m0.velocity;
-  RigidMotion md = m0;
-  out.clear();
-  EXPECT_EQ(apply_walls_to_body(p, walls, driven, 0.5 * m0.dt, md, scratch, out), 0);
+  const RigidMotion md = after(walls, driven);
+  EXPECT_EQ(sweeps, 0);
   EXPECT_TRUE(out.empty());
   EXPECT_EQ(norm(md.omega - m0.omega), 0.0);
 }

@@ -74,6 +74,47 @@ namespace {
 
 using namespace anvil;
 
+// The momenta of a rigid body whose nodes are the owned ones left of x = 0.5 (the decks'
+// other part lies beyond): mass, centre, the centre's velocity and the angular momentum
+// about the centre (collective).
+struct BodyMoments {
+  double mass = 0;
+  Vec3 centre, velocity, L;
+};
+BodyMoments body_moments(const Simulation& sim, const Comm& world) {
+  const auto& nd = sim.nodes();
+  BodyMoments b;
+  double m = 0;
+  Vec3 p{0, 0, 0}, mx{0, 0, 0};
+  for (std::size_t n = 0; n < nd.size(); ++n) {
+    if (!sim.fe().node_owned[n] || nd.x[0][n] > 0.5) continue;
+    m += nd.mass[n];
+    p += nd.mass[n] * Vec3{nd.v[0][n], nd.v[1][n], nd.v[2][n]};
+    mx += nd.mass[n] * Vec3{nd.x[0][n], nd.x[1][n], nd.x[2][n]};
+  }
+  b.mass = world.sum(m);
+  for (int i = 0; i < 3; ++i) {
+    b.velocity[i] = world.sum(p[i]) / b.mass;
+    b.centre[i] = world.sum(mx[i]) / b.mass;
+  }
+  Vec3 l{0, 0, 0};
+  for (std::size_t n = 0; n < nd.size(); ++n) {
+    if (!sim.fe().node_owned[n] || nd.x[0][n] > 0.5) continue;
+    const Vec3 r = Vec3{nd.x[0][n], nd.x[1][n], nd.x[2][n]} - b.centre;
+    l += nd.mass[n] * cross(r, Vec3{nd.v[0][n], nd.v[1][n], nd.v[2][n]} - b.velocity);
+  }
+  for (int i = 0; i < 3; ++i) b.L[i] = world.sum(l[i]);
+  return b;
+}
+
+// How many values of two series differ in their bits.
+std::size_t differing_bits(const std::vector<double>& a, const std::vector<double>& b) {
+  std::size_t differing = 0;
+  for (std::size_t k = 0; k < a.size() && k < b.size(); ++k)
+    differing += std::memcmp(&a[k], &b[k], sizeof(double)) != 0;
+  return differing;
+}
+
 constexpr double L = 0.05, a = 0.002, rho = 7850, E = 200e9, nu = 0.3, v0 = 5.0;
 const double c_wave = std::sqrt(E * (1 - nu) / ((1 + nu) * (1 - 2 * nu)) / rho);
 const double t_contact = 2 * L / c_wave;
@@ -203,10 +244,8 @@ TEST(RigidBody, ElasticBarOnAHeavyFreeBlock) {
   if (world.rank() != 0) return;
   const BarRun one = run(Comm::self());
   ASSERT_EQ(one.probes.size(), r.probes.size());
-  std::size_t differing = 0;
-  for (std::size_t k = 0; k < r.probes.size(); ++k)
-    differing += std::memcmp(&one.probes[k], &r.probes[k], sizeof(double)) != 0;
-  EXPECT_EQ(differing, 0u) << "probe values differing from the one-rank run";
+  EXPECT_EQ(differing_bits(one.probes, r.probes), 0u)
+      << "probe values differing from the one-rank run";
 }
 
 // What rigid bodies do not support is an input error on every rank (no rank left waiting):
@@ -351,32 +390,8 @@ initial_conditions:
 )");
   Simulation sim(config, world);
   // The body's nodes (those left of x = 0.5), their momentum and angular momentum.
-  auto moments = [&](Vec3& v_c, Vec3& L, Vec3& centre, double& M) {
-    const auto& nd = sim.nodes();
-    double m = 0;
-    Vec3 p{0, 0, 0}, mx{0, 0, 0};
-    for (std::size_t n = 0; n < nd.size(); ++n) {
-      if (!sim.fe().node_owned[n] || nd.x[0][n] > 0.5) continue;
-      m += nd.mass[n];
-      p += nd.mass[n] * Vec3{nd.v[0][n], nd.v[1][n], nd.v[2][n]};
-      mx += nd.mass[n] * Vec3{nd.x[0][n], nd.x[1][n], nd.x[2][n]};
-    }
-    M = world.sum(m);
-    for (int i = 0; i < 3; ++i) {
-      v_c[i] = world.sum(p[i]) / M;
-      centre[i] = world.sum(mx[i]) / M;
-    }
-    Vec3 l{0, 0, 0};
-    for (std::size_t n = 0; n < nd.size(); ++n) {
-      if (!sim.fe().node_owned[n] || nd.x[0][n] > 0.5) continue;
-      const Vec3 r = Vec3{nd.x[0][n], nd.x[1][n], nd.x[2][n]} - centre;
-      l += nd.mass[n] * cross(r, Vec3{nd.v[0][n], nd.v[1][n], nd.v[2][n]} - v_c);
-    }
-    for (int i = 0; i < 3; ++i) L[i] = world.sum(l[i]);
-  };
-  Vec3 v0, L0, c0;
-  double M = 0;
-  moments(v0, L0, c0, M);
+  const BodyMoments start = body_moments(sim, world);
+  const Vec3 v0 = start.velocity, L0 = start.L, c0 = start.centre;
   // At t = 0 the centre moves at V and the spin is omega about it: L = I omega.
   const Vec3 V{3.0, -2.0, 1.0}, w{40.0, 70.0, 300.0};
   Vec3 Iw{0, 0, 0};
@@ -393,8 +408,8 @@ initial_conditions:
   EXPECT_LT(norm(v0 - V), 1e-12 * norm(V));
   EXPECT_LT(norm(L0 - Iw), 1e-12 * norm(Iw));
   while (!sim.finished()) sim.step();
-  Vec3 v1, L1, c1;
-  moments(v1, L1, c1, M);
+  const BodyMoments end = body_moments(sim, world);
+  const Vec3 v1 = end.velocity, L1 = end.L;
   // v(n - 1/2) at the end: the centre's velocity is V, and the angular momentum kept.
   if (world.rank() == 0)
     std::printf("rigid body about its centre of mass: centre velocity off by %.2e of |V|, "
@@ -670,10 +685,8 @@ TEST(RigidBody, FreeBodyLandsOnAWall) {
   if (world.rank() != 0) return;
   const WallDrop one = drop_on_wall(Comm::self());
   ASSERT_EQ(one.rows.size(), r.rows.size());
-  std::size_t differing = 0;
-  for (std::size_t k = 0; k < r.rows.size(); ++k)
-    differing += std::memcmp(&one.rows[k], &r.rows[k], sizeof(double)) != 0;
-  EXPECT_EQ(differing, 0u) << "wall forces and body motions differing from the one-rank run";
+  EXPECT_EQ(differing_bits(one.rows, r.rows), 0u)
+      << "wall forces and body motions differing from the one-rank run";
 }
 
 TEST(RigidBody, MergedPartsMoveAsOneBody) {
@@ -754,36 +767,10 @@ boundary_conditions:
   - {part: dummy, fix: all}
 )"),
                  world);
-  // The bar's angular momentum about its centre of mass, from its owned nodes.
-  auto momentum = [&] {
-    const auto& nd = sim.nodes();
-    double m = 0;
-    Vec3 mx{0, 0, 0}, p{0, 0, 0};
-    for (std::size_t n = 0; n < nd.size(); ++n) {
-      if (!sim.fe().node_owned[n] || nd.x[0][n] > 0.5) continue;
-      m += nd.mass[n];
-      mx += nd.mass[n] * Vec3{nd.x[0][n], nd.x[1][n], nd.x[2][n]};
-      p += nd.mass[n] * Vec3{nd.v[0][n], nd.v[1][n], nd.v[2][n]};
-    }
-    const double M = world.sum(m);
-    Vec3 c, v;
-    for (int i = 0; i < 3; ++i) {
-      c[i] = world.sum(mx[i]) / M;
-      v[i] = world.sum(p[i]) / M;
-    }
-    Vec3 L{0, 0, 0};
-    for (std::size_t n = 0; n < nd.size(); ++n) {
-      if (!sim.fe().node_owned[n] || nd.x[0][n] > 0.5) continue;
-      L += nd.mass[n] * cross(Vec3{nd.x[0][n], nd.x[1][n], nd.x[2][n]} - c,
-                              Vec3{nd.v[0][n], nd.v[1][n], nd.v[2][n]} - v);
-    }
-    for (int i = 0; i < 3; ++i) L[i] = world.sum(L[i]);
-    return L;
-  };
   sim.step();
-  const Vec3 L0 = momentum();
+  const Vec3 L0 = body_moments(sim, world).L;
   while (!sim.finished()) sim.step(); // (threw "spins too fast" at 0.29 ms)
-  const Vec3 L1 = momentum();
+  const Vec3 L1 = body_moments(sim, world).L;
   if (world.rank() == 0)
     std::printf("slender bar tumbling: t = %.3g s, angular momentum change %.1e\n",
                 sim.clock().time, norm(L1 - L0) / norm(L0));
